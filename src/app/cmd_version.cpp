@@ -1,0 +1,17 @@
+// `panoptes version`: prints the version and the libraries Panoptes was built with.
+#include <cstdio>
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+}
+
+#include "app/command.hpp"
+
+namespace {
+panoptes::app::CommandRegistration reg([](CLI::App& root) {
+  auto* sub = root.add_subcommand("version", "Print the Panoptes version and the versions of its libraries");
+  sub->callback([] {
+    std::printf("panoptes 0.1.0\nlibavcodec %s\n", AV_STRINGIFY(LIBAVCODEC_VERSION));
+  });
+});
+}  // namespace

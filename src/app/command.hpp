@@ -1,0 +1,24 @@
+#pragma once
+// Subcommands register themselves here, so each lives in its own thin cmd_<name>.cpp.
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace panoptes::app {
+
+/// Adds a subcommand (options + callback) to the root `panoptes` app. Callbacks report failures by
+/// throwing; main() prints them as one line and exits non-zero.
+using CommandSetup = std::function<void(CLI::App& root)>;
+
+/// Registers a subcommand at static-initialization time: `static CommandRegistration r([](CLI::App& root){...});`
+struct CommandRegistration {
+  explicit CommandRegistration(CommandSetup setup);
+};
+
+/// Runs every registered setup on root (in name order of registration files).
+void add_registered_commands(CLI::App& root);
+
+/// Exit code a callback may set to end the program with a status other than 0 without an error line.
+int& exit_code();
+
+}  // namespace panoptes::app

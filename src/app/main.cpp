@@ -1,0 +1,46 @@
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "app/command.hpp"
+#include "core/error.hpp"
+
+namespace panoptes::app {
+namespace {
+std::vector<CommandSetup>& registry() {
+  static std::vector<CommandSetup> r;
+  return r;
+}
+}  // namespace
+
+CommandRegistration::CommandRegistration(CommandSetup setup) { registry().push_back(std::move(setup)); }
+
+void add_registered_commands(CLI::App& root) {
+  for (auto& setup : registry()) setup(root);
+}
+
+int& exit_code() {
+  static int code = 0;
+  return code;
+}
+
+}  // namespace panoptes::app
+
+int main(int argc, char** argv) {
+  CLI::App root{
+      "Panoptes: in-situ visualization from very many cameras, kept as compressed movies, explored "
+      "interactively afterwards.",
+      "panoptes"};
+  root.set_version_flag("--version", "panoptes 0.1.0");
+  root.require_subcommand(1);
+  panoptes::app::add_registered_commands(root);
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return root.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "panoptes: error: %s\n", e.what());
+    return 1;
+  }
+  return panoptes::app::exit_code();
+}

@@ -1,0 +1,53 @@
+#pragma once
+// Reads a movie written by MovieWriter (or any H.264 MP4): exact random access and sequential decode.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/image.hpp"
+
+namespace panoptes::video {
+
+/// A decoded frame as planar YUV 4:2:0 (BT.601 limited range, as written), ready for GPU upload.
+/// Planes are tightly packed: y has width*height bytes, u and v ((width+1)/2)*((height+1)/2).
+struct YuvFrame {
+  int width = 0, height = 0;
+  int index = -1;  ///< frame number in the movie
+  std::vector<std::uint8_t> y, u, v;
+};
+
+/// An open movie. Not thread-safe: use one reader per thread.
+class MovieReader {
+ public:
+  /// Opens the file and indexes its packets (no decoding). Throws FileError if the file is missing,
+  /// not a movie, or holds no decodable video stream. A truncated movie opens with the frames it has.
+  explicit MovieReader(const std::string& path);
+  ~MovieReader();
+  MovieReader(const MovieReader&) = delete;
+  MovieReader& operator=(const MovieReader&) = delete;
+
+  /// Crops decoded frames to width x height (to remove the padding of odd sizes; see the manifest).
+  /// Throws Error if larger than the coded size.
+  void set_crop(int width, int height);
+
+  int frame_count() const;
+  double fps() const;
+  double duration() const;  ///< seconds: frame_count() / fps()
+  int width() const;        ///< after cropping
+  int height() const;
+  const std::string& path() const;
+
+  /// Decodes exactly frame `index` (seeks to the keyframe at or before it, decodes forward; consecutive
+  /// indices decode without seeking). Throws Error if index is out of range or the frame is unreadable.
+  void read(int index, YuvFrame& out);
+  Image read_rgba(int index);
+  /// Converts a decoded frame to RGBA (for screenshots, tests, export; not the display path).
+  static Image to_rgba(const YuvFrame& frame);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace panoptes::video

@@ -1,0 +1,44 @@
+#pragma once
+// Writes 8-bit RGB(A) frames as an H.264 (yuv420p) fragmented MP4 that stays readable up to its last
+// flushed fragment if the process dies.
+#include <memory>
+#include <string>
+
+#include "core/image.hpp"
+#include "video/video_settings.hpp"
+
+namespace panoptes::video {
+
+/// One movie being written. Frames must all have the size given at construction. Odd sizes are
+/// padded (edge pixels repeated) to the even size H.264 4:2:0 needs; padded_width()/padded_height()
+/// report it so the manifest can record the padding and readers crop it off.
+class MovieWriter {
+ public:
+  /// Creates (or truncates) the file. Throws FileError if it cannot be created, Error on bad settings.
+  MovieWriter(const std::string& path, int width, int height, const VideoSettings& settings = {});
+  ~MovieWriter();  ///< Closes the movie if still open; never throws.
+  MovieWriter(const MovieWriter&) = delete;
+  MovieWriter& operator=(const MovieWriter&) = delete;
+
+  /// Encodes one frame (3 or 4 channels). Throws Error if its size differs from the movie's,
+  /// FileError if writing fails (e.g. disk full).
+  void append(const Image& frame);
+  /// Makes every appended frame durable in the file: drains the encoder's delay and writes a
+  /// fragment. After flush() returns, a reader sees frames_written() frames even if the process dies.
+  void flush();
+  /// Writes the trailer and closes the file. Further appends throw.
+  void close();
+
+  int frames_written() const;
+  int width() const;
+  int height() const;
+  int padded_width() const;
+  int padded_height() const;
+  const std::string& path() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace panoptes::video

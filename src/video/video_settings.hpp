@@ -1,0 +1,19 @@
+#pragma once
+// Encoder settings of a movie; stored in the manifest so a database says how it was made.
+#include <string>
+
+namespace panoptes::video {
+
+/// H.264 (libx264) settings. Defaults are chosen by measurement: see docs/formats.md.
+struct VideoSettings {
+  int crf = 23;                        ///< constant rate factor, 0 (lossless) .. 51
+  std::string preset = "veryfast";     ///< x264 preset name
+  int gop = 10;                        ///< keyframe interval in frames (1 = all intra)
+  int threads = 1;                     ///< encoder threads per movie (many movies encode in parallel)
+  double fps = 30;                     ///< nominal playback frame rate
+
+  /// Throws panoptes::Error naming the bad field if a value is out of range.
+  void validate() const;
+};
+
+}  // namespace panoptes::video
