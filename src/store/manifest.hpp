@@ -1,0 +1,189 @@
+#pragma once
+// The manifest of a movie database (`panoptes.json`): plain data + versioned JSON (de)serialization.
+// Its size grows with cameras + tasks, never cameras × tasks: streams are found by a file-name pattern.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/vec3.hpp"
+#include "video/video_settings.hpp"
+
+namespace panoptes::store {
+
+/// Schema version this build writes; reading any other version is refused with a clear error.
+inline constexpr int kSchemaVersion = 1;
+/// File name of the manifest inside the database directory.
+inline constexpr const char* kManifestFileName = "panoptes.json";
+/// Default movie file-name pattern, relative to the database directory.
+inline constexpr const char* kDefaultMoviePattern = "movies/c{camera}/t{task}.mp4";
+
+/// Who made the database, when and how.
+struct Provenance {
+  std::string program;       ///< e.g. "panoptes synth-db", "seismic demo", "mysim"
+  std::string version;       ///< program version
+  std::string created;       ///< ISO 8601 UTC time, e.g. "2026-11-21T22:40:00Z"
+  std::string host;          ///< host name of the writer (rank 0)
+  std::string command_line;  ///< the command that produced it
+  std::map<std::string, std::string> extra;  ///< free-form key/value notes
+  bool operator==(const Provenance&) const = default;
+};
+
+/// The simulation domain the images show (informational; the player shows it in its HUD).
+struct Domain {
+  std::array<std::int64_t, 3> dims{0, 0, 0};  ///< grid points per axis (0 = unknown)
+  Vec3 origin{0, 0, 0};
+  Vec3 spacing{1, 1, 1};
+  std::string units;  ///< length unit, e.g. "m", "km"; empty = dimensionless
+  bool operator==(const Domain&) const = default;
+};
+
+/// Size of every frame of every stream. Movies are coded at padded_* (even, for 4:2:0) and
+/// readers crop to width x height.
+struct ImageSize {
+  int width = 0, height = 0;
+  int padded_width = 0, padded_height = 0;  ///< 0 = not yet known (set by DatabaseWriter::create)
+  bool operator==(const ImageSize&) const = default;
+};
+
+/// Labels of a camera, for the HUD and for navigation.
+struct CameraLabels {
+  std::string patch;     ///< rig patch, e.g. "yin", "yang", "fibonacci"; empty if none
+  double lat_deg = 0;    ///< latitude of the viewing direction seen from the look-at point
+  double lon_deg = 0;    ///< longitude, degrees
+  int shell = 0;         ///< index of the radius shell (0 = outermost or only)
+  std::map<std::string, std::string> extra;  ///< free-form labels
+  bool operator==(const CameraLabels&) const = default;
+};
+
+/// One camera. Its id is its index in Manifest::cameras (0..N-1); stored for readability and checked.
+struct CameraEntry {
+  int id = 0;
+  Vec3 position{0, 0, 1};
+  Vec3 look_at{0, 0, 0};
+  Vec3 up{0, 1, 0};
+  double fov_y_deg = 45;
+  CameraLabels labels;
+  bool operator==(const CameraEntry&) const = default;
+};
+
+/// How the cameras were placed (e.g. kind "yin-yang", parameters {"nlat":5,"nlon":13,"radius":3}).
+struct RigDescription {
+  std::string kind;
+  nlohmann::json parameters = nlohmann::json::object();
+  bool operator==(const RigDescription&) const = default;
+};
+
+/// Neighbours of one camera in the navigation graph; -1 = none.
+struct Neighbours {
+  int left = -1, right = -1, up = -1, down = -1;
+  int in = -1, out = -1;  ///< closer / farther shell
+  bool operator==(const Neighbours&) const = default;
+};
+
+/// The navigation graph: empty (no navigation data) or exactly one entry per camera.
+struct NavigationGraph {
+  std::vector<Neighbours> neighbours;
+  bool empty() const { return neighbours.empty(); }
+  bool operator==(const NavigationGraph&) const = default;
+};
+
+/// A parameter axis, e.g. {"isovalue", {0.1, 0.2, 0.3}}. Tasks sit at an index of some axes.
+struct ParameterAxis {
+  std::string name;
+  std::vector<double> values;
+  std::string units;  ///< optional
+  bool operator==(const ParameterAxis&) const = default;
+};
+
+/// The position of a task on one parameter axis: Manifest::axes[axis].values[index].
+struct AxisPosition {
+  std::string axis;  ///< name of a ParameterAxis
+  int index = 0;
+  bool operator==(const AxisPosition&) const = default;
+};
+
+/// One visualization task. Its id is its index in Manifest::tasks (0..K-1).
+struct TaskEntry {
+  int id = 0;
+  std::string name;                 ///< unique, e.g. "phi_s iso 0.2"
+  std::string method;               ///< "volume", "isosurface", "slice", "synthetic", ...
+  std::vector<std::string> fields;  ///< fields it reads
+  nlohmann::json parameters = nlohmann::json::object();  ///< method parameters
+  std::vector<AxisPosition> axes;   ///< where it sits on the parameter axes (may be empty)
+  bool operator==(const TaskEntry&) const = default;
+};
+
+/// Lifecycle of a database. `running` on disk with no live writer is reported as interrupted by
+/// Database::open (see database.hpp).
+enum class Status { running, complete, interrupted };
+
+std::string_view to_string(Status status);
+/// Parses "running" / "complete" / "interrupted"; throws Error otherwise.
+Status parse_status(std::string_view text);
+
+/// Everything a reader needs to know about a database.
+struct Manifest {
+  int schema_version = kSchemaVersion;
+  std::string title;
+  Provenance provenance;
+  Domain domain;
+  std::vector<double> times;  ///< simulation time of each frame (may be empty or longer than frames_written)
+  ImageSize image;
+  video::VideoSettings video;
+  std::vector<CameraEntry> cameras;
+  RigDescription rig;
+  NavigationGraph graph;
+  std::vector<TaskEntry> tasks;
+  std::vector<ParameterAxis> axes;
+  Status status = Status::running;
+  int frames_written = 0;  ///< complete snapshots: every stream holds at least this many frames
+  std::string movie_pattern = kDefaultMoviePattern;  ///< relative; must contain {camera} and {task}
+
+  int camera_count() const { return int(cameras.size()); }
+  int task_count() const { return int(tasks.size()); }
+  std::int64_t stream_count() const { return std::int64_t(cameras.size()) * std::int64_t(tasks.size()); }
+
+  /// Time of frame i: times[i] if present, else i.
+  double frame_time(int frame) const;
+  /// The stream's file name relative to the database directory (pattern expanded; not checked on disk).
+  /// Throws Error if camera or task is out of range.
+  std::string stream_relative_path(int camera, int task) const;
+
+  /// Index of the task with this name, or -1.
+  int find_task(std::string_view name) const;
+  /// Index of the axis with this name, or -1.
+  int find_axis(std::string_view name) const;
+  /// The task that sits at the same positions as `task` on every axis except `axis`, where its index
+  /// is moved by `delta`; -1 if there is none (end of the axis, or task not on that axis).
+  int step_task_on_axis(int task, std::string_view axis, int delta) const;
+
+  /// Checks internal consistency (ids, graph size and targets, axis references, pattern safety, image
+  /// size, video settings, frames_written). Throws Error naming the first bad field and its value.
+  void validate() const;
+
+  bool operator==(const Manifest&) const = default;
+};
+
+/// Checks a movie file-name pattern: relative, no "..", "." or empty components, no backslash or NUL,
+/// contains {camera} and {task}, no other {...} placeholders. Throws Error with the reason.
+void validate_movie_pattern(const std::string& pattern);
+
+/// Serializes to JSON (schema_version included).
+nlohmann::json to_json(const Manifest& manifest);
+/// Parses and validates. `source` names the origin (file path) in error messages. Throws Error on an
+/// unknown schema version, a missing or mistyped field, or a failed validate().
+Manifest manifest_from_json(const nlohmann::json& json, const std::string& source);
+
+/// Reads `path` (a panoptes.json file). Throws FileError if missing/unreadable/not JSON/invalid.
+Manifest read_manifest(const std::filesystem::path& path);
+/// Writes atomically: temp file in the same directory, fsync, rename over `path`, fsync the directory.
+/// On failure (e.g. disk full) the previous file at `path` is left untouched and FileError is thrown.
+void write_manifest_atomic(const std::filesystem::path& path, const Manifest& manifest);
+
+}  // namespace panoptes::store
