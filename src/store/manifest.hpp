@@ -166,8 +166,7 @@ struct Manifest {
   /// Checks internal consistency (ids, graph size and targets, axis references, pattern safety, image
   /// size, video settings, frames_written). Throws Error naming the first bad field and its value.
   void validate() const;
-
-  bool operator==(const Manifest&) const = default;
+  // No operator==: compare to_json() results (VideoSettings has no comparison).
 };
 
 /// Checks a movie file-name pattern: relative, no "..", "." or empty components, no backslash or NUL,

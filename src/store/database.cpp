@@ -1,0 +1,539 @@
+#include "store/database.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "video/movie_writer.hpp"
+
+namespace panoptes::store {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string host_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+bool lock_unsupported(int err) { return err == ENOLCK || err == ENOSYS || err == EOPNOTSUPP || err == EINVAL; }
+
+// True if `path` (canonical) lies inside `root` (canonical).
+bool inside(const fs::path& root, const fs::path& path) {
+  auto r = root.begin(), p = path.begin();
+  for (; r != root.end(); ++r, ++p)
+    if (p == path.end() || *r != *p) return false;
+  return p != path.end();
+}
+
+// Runs body(i) for i in [0, n) on `threads` threads (the caller is one of them); rethrows the first
+// exception after every thread stopped.
+template <class Body>
+void parallel_for(std::int64_t n, int threads, Body body) {
+  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = int(std::min<std::int64_t>(threads, std::max<std::int64_t>(n, 1)));
+  std::atomic<std::int64_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&] {
+    for (std::int64_t i; (i = next.fetch_add(1)) < n;) {
+      try {
+        body(i);
+      } catch (...) {
+        std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = n;  // stop handing out work
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+// ---- writer ----------------------------------------------------------------------------------
+
+struct DatabaseWriter::Impl {
+  struct Stream {
+    std::unique_ptr<video::MovieWriter> writer;
+    int frames = 0;
+  };
+
+  fs::path dir;
+  Manifest manifest;
+  WriterOptions options;
+  std::vector<int> slot_of_camera;  // camera -> index among owned cameras, -1 if not owned
+  int owned = 0;
+  std::vector<Stream> streams;      // owned × tasks, row-major by owned camera
+  std::mutex mutex;                 // guards manifest.image padding updates and directory creation
+  int lock_fd = -1;
+  bool finalized = false;
+
+  Stream& stream(int camera, int task) {
+    if (finalized) throw Error(dir.string() + ": database already finalized; cannot append");
+    if (camera < 0 || camera >= manifest.camera_count())
+      throw Error(dir.string() + ": camera " + std::to_string(camera) + " out of range (database has " +
+                  std::to_string(manifest.camera_count()) + " cameras)");
+    if (task < 0 || task >= manifest.task_count())
+      throw Error(dir.string() + ": task " + std::to_string(task) + " out of range (database has " +
+                  std::to_string(manifest.task_count()) + " tasks)");
+    const int slot = slot_of_camera[std::size_t(camera)];
+    if (slot < 0) throw Error(dir.string() + ": camera " + std::to_string(camera) + " is not owned by this writer");
+    return streams[std::size_t(slot) * std::size_t(manifest.task_count()) + std::size_t(task)];
+  }
+
+  int complete_frames() const {
+    if (streams.empty()) return 0;
+    int m = streams.front().frames;
+    for (const auto& s : streams) m = std::min(m, s.frames);
+    return m;
+  }
+
+  // Flushes every open movie in parallel; the first failure is rethrown naming its stream.
+  void flush_all() {
+    const int threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    parallel_for(std::int64_t(streams.size()), streams.size() > 16 ? threads : 1, [&](std::int64_t i) {
+      if (streams[std::size_t(i)].writer) streams[std::size_t(i)].writer->flush();
+    });
+  }
+
+  void write_manifest(Status status, int frames_written) {
+    Manifest m = manifest;
+    m.status = status;
+    m.frames_written = frames_written;
+    write_manifest_atomic(dir / kManifestFileName, m);
+    manifest.status = status;
+    manifest.frames_written = frames_written;
+  }
+
+  void release_lock() {
+    if (lock_fd >= 0) {
+      ::unlink((dir / kLockFileName).c_str());
+      ::close(lock_fd);  // drops the flock
+      lock_fd = -1;
+    }
+  }
+
+  void take_lock() {
+    const fs::path path = dir / kLockFileName;
+    lock_fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd < 0) throw FileError(path.string(), std::string("cannot create the writer lock: ") + std::strerror(errno));
+    if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      if (err == EWOULDBLOCK) {
+        ::close(lock_fd);
+        lock_fd = -1;
+        throw FileError(dir.string(), "another process is writing this database right now (lock " + path.string() + ")");
+      }
+      if (!lock_unsupported(err)) {
+        ::close(lock_fd);
+        lock_fd = -1;
+        throw FileError(path.string(), std::string("cannot lock: ") + std::strerror(err));
+      }
+      // File systems without flock: readers fall back to the pid check on the same host.
+      log::warn(dir.string() + ": file locks unsupported here; liveness falls back to the writer's pid");
+    }
+    const std::string who = std::to_string(::getpid()) + " " + host_name() + "\n";
+    if (::ftruncate(lock_fd, 0) != 0 || ::pwrite(lock_fd, who.data(), who.size(), 0) != ssize_t(who.size()))
+      throw FileError(path.string(), std::string("cannot write the writer lock: ") + std::strerror(errno));
+  }
+};
+
+DatabaseWriter::DatabaseWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+DatabaseWriter::DatabaseWriter(DatabaseWriter&&) noexcept = default;
+DatabaseWriter& DatabaseWriter::operator=(DatabaseWriter&& other) noexcept {
+  if (this != &other) {
+    DatabaseWriter old(std::move(*this));  // an unfinalized target is marked interrupted, as on destruction
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
+
+DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, bool overwrite) {
+  WriterOptions options;
+  options.overwrite = overwrite;
+  return create(dir, std::move(manifest), options);
+}
+
+DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, const WriterOptions& options) {
+  if (manifest.image.padded_width == 0 && manifest.image.padded_height == 0) {
+    // H.264 4:2:0 needs even sizes; MovieWriter pads odd ones by repeating the edge.
+    manifest.image.padded_width = (manifest.image.width + 1) & ~1;
+    manifest.image.padded_height = (manifest.image.height + 1) & ~1;
+  }
+  manifest.status = Status::running;
+  manifest.frames_written = 0;
+  manifest.schema_version = kSchemaVersion;
+  try {
+    manifest.validate();
+  } catch (const Error& e) {
+    throw Error(dir.string() + ": cannot create the database: " + e.what());
+  }
+
+  auto impl = std::make_unique<Impl>();
+  impl->dir = dir;
+  impl->options = options;
+  impl->slot_of_camera.assign(std::size_t(manifest.camera_count()), -1);
+  if (options.owned_cameras.empty()) {
+    for (int c = 0; c < manifest.camera_count(); ++c) impl->slot_of_camera[std::size_t(c)] = impl->owned++;
+  } else {
+    for (int c : options.owned_cameras) {
+      if (c < 0 || c >= manifest.camera_count())
+        throw Error(dir.string() + ": owned camera " + std::to_string(c) + " out of range (database has " +
+                    std::to_string(manifest.camera_count()) + " cameras)");
+      if (impl->slot_of_camera[std::size_t(c)] < 0) impl->slot_of_camera[std::size_t(c)] = impl->owned++;
+    }
+  }
+  impl->streams.resize(std::size_t(impl->owned) * std::size_t(manifest.task_count()));
+  impl->manifest = std::move(manifest);
+
+  if (!options.writes_manifest) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist (create it on the root writer first)");
+    return DatabaseWriter(std::move(impl));
+  }
+
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw FileError(dir.string(), "exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec) throw FileError(dir.string(), "cannot create the database directory: " + ec.message());
+  impl->take_lock();  // before looking at an old database, so two creators cannot both proceed
+
+  const fs::path manifest_path = dir / kManifestFileName;
+  if (fs::exists(manifest_path, ec)) {
+    if (!options.overwrite) {
+      impl->release_lock();
+      throw FileError(dir.string(), "already holds a Panoptes database (panoptes.json); refusing to overwrite it "
+                                    "(use --overwrite / WriterOptions::overwrite to replace it)");
+    }
+    // Remove the old movie tree: the top directory of the old and the new pattern, when the pattern
+    // has a fixed first directory (a flat pattern's files are simply truncated when rewritten).
+    std::vector<std::string> patterns{impl->manifest.movie_pattern};
+    try {
+      patterns.push_back(read_manifest(manifest_path).movie_pattern);
+    } catch (const Error&) {
+      // An unreadable old manifest: only the new pattern's tree is removed.
+    }
+    for (const auto& pattern : patterns) {
+      const auto slash = pattern.find('/');
+      if (slash == std::string::npos) continue;
+      const std::string top = pattern.substr(0, slash);
+      if (top.find('{') != std::string::npos) continue;
+      const fs::path tree = dir / top;
+      if (fs::is_symlink(tree, ec)) {
+        fs::remove(tree, ec);  // never follow a link out of the directory
+      } else {
+        fs::remove_all(tree, ec);
+      }
+      if (ec) {
+        impl->release_lock();
+        throw FileError(tree.string(), "cannot remove the old movies: " + ec.message());
+      }
+    }
+    fs::remove(manifest_path, ec);
+  }
+  try {
+    impl->write_manifest(Status::running, 0);
+  } catch (...) {
+    impl->release_lock();
+    throw;
+  }
+  return DatabaseWriter(std::move(impl));
+}
+
+DatabaseWriter::~DatabaseWriter() {
+  if (!impl_ || impl_->finalized) return;
+  if (impl_->options.writes_manifest) {
+    try {
+      int frames = impl_->manifest.frames_written;
+      try {
+        impl_->flush_all();
+        frames = impl_->complete_frames();
+      } catch (...) {
+        // Keep the last checkpoint's count: not every movie is known to hold more.
+      }
+      impl_->write_manifest(Status::interrupted, frames);
+    } catch (...) {
+      // Best effort: the manifest on disk still says `running`, which readers report as interrupted.
+    }
+  }
+  impl_->streams.clear();  // closes the movies
+  impl_->release_lock();
+}
+
+void DatabaseWriter::append(int camera, int task, const Image& frame) {
+  auto& s = impl_->stream(camera, task);
+  const auto& im = impl_->manifest.image;
+  if (frame.width != im.width || frame.height != im.height)
+    throw Error(impl_->dir.string() + ": frame for camera " + std::to_string(camera) + ", task " + std::to_string(task) +
+                " is " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+                ", expected the database image size " + std::to_string(im.width) + "x" + std::to_string(im.height));
+  if (frame.channels != 3 && frame.channels != 4)
+    throw Error(impl_->dir.string() + ": frame has " + std::to_string(frame.channels) + " channels, expected 3 or 4");
+  if (!s.writer) {
+    const fs::path path = impl_->dir / impl_->manifest.stream_relative_path(camera, task);
+    {
+      std::lock_guard lock(impl_->mutex);
+      std::error_code ec;
+      fs::create_directories(path.parent_path(), ec);
+      if (ec && !fs::is_directory(path.parent_path()))
+        throw FileError(path.parent_path().string(), "cannot create the movie directory: " + ec.message());
+    }
+    auto writer = std::make_unique<video::MovieWriter>(path.string(), im.width, im.height, impl_->manifest.video);
+    if (writer->padded_width() != im.padded_width || writer->padded_height() != im.padded_height) {
+      std::lock_guard lock(impl_->mutex);
+      impl_->manifest.image.padded_width = writer->padded_width();
+      impl_->manifest.image.padded_height = writer->padded_height();
+    }
+    s.writer = std::move(writer);
+  }
+  s.writer->append(frame);
+  ++s.frames;
+}
+
+void DatabaseWriter::set_time(int frame, double time) {
+  if (frame < 0) throw Error("set_time: negative frame " + std::to_string(frame));
+  auto& times = impl_->manifest.times;
+  if (std::size_t(frame) >= times.size()) {
+    const std::size_t old = times.size();
+    times.resize(std::size_t(frame) + 1);
+    for (std::size_t i = old; i < times.size(); ++i) times[i] = double(i);  // unknown times default to the index
+  }
+  times[std::size_t(frame)] = time;
+}
+
+void DatabaseWriter::flush() { impl_->flush_all(); }
+
+int DatabaseWriter::complete_frames() const { return impl_->complete_frames(); }
+
+void DatabaseWriter::checkpoint() {
+  impl_->flush_all();
+  if (impl_->options.writes_manifest) impl_->write_manifest(Status::running, impl_->complete_frames());
+}
+
+void DatabaseWriter::checkpoint(int frames_written) {
+  impl_->flush_all();
+  if (impl_->options.writes_manifest) impl_->write_manifest(Status::running, frames_written);
+}
+
+void DatabaseWriter::finalize() { finalize(-1); }
+
+void DatabaseWriter::finalize(int frames_written) {
+  if (impl_->finalized) return;
+  auto& streams = impl_->streams;
+  parallel_for(std::int64_t(streams.size()), streams.size() > 16 ? 0 : 1, [&](std::int64_t i) {
+    if (streams[std::size_t(i)].writer) streams[std::size_t(i)].writer->close();
+  });
+  if (frames_written < 0) frames_written = impl_->complete_frames();
+  if (impl_->options.writes_manifest) impl_->write_manifest(Status::complete, frames_written);
+  impl_->finalized = true;
+  streams.clear();
+  impl_->release_lock();
+}
+
+const Manifest& DatabaseWriter::manifest() const { return impl_->manifest; }
+const fs::path& DatabaseWriter::dir() const { return impl_->dir; }
+
+// ---- reader ----------------------------------------------------------------------------------
+
+bool writer_is_alive(const fs::path& dir) {
+  const fs::path path = dir / kLockFileName;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;  // no lock file: the writer finished or never started
+  bool alive;
+  if (::flock(fd, LOCK_SH | LOCK_NB) == 0) {
+    alive = false;  // nobody holds the writer's exclusive lock
+    ::flock(fd, LOCK_UN);
+  } else if (errno == EWOULDBLOCK) {
+    alive = true;
+  } else {
+    // No flock here: trust the pid when the writer ran on this host; elsewhere assume it lives.
+    char buf[300] = {};
+    const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+    long pid = 0;
+    char host[256] = {};
+    alive = true;
+    if (n > 0 && std::sscanf(buf, "%ld %255s", &pid, host) == 2 && host_name() == host)
+      alive = pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM);
+  }
+  ::close(fd);
+  return alive;
+}
+
+std::string_view to_string(StreamProblem::Kind kind) {
+  switch (kind) {
+    case StreamProblem::Kind::missing: return "missing";
+    case StreamProblem::Kind::unreadable: return "unreadable";
+    case StreamProblem::Kind::truncated: return "truncated";
+    case StreamProblem::Kind::unsafe: return "unsafe";
+  }
+  return "unknown";
+}
+
+Database Database::open(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) throw FileError(dir.string(), "no such database directory");
+  if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "not a directory (a database is a directory holding panoptes.json)");
+  Database db;
+  db.dir_ = dir;
+  db.manifest_ = read_manifest(dir / kManifestFileName);
+  db.stored_status_ = db.manifest_.status;
+  if (db.manifest_.status == Status::running && !writer_is_alive(dir)) db.manifest_.status = Status::interrupted;
+  return db;
+}
+
+fs::path Database::stream_path(int camera, int task) const {
+  return dir_ / manifest_.stream_relative_path(camera, task);
+}
+
+namespace {
+
+// A stream failure that knows its kind, so validate_streams can classify it without parsing text.
+class StreamFileError : public FileError {
+ public:
+  StreamFileError(const fs::path& path, const std::string& what, StreamProblem::Kind kind)
+      : FileError(path.string(), what), kind(kind) {}
+  StreamProblem::Kind kind;
+};
+
+// The message of e without a leading "<path>: " (to avoid naming the same file twice).
+std::string without_path(const Error& e, const std::string& path) {
+  std::string m = e.what();
+  if (m.rfind(path + ": ", 0) == 0) m.erase(0, path.size() + 2);
+  return m;
+}
+
+// Resolves a stream's path and refuses anything that leaves the database directory.
+fs::path resolve_stream(const fs::path& dir, const fs::path& path, int camera, int task) {
+  const std::string which = " (stream camera " + std::to_string(camera) + ", task " + std::to_string(task) + ")";
+  std::error_code ec;
+  const fs::path root = fs::canonical(dir, ec);
+  if (ec) {
+    throw StreamFileError(dir, "cannot resolve the database directory: " + ec.message(), StreamProblem::Kind::missing);
+  }
+  const auto st = fs::symlink_status(path, ec);
+  if (ec || !fs::exists(st)) {
+    throw StreamFileError(path, "movie missing" + which, StreamProblem::Kind::missing);
+  }
+  // weakly_canonical does not need the target to exist, so a dangling link out is refused as unsafe
+  // rather than reported as missing.
+  const fs::path resolved = fs::weakly_canonical(path, ec);
+  if (ec || !inside(root, resolved)) {
+    throw StreamFileError(path,
+                          "resolves to " + resolved.string() + ", outside the database directory " + root.string() +
+                              "; refused" + which,
+                          StreamProblem::Kind::unsafe);
+  }
+  if (!fs::exists(resolved, ec)) {
+    throw StreamFileError(path, "movie missing (dangling link)" + which, StreamProblem::Kind::missing);
+  }
+  if (!fs::is_regular_file(resolved, ec)) {
+    throw StreamFileError(path, "not a regular file" + which, StreamProblem::Kind::unreadable);
+  }
+  return resolved;
+}
+
+}  // namespace
+
+std::unique_ptr<video::MovieReader> Database::stream(int camera, int task) const {
+  const fs::path path = stream_path(camera, task);
+  const fs::path resolved = resolve_stream(dir_, path, camera, task);
+  const std::string which = " (stream camera " + std::to_string(camera) + ", task " + std::to_string(task) + ")";
+  std::unique_ptr<video::MovieReader> reader;
+  try {
+    reader = std::make_unique<video::MovieReader>(resolved.string());
+  } catch (const Error& e) {
+    throw StreamFileError(path, "not a readable movie" + which + ": " + without_path(e, resolved.string()),
+                          StreamProblem::Kind::unreadable);
+  }
+  if (reader->width() != manifest_.image.width || reader->height() != manifest_.image.height)
+    reader->set_crop(manifest_.image.width, manifest_.image.height);
+  if (reader->frame_count() < manifest_.frames_written)
+    throw StreamFileError(path,
+                    "truncated movie" + which + ": holds " + std::to_string(reader->frame_count()) + " of the " +
+                        std::to_string(manifest_.frames_written) + " frames the manifest records",
+                          StreamProblem::Kind::truncated);
+  return reader;
+}
+
+StreamReport Database::validate_streams(int threads, bool decode_last,
+                                        const std::function<void(std::int64_t, std::int64_t)>& progress) const {
+  const std::int64_t total = stream_count();
+  const int tasks = task_count();
+  StreamReport report;
+  std::mutex mutex;
+  std::atomic<std::int64_t> done{0}, bytes{0};
+  std::atomic<bool> finished{false};
+  std::thread reporter;
+  if (progress)
+    reporter = std::thread([&] {
+      while (!finished.load()) {
+        progress(done.load(), total);
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      }
+    });
+  auto check = [&](std::int64_t i) {
+    const int camera = int(i / tasks), task = int(i % tasks);
+    StreamProblem problem{camera, task, StreamProblem::Kind::missing, {}};
+    try {
+      const fs::path resolved = resolve_stream(dir_, stream_path(camera, task), camera, task);
+      std::error_code ec;
+      const auto size = fs::file_size(resolved, ec);
+      if (!ec) bytes += std::int64_t(size);
+      auto reader = stream(camera, task);
+      if (decode_last && frame_count() > 0) {
+        video::YuvFrame frame;
+        reader->read(frame_count() - 1, frame);
+      }
+      problem.message.clear();
+    } catch (const StreamFileError& e) {
+      problem.message = e.what();
+      problem.kind = e.kind;
+    } catch (const Error& e) {
+      problem.message = e.what();  // a decode failure of the last frame
+      problem.kind = StreamProblem::Kind::unreadable;
+    }
+    if (!problem.message.empty()) {
+      std::lock_guard lock(mutex);
+      report.problems.push_back(std::move(problem));
+    }
+    ++done;
+  };
+  try {
+    parallel_for(total, threads, check);
+  } catch (...) {
+    finished = true;
+    if (reporter.joinable()) reporter.join();
+    throw;
+  }
+  finished = true;
+  if (reporter.joinable()) reporter.join();
+  if (progress) progress(total, total);
+  report.checked = total;
+  report.bytes = bytes.load();
+  std::sort(report.problems.begin(), report.problems.end(), [](const StreamProblem& a, const StreamProblem& b) {
+    return a.camera != b.camera ? a.camera < b.camera : a.task < b.task;
+  });
+  return report;
+}
+
+}  // namespace panoptes::store

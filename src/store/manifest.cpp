@@ -1,0 +1,566 @@
+#include "store/manifest.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include "core/error.hpp"
+
+namespace panoptes::store {
+
+using nlohmann::json;
+
+std::string_view to_string(Status status) {
+  switch (status) {
+    case Status::running: return "running";
+    case Status::complete: return "complete";
+    case Status::interrupted: return "interrupted";
+  }
+  return "unknown";
+}
+
+Status parse_status(std::string_view text) {
+  if (text == "running") return Status::running;
+  if (text == "complete") return Status::complete;
+  if (text == "interrupted") return Status::interrupted;
+  throw Error("status \"" + std::string(text) + "\" is not one of running, complete, interrupted");
+}
+
+double Manifest::frame_time(int frame) const {
+  return frame >= 0 && std::size_t(frame) < times.size() ? times[std::size_t(frame)] : double(frame);
+}
+
+namespace {
+
+void replace_all(std::string& s, std::string_view what, const std::string& with) {
+  for (std::size_t pos = 0; (pos = s.find(what, pos)) != std::string::npos; pos += with.size())
+    s.replace(pos, what.size(), with);
+}
+
+}  // namespace
+
+std::string Manifest::stream_relative_path(int camera, int task) const {
+  if (camera < 0 || camera >= camera_count())
+    throw Error("camera " + std::to_string(camera) + " out of range (database has " +
+                std::to_string(camera_count()) + " cameras)");
+  if (task < 0 || task >= task_count())
+    throw Error("task " + std::to_string(task) + " out of range (database has " + std::to_string(task_count()) +
+                " tasks)");
+  std::string s = movie_pattern;
+  replace_all(s, "{camera}", std::to_string(camera));
+  replace_all(s, "{task}", std::to_string(task));
+  return s;
+}
+
+int Manifest::find_task(std::string_view name) const {
+  for (const auto& t : tasks)
+    if (t.name == name) return t.id;
+  return -1;
+}
+
+int Manifest::find_axis(std::string_view name) const {
+  for (std::size_t i = 0; i < axes.size(); ++i)
+    if (axes[i].name == name) return int(i);
+  return -1;
+}
+
+int Manifest::step_task_on_axis(int task, std::string_view axis, int delta) const {
+  if (task < 0 || task >= task_count()) return -1;
+  const auto& from = tasks[std::size_t(task)].axes;
+  int target_index = -1;
+  for (const auto& p : from)
+    if (p.axis == axis) target_index = p.index + delta;
+  if (target_index < 0) return -1;
+  for (const auto& t : tasks) {
+    if (t.axes.size() != from.size()) continue;
+    bool match = true;
+    for (std::size_t i = 0; i < from.size() && match; ++i) {
+      const auto& a = from[i];
+      // Axis positions are compared by name so their order in the two tasks does not matter.
+      const auto it = std::find_if(t.axes.begin(), t.axes.end(), [&](const AxisPosition& q) { return q.axis == a.axis; });
+      match = it != t.axes.end() && it->index == (a.axis == axis ? target_index : a.index);
+    }
+    if (match) return t.id;
+  }
+  return -1;
+}
+
+void validate_movie_pattern(const std::string& pattern) {
+  const auto bad = [&](const std::string& why) {
+    throw Error("movie pattern \"" + pattern + "\" " + why);
+  };
+  if (pattern.empty()) bad("is empty");
+  if (pattern.find('\0') != std::string::npos) bad("contains a NUL character");
+  if (pattern.find('\\') != std::string::npos) bad("contains a backslash");
+  if (pattern.front() == '/') bad("is absolute (it must be relative to the database directory)");
+  if (pattern.find("{camera}") == std::string::npos) bad("lacks {camera}");
+  if (pattern.find("{task}") == std::string::npos) bad("lacks {task}");
+  std::string rest = pattern;
+  replace_all(rest, "{camera}", "0");
+  replace_all(rest, "{task}", "0");
+  if (rest.find_first_of("{}") != std::string::npos) bad("has a placeholder other than {camera} and {task}");
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = pattern.find('/', start);
+    const std::string part = pattern.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    if (part.empty()) bad("has an empty path component");
+    if (part == "..") bad("reaches outside the database directory (\"..\")");
+    if (part == ".") bad("has a \".\" path component");
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  if (rest == "panoptes.json" || rest.rfind(".panoptes", 0) == 0) bad("would overwrite the manifest or lock");
+}
+
+void Manifest::validate() const {
+  const auto fail = [](const std::string& m) { throw Error("manifest: " + m); };
+  if (schema_version != kSchemaVersion)
+    fail("schema_version " + std::to_string(schema_version) + " is not supported (this build reads version " +
+         std::to_string(kSchemaVersion) + ")");
+  if (image.width <= 0 || image.height <= 0)
+    fail("image size " + std::to_string(image.width) + "x" + std::to_string(image.height) + " must be positive");
+  if (image.padded_width != 0 || image.padded_height != 0)
+    if (image.padded_width < image.width || image.padded_height < image.height)
+      fail("padded image size " + std::to_string(image.padded_width) + "x" + std::to_string(image.padded_height) +
+           " is smaller than the image size " + std::to_string(image.width) + "x" + std::to_string(image.height));
+  try {
+    video.validate();
+  } catch (const Error& e) {
+    fail(std::string("video settings: ") + e.what());
+  }
+  try {
+    validate_movie_pattern(movie_pattern);
+  } catch (const Error& e) {
+    fail(e.what());
+  }
+  if (frames_written < 0) fail("frames_written " + std::to_string(frames_written) + " is negative");
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const auto& c = cameras[i];
+    const std::string at = "cameras[" + std::to_string(i) + "]";
+    if (c.id != int(i)) fail(at + ".id is " + std::to_string(c.id) + ", expected its index " + std::to_string(i));
+    if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180))
+      fail(at + ".fov_y_deg " + std::to_string(c.fov_y_deg) + " is not in (0, 180)");
+    if (c.position == c.look_at) fail(at + ": position equals look_at");
+  }
+  if (!graph.neighbours.empty()) {
+    if (graph.neighbours.size() != cameras.size())
+      fail("navigation graph has " + std::to_string(graph.neighbours.size()) + " entries, expected 0 or one per camera (" +
+           std::to_string(cameras.size()) + ")");
+    const int n = camera_count();
+    for (std::size_t i = 0; i < graph.neighbours.size(); ++i) {
+      const auto& g = graph.neighbours[i];
+      for (int v : {g.left, g.right, g.up, g.down, g.in, g.out})
+        if (v < -1 || v >= n)
+          fail("navigation graph entry " + std::to_string(i) + " names camera " + std::to_string(v) +
+               " (valid: -1 or 0.." + std::to_string(n - 1) + ")");
+    }
+  }
+  std::unordered_map<std::string, std::size_t> axis_size;
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    if (axes[i].name.empty()) fail("axes[" + std::to_string(i) + "] has an empty name");
+    if (!axis_size.emplace(axes[i].name, axes[i].values.size()).second)
+      fail("axis \"" + axes[i].name + "\" is defined twice");
+  }
+  std::set<std::string_view> names;
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    const auto& t = tasks[i];
+    const std::string at = "tasks[" + std::to_string(i) + "]";
+    if (t.id != int(i)) fail(at + ".id is " + std::to_string(t.id) + ", expected its index " + std::to_string(i));
+    if (t.name.empty()) fail(at + " has an empty name");
+    if (!names.insert(t.name).second) fail("task name \"" + t.name + "\" is used twice");
+    if (!t.parameters.is_object()) fail(at + ".parameters is not a JSON object");
+    for (const auto& p : t.axes) {
+      const auto it = axis_size.find(p.axis);
+      if (it == axis_size.end()) fail(at + " sits on unknown axis \"" + p.axis + "\"");
+      if (p.index < 0 || std::size_t(p.index) >= it->second)
+        fail(at + " has index " + std::to_string(p.index) + " on axis \"" + p.axis + "\" of " +
+             std::to_string(it->second) + " values");
+    }
+  }
+  if (!rig.parameters.is_object()) fail("rig.parameters is not a JSON object");
+}
+
+// ---- JSON ------------------------------------------------------------------------------------
+
+namespace {
+
+json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+json labels_json(const std::map<std::string, std::string>& m) {
+  json j = json::object();
+  for (const auto& [k, v] : m) j[k] = v;
+  return j;
+}
+
+// Field access with messages naming the JSON path and the expected type.
+struct Reader {
+  const std::string& source;
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw Error(source + ": " + path + ": " + what);
+  }
+  const json& field(const json& obj, const char* key, const std::string& path) const {
+    if (!obj.is_object()) fail(path, "expected a JSON object");
+    const auto it = obj.find(key);
+    if (it == obj.end()) fail(path.empty() ? std::string(key) : path + "." + key, "missing");
+    return *it;
+  }
+  const json* optional(const json& obj, const char* key, const std::string& path) const {
+    if (!obj.is_object()) fail(path, "expected a JSON object");
+    const auto it = obj.find(key);
+    return it == obj.end() || it->is_null() ? nullptr : &*it;
+  }
+  std::string str(const json& j, const std::string& path) const {
+    if (!j.is_string()) fail(path, "expected a string, found " + std::string(j.type_name()));
+    return j.get<std::string>();
+  }
+  double num(const json& j, const std::string& path) const {
+    if (!j.is_number()) fail(path, "expected a number, found " + std::string(j.type_name()));
+    return j.get<double>();
+  }
+  std::int64_t integer(const json& j, const std::string& path) const {
+    if (!j.is_number_integer()) fail(path, "expected an integer, found " + std::string(j.type_name()));
+    return j.get<std::int64_t>();
+  }
+  int int32(const json& j, const std::string& path) const {
+    const std::int64_t v = integer(j, path);
+    if (v < INT32_MIN || v > INT32_MAX) fail(path, "integer " + std::to_string(v) + " out of range");
+    return int(v);
+  }
+  const json& array(const json& j, const std::string& path) const {
+    if (!j.is_array()) fail(path, "expected an array, found " + std::string(j.type_name()));
+    return j;
+  }
+  Vec3 vec3(const json& j, const std::string& path) const {
+    if (!j.is_array() || j.size() != 3) fail(path, "expected an array of 3 numbers");
+    return {num(j[0], path + "[0]"), num(j[1], path + "[1]"), num(j[2], path + "[2]")};
+  }
+  std::map<std::string, std::string> string_map(const json& j, const std::string& path) const {
+    if (!j.is_object()) fail(path, "expected an object of strings");
+    std::map<std::string, std::string> m;
+    for (auto it = j.begin(); it != j.end(); ++it) m[it.key()] = str(it.value(), path + "." + it.key());
+    return m;
+  }
+  std::string opt_str(const json& obj, const char* key, const std::string& path) const {
+    const json* j = optional(obj, key, path);
+    return j ? str(*j, path + "." + key) : std::string();
+  }
+};
+
+}  // namespace
+
+json to_json(const Manifest& m) {
+  json j;
+  j["schema_version"] = m.schema_version;
+  j["format"] = "panoptes movie database";
+  j["title"] = m.title;
+  j["status"] = std::string(to_string(m.status));
+  j["frames_written"] = m.frames_written;
+  j["movie_pattern"] = m.movie_pattern;
+  j["provenance"] = {{"program", m.provenance.program},
+                     {"version", m.provenance.version},
+                     {"created", m.provenance.created},
+                     {"host", m.provenance.host},
+                     {"command_line", m.provenance.command_line},
+                     {"extra", labels_json(m.provenance.extra)}};
+  j["domain"] = {{"dims", m.domain.dims},
+                 {"origin", vec3_json(m.domain.origin)},
+                 {"spacing", vec3_json(m.domain.spacing)},
+                 {"units", m.domain.units}};
+  j["times"] = m.times;
+  j["image"] = {{"width", m.image.width},
+                {"height", m.image.height},
+                {"padded_width", m.image.padded_width},
+                {"padded_height", m.image.padded_height}};
+  j["video"] = {{"codec", "h264"},
+                {"container", "fragmented mp4"},
+                {"crf", m.video.crf},
+                {"preset", m.video.preset},
+                {"gop", m.video.gop},
+                {"threads", m.video.threads},
+                {"fps", m.video.fps}};
+  j["rig"] = {{"kind", m.rig.kind}, {"parameters", m.rig.parameters}};
+  json cams = json::array();
+  for (const auto& c : m.cameras) {
+    json labels = {{"patch", c.labels.patch}, {"lat_deg", c.labels.lat_deg}, {"lon_deg", c.labels.lon_deg},
+                   {"shell", c.labels.shell}};
+    if (!c.labels.extra.empty()) labels["extra"] = labels_json(c.labels.extra);
+    cams.push_back({{"id", c.id},
+                    {"position", vec3_json(c.position)},
+                    {"look_at", vec3_json(c.look_at)},
+                    {"up", vec3_json(c.up)},
+                    {"fov_y_deg", c.fov_y_deg},
+                    {"labels", std::move(labels)}});
+  }
+  j["cameras"] = std::move(cams);
+  // One compact row per camera keeps the graph small for 10^5 cameras.
+  json rows = json::array();
+  for (const auto& g : m.graph.neighbours) rows.push_back(json::array({g.left, g.right, g.up, g.down, g.in, g.out}));
+  j["navigation"] = {{"columns", json::array({"left", "right", "up", "down", "in", "out"})}, {"neighbours", std::move(rows)}};
+  json axes = json::array();
+  for (const auto& a : m.axes) axes.push_back({{"name", a.name}, {"values", a.values}, {"units", a.units}});
+  j["axes"] = std::move(axes);
+  json tasks = json::array();
+  for (const auto& t : m.tasks) {
+    json pos = json::array();
+    for (const auto& p : t.axes) pos.push_back({{"axis", p.axis}, {"index", p.index}});
+    tasks.push_back({{"id", t.id},
+                     {"name", t.name},
+                     {"method", t.method},
+                     {"fields", t.fields},
+                     {"parameters", t.parameters},
+                     {"axes", std::move(pos)}});
+  }
+  j["tasks"] = std::move(tasks);
+  return j;
+}
+
+Manifest manifest_from_json(const json& j, const std::string& source) {
+  const Reader r{source};
+  if (!j.is_object()) r.fail("manifest", "expected a JSON object at the top level");
+  Manifest m;
+  {
+    const auto it = j.find("schema_version");
+    if (it == j.end()) r.fail("schema_version", "missing (not a Panoptes manifest?)");
+    const std::int64_t v = r.integer(*it, "schema_version");
+    if (v != kSchemaVersion)
+      throw Error(source + ": schema_version " + std::to_string(v) + " is not supported (this build reads version " +
+                  std::to_string(kSchemaVersion) + "; " +
+                  (v > kSchemaVersion ? "written by a newer Panoptes" : "unknown version") + ")");
+    m.schema_version = int(v);
+  }
+  m.title = r.opt_str(j, "title", "");
+  m.status = [&] {
+    const std::string s = r.str(r.field(j, "status", ""), "status");
+    try {
+      return parse_status(s);
+    } catch (const Error& e) {
+      r.fail("status", e.what());
+    }
+  }();
+  m.frames_written = r.int32(r.field(j, "frames_written", ""), "frames_written");
+  m.movie_pattern = r.str(r.field(j, "movie_pattern", ""), "movie_pattern");
+
+  if (const json* p = r.optional(j, "provenance", "")) {
+    m.provenance.program = r.opt_str(*p, "program", "provenance");
+    m.provenance.version = r.opt_str(*p, "version", "provenance");
+    m.provenance.created = r.opt_str(*p, "created", "provenance");
+    m.provenance.host = r.opt_str(*p, "host", "provenance");
+    m.provenance.command_line = r.opt_str(*p, "command_line", "provenance");
+    if (const json* e = r.optional(*p, "extra", "provenance")) m.provenance.extra = r.string_map(*e, "provenance.extra");
+  }
+  if (const json* d = r.optional(j, "domain", "")) {
+    if (const json* dims = r.optional(*d, "dims", "domain")) {
+      if (!dims->is_array() || dims->size() != 3) r.fail("domain.dims", "expected an array of 3 integers");
+      for (int i = 0; i < 3; ++i) m.domain.dims[std::size_t(i)] = r.integer((*dims)[std::size_t(i)], "domain.dims");
+    }
+    if (const json* o = r.optional(*d, "origin", "domain")) m.domain.origin = r.vec3(*o, "domain.origin");
+    if (const json* s = r.optional(*d, "spacing", "domain")) m.domain.spacing = r.vec3(*s, "domain.spacing");
+    m.domain.units = r.opt_str(*d, "units", "domain");
+  }
+  if (const json* t = r.optional(j, "times", "")) {
+    r.array(*t, "times");
+    m.times.reserve(t->size());
+    for (std::size_t i = 0; i < t->size(); ++i) m.times.push_back(r.num((*t)[i], "times[" + std::to_string(i) + "]"));
+  }
+  {
+    const json& im = r.field(j, "image", "");
+    m.image.width = r.int32(r.field(im, "width", "image"), "image.width");
+    m.image.height = r.int32(r.field(im, "height", "image"), "image.height");
+    if (const json* v = r.optional(im, "padded_width", "image")) m.image.padded_width = r.int32(*v, "image.padded_width");
+    if (const json* v = r.optional(im, "padded_height", "image")) m.image.padded_height = r.int32(*v, "image.padded_height");
+  }
+  if (const json* v = r.optional(j, "video", "")) {
+    if (const json* x = r.optional(*v, "codec", "video"); x && r.str(*x, "video.codec") != "h264")
+      r.fail("video.codec", "\"" + x->get<std::string>() + "\" is not supported (expected \"h264\")");
+    if (const json* x = r.optional(*v, "crf", "video")) m.video.crf = r.int32(*x, "video.crf");
+    if (const json* x = r.optional(*v, "preset", "video")) m.video.preset = r.str(*x, "video.preset");
+    if (const json* x = r.optional(*v, "gop", "video")) m.video.gop = r.int32(*x, "video.gop");
+    if (const json* x = r.optional(*v, "threads", "video")) m.video.threads = r.int32(*x, "video.threads");
+    if (const json* x = r.optional(*v, "fps", "video")) m.video.fps = r.num(*x, "video.fps");
+  }
+  if (const json* rig = r.optional(j, "rig", "")) {
+    m.rig.kind = r.opt_str(*rig, "kind", "rig");
+    if (const json* p = r.optional(*rig, "parameters", "rig")) {
+      if (!p->is_object()) r.fail("rig.parameters", "expected a JSON object");
+      m.rig.parameters = *p;
+    }
+  }
+  {
+    const json& cams = r.array(r.field(j, "cameras", ""), "cameras");
+    m.cameras.resize(cams.size());
+    for (std::size_t i = 0; i < cams.size(); ++i) {
+      const json& c = cams[i];
+      const std::string at = "cameras[" + std::to_string(i) + "]";
+      auto& e = m.cameras[i];
+      e.id = r.int32(r.field(c, "id", at), at + ".id");
+      e.position = r.vec3(r.field(c, "position", at), at + ".position");
+      e.look_at = r.vec3(r.field(c, "look_at", at), at + ".look_at");
+      e.up = r.vec3(r.field(c, "up", at), at + ".up");
+      e.fov_y_deg = r.num(r.field(c, "fov_y_deg", at), at + ".fov_y_deg");
+      if (const json* l = r.optional(c, "labels", at)) {
+        const std::string lat = at + ".labels";
+        e.labels.patch = r.opt_str(*l, "patch", lat);
+        if (const json* x = r.optional(*l, "lat_deg", lat)) e.labels.lat_deg = r.num(*x, lat + ".lat_deg");
+        if (const json* x = r.optional(*l, "lon_deg", lat)) e.labels.lon_deg = r.num(*x, lat + ".lon_deg");
+        if (const json* x = r.optional(*l, "shell", lat)) e.labels.shell = r.int32(*x, lat + ".shell");
+        if (const json* x = r.optional(*l, "extra", lat)) e.labels.extra = r.string_map(*x, lat + ".extra");
+      }
+    }
+  }
+  if (const json* nav = r.optional(j, "navigation", "")) {
+    static const char* kColumns[] = {"left", "right", "up", "down", "in", "out"};
+    if (const json* cols = r.optional(*nav, "columns", "navigation")) {
+      if (!cols->is_array() || cols->size() != 6) r.fail("navigation.columns", "expected [left,right,up,down,in,out]");
+      for (std::size_t k = 0; k < 6; ++k)
+        if ((*cols)[k] != kColumns[k]) r.fail("navigation.columns", "expected [left,right,up,down,in,out]");
+    }
+    if (const json* rows = r.optional(*nav, "neighbours", "navigation")) {
+      r.array(*rows, "navigation.neighbours");
+      m.graph.neighbours.resize(rows->size());
+      for (std::size_t i = 0; i < rows->size(); ++i) {
+        const json& row = (*rows)[i];
+        const std::string at = "navigation.neighbours[" + std::to_string(i) + "]";
+        if (!row.is_array() || row.size() != 6) r.fail(at, "expected an array of 6 camera ids");
+        auto& g = m.graph.neighbours[i];
+        int* slots[] = {&g.left, &g.right, &g.up, &g.down, &g.in, &g.out};
+        for (std::size_t k = 0; k < 6; ++k) *slots[k] = r.int32(row[k], at);
+      }
+    }
+  }
+  if (const json* axes = r.optional(j, "axes", "")) {
+    r.array(*axes, "axes");
+    for (std::size_t i = 0; i < axes->size(); ++i) {
+      const std::string at = "axes[" + std::to_string(i) + "]";
+      const json& a = (*axes)[i];
+      ParameterAxis axis;
+      axis.name = r.str(r.field(a, "name", at), at + ".name");
+      const json& values = r.array(r.field(a, "values", at), at + ".values");
+      for (std::size_t k = 0; k < values.size(); ++k) axis.values.push_back(r.num(values[k], at + ".values"));
+      axis.units = r.opt_str(a, "units", at);
+      m.axes.push_back(std::move(axis));
+    }
+  }
+  {
+    const json& tasks = r.array(r.field(j, "tasks", ""), "tasks");
+    m.tasks.resize(tasks.size());
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      const json& t = tasks[i];
+      const std::string at = "tasks[" + std::to_string(i) + "]";
+      auto& e = m.tasks[i];
+      e.id = r.int32(r.field(t, "id", at), at + ".id");
+      e.name = r.str(r.field(t, "name", at), at + ".name");
+      e.method = r.opt_str(t, "method", at);
+      if (const json* f = r.optional(t, "fields", at)) {
+        r.array(*f, at + ".fields");
+        for (const auto& x : *f) e.fields.push_back(r.str(x, at + ".fields"));
+      }
+      if (const json* p = r.optional(t, "parameters", at)) {
+        if (!p->is_object()) r.fail(at + ".parameters", "expected a JSON object");
+        e.parameters = *p;
+      }
+      if (const json* pos = r.optional(t, "axes", at)) {
+        r.array(*pos, at + ".axes");
+        for (const auto& p : *pos)
+          e.axes.push_back({r.str(r.field(p, "axis", at + ".axes"), at + ".axes.axis"),
+                            r.int32(r.field(p, "index", at + ".axes"), at + ".axes.index")});
+      }
+    }
+  }
+  try {
+    m.validate();
+  } catch (const Error& e) {
+    throw Error(source + ": " + e.what());
+  }
+  return m;
+}
+
+Manifest read_manifest(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw FileError(name, "no manifest here (not a Panoptes database)");
+    throw FileError(name, std::string("cannot read the manifest: ") + std::strerror(errno));
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  json j;
+  try {
+    j = json::parse(buffer.str());
+  } catch (const json::parse_error& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..."; keep the useful tail.
+    std::string what = e.what();
+    const auto pos = what.find("parse error");
+    throw FileError(name, "malformed manifest (not valid JSON): " + (pos == std::string::npos ? what : what.substr(pos)));
+  }
+  try {
+    return manifest_from_json(j, name);
+  } catch (const FileError&) {
+    throw;
+  } catch (const Error& e) {
+    // Messages already start with the file name.
+    throw FileError(name, std::string(e.what()).substr(name.size() + 2));
+  }
+}
+
+namespace {
+
+void write_all(int fd, const std::string& data, const std::string& path) {
+  std::size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw FileError(path, std::string("cannot write: ") + std::strerror(errno));
+    }
+    done += std::size_t(n);
+  }
+}
+
+}  // namespace
+
+void write_manifest_atomic(const std::filesystem::path& path, const Manifest& manifest) {
+  manifest.validate();
+  const std::string data = to_json(manifest).dump(1) + "\n";
+  // A unique temp name per writer: two processes writing at once must not share a temp file.
+  const std::filesystem::path tmp =
+      path.string() + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(std::random_device{}());
+  const std::string tmp_name = tmp.string();
+  const int fd = ::open(tmp_name.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw FileError(tmp_name, std::string("cannot create the manifest: ") + std::strerror(errno));
+  bool closed = false;
+  try {
+    write_all(fd, data, tmp_name);
+    if (::fsync(fd) != 0) throw FileError(tmp_name, std::string("cannot sync: ") + std::strerror(errno));
+    closed = true;  // close() releases the descriptor even when it reports an error
+    if (::close(fd) != 0) throw FileError(tmp_name, std::string("cannot close: ") + std::strerror(errno));
+  } catch (...) {
+    if (!closed) ::close(fd);
+    ::unlink(tmp_name.c_str());
+    throw;
+  }
+  if (::rename(tmp_name.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp_name.c_str());
+    throw FileError(path.string(), std::string("cannot replace the manifest: ") + std::strerror(err));
+  }
+  // Make the rename itself durable (best effort: some file systems refuse fsync on directories).
+  const std::string dir = path.has_parent_path() ? path.parent_path().string() : ".";
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+}  // namespace panoptes::store
