@@ -36,12 +36,19 @@ class MovieReader {
   double duration() const;  ///< seconds: frame_count() / fps()
   int width() const;        ///< after cropping
   int height() const;
+  int coded_width() const;   ///< size of the decoded pictures, before cropping
+  int coded_height() const;
+  /// True if frame `index` is a keyframe (decoding can start there).
+  bool is_keyframe(int index) const;
   const std::string& path() const;
 
   /// Decodes exactly frame `index` (seeks to the keyframe at or before it, decodes forward; consecutive
   /// indices decode without seeking). Throws Error if index is out of range or the frame is unreadable.
   void read(int index, YuvFrame& out);
   Image read_rgba(int index);
+  /// Packets sent to the decoder since open (a measure of decoding work: reading frames i, i+1, ...
+  /// in order costs one packet each; a random read costs the distance from its keyframe plus one).
+  std::int64_t packets_decoded() const;
   /// Converts a decoded frame to RGBA (for screenshots, tests, export; not the display path).
   static Image to_rgba(const YuvFrame& frame);
 

@@ -1,0 +1,397 @@
+#include "video/movie_reader.hpp"
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
+#include <libswscale/swscale.h>
+}
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "video/ffmpeg_util.hpp"
+
+namespace panoptes::video {
+
+namespace {
+
+struct PacketInfo {
+  std::int64_t pos = 0;  // byte offset of the sample in the file
+  int size = 0;
+  std::int64_t pts = 0;
+  std::int64_t dts = 0;
+  bool key = false;
+};
+
+std::string errno_string(int e) { return std::strerror(e); }
+
+}  // namespace
+
+struct MovieReader::Impl {
+  std::string path;
+  int fd = -1;
+  std::int64_t file_size = 0;
+
+  // The index, built once at open: packets in decode order; frames in presentation (pts) order.
+  std::vector<PacketInfo> packets;
+  std::vector<std::int64_t> frame_pts;  // sorted
+  std::vector<int> frame_packet;        // frame -> its packet
+  std::vector<int> frame_start;         // frame -> the keyframe packet decoding must start from
+  AVRational time_base{1, 1};
+  double fps = 0;
+  int coded_width = 0, coded_height = 0;
+  int crop_width = 0, crop_height = 0;
+
+  AVCodecContext* dec = nullptr;
+  AVFrame* frame = nullptr;
+  AVPacket* pkt = nullptr;
+  AVBufferRef* storage = nullptr;  // packet bytes, reused while no decoder holds a reference to it
+  SwsContext* sws_yuv = nullptr;   // only for decoders that output something other than yuv420p
+  YuvFrame scratch;                // read_rgba's frame
+
+  // Decoder position: next packet to send; -1 = decoder not primed (next read seeks).
+  int next_packet = -1;
+  int current_frame = -1;  // frame held in `frame`, -1 if none
+  std::int64_t packets_sent = 0;
+  bool draining = false;
+
+  ~Impl() {
+    avcodec_free_context(&dec);
+    av_frame_free(&frame);
+    av_packet_free(&pkt);
+    av_buffer_unref(&storage);
+    sws_freeContext(sws_yuv);
+    if (fd >= 0) ::close(fd);
+  }
+
+  int frame_of_pts(std::int64_t pts) const {
+    auto it = std::lower_bound(frame_pts.begin(), frame_pts.end(), pts);
+    if (it == frame_pts.end() || *it != pts) return -1;
+    return int(it - frame_pts.begin());
+  }
+
+  void build_index() {
+    struct stat sb {};
+    if (::stat(path.c_str(), &sb) != 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
+    if (S_ISDIR(sb.st_mode)) throw FileError(path, "is a directory, not a movie");
+    file_size = sb.st_size;
+
+    AVFormatContext* fmt = nullptr;
+    int ret = avformat_open_input(&fmt, path.c_str(), nullptr, nullptr);
+    if (ret < 0) throw FileError(path, "not a readable movie (" + av_error_string(ret) + ")");
+    struct Closer {
+      AVFormatContext*& f;
+      ~Closer() { avformat_close_input(&f); }
+    } closer{fmt};
+
+    const int si = av_find_best_stream(fmt, AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
+    if (si < 0) throw FileError(path, "has no video stream");
+    AVStream* st = fmt->streams[si];
+    for (unsigned i = 0; i < fmt->nb_streams; ++i)
+      if (int(i) != si) fmt->streams[i]->discard = AVDISCARD_ALL;
+    time_base = st->time_base;
+    const AVCodec* codec = avcodec_find_decoder(st->codecpar->codec_id);
+    if (!codec)
+      throw FileError(path, std::string("has no decoder for its video codec ") +
+                                avcodec_get_name(st->codecpar->codec_id));
+    coded_width = st->codecpar->width;
+    coded_height = st->codecpar->height;
+    if (coded_width <= 0 || coded_height <= 0) throw FileError(path, "video stream has no frame size");
+
+    // One pass over the packets (no decoding) gives the exact frame count, even for fragmented or
+    // truncated files whose header holds no sample table. Samples cut off by truncation are dropped.
+    AVPacket* p = av_packet_alloc();
+    if (!p) throw Error("out of memory");
+    std::vector<std::int64_t> durations;
+    for (;;) {
+      ret = av_read_frame(fmt, p);
+      if (ret < 0) break;  // end of file, or the truncated tail: keep what was complete
+      if (p->stream_index == si) {
+        const std::int64_t pts = p->pts != AV_NOPTS_VALUE ? p->pts : p->dts;
+        const bool complete = p->pos >= 0 && p->pos + p->size <= file_size && p->size > 0 &&
+                              !(p->flags & AV_PKT_FLAG_CORRUPT) && pts != AV_NOPTS_VALUE;
+        if (complete) {
+          packets.push_back({p->pos, p->size, pts, p->dts, (p->flags & AV_PKT_FLAG_KEY) != 0});
+          if (p->duration > 0) durations.push_back(p->duration);
+        } else if (p->pos < 0) {
+          av_packet_free(&p);
+          throw FileError(path, "container gives no packet positions (only MP4/MOV-like files are supported)");
+        }
+      }
+      av_packet_unref(p);
+    }
+    av_packet_free(&p);
+    // The declared sample sizes: a sample cut short by truncation reads back shorter than declared.
+    {
+      const int n = avformat_index_get_entries_count(st);
+      for (int i = 0; i < n; ++i) {
+        const AVIndexEntry* e = avformat_index_get_entry(st, i);
+        if (!e || e->pos + e->size <= file_size) continue;
+        packets.erase(std::remove_if(packets.begin(), packets.end(),
+                                     [&](const PacketInfo& pi) { return pi.pos == e->pos; }),
+                      packets.end());
+      }
+    }
+    // Decoding needs a keyframe first: anything before the first keyframe cannot be shown.
+    const auto first_key = std::find_if(packets.begin(), packets.end(), [](const PacketInfo& pi) { return pi.key; });
+    packets.erase(packets.begin(), first_key);
+
+    std::vector<int> order(packets.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return packets[a].pts < packets[b].pts; });
+    for (int k : order) {
+      if (!frame_pts.empty() && frame_pts.back() == packets[k].pts) continue;  // duplicate pts: unaddressable
+      frame_pts.push_back(packets[k].pts);
+      frame_packet.push_back(k);
+    }
+    // Start packet of each frame: the last keyframe at or before its packet in decode order whose pts
+    // is not after the frame's (for streams without B-frames, simply the keyframe at or before it).
+    std::vector<int> last_key(packets.size(), 0);
+    for (std::size_t k = 0, lk = 0; k < packets.size(); ++k) {
+      if (packets[k].key) lk = k;
+      last_key[k] = int(lk);
+    }
+    frame_start.resize(frame_pts.size());
+    for (std::size_t f = 0; f < frame_pts.size(); ++f) {
+      int k = last_key[frame_packet[f]];
+      while (k > 0 && packets[k].pts > frame_pts[f]) k = last_key[k - 1];
+      frame_start[f] = k;
+    }
+
+    // Frame rate: the median packet duration, else the median pts step, else the container's guess.
+    if (durations.empty())
+      for (std::size_t f = 1; f < frame_pts.size(); ++f) durations.push_back(frame_pts[f] - frame_pts[f - 1]);
+    if (!durations.empty()) {
+      std::nth_element(durations.begin(), durations.begin() + durations.size() / 2, durations.end());
+      fps = 1.0 / (double(durations[durations.size() / 2]) * av_q2d(time_base));
+    } else if (st->avg_frame_rate.num > 0 && st->avg_frame_rate.den > 0) {
+      fps = av_q2d(st->avg_frame_rate);
+    } else {
+      fps = 30;
+    }
+
+    dec = avcodec_alloc_context3(codec);
+    if (!dec) throw Error("out of memory");
+    ret = avcodec_parameters_to_context(dec, st->codecpar);
+    if (ret < 0) throw FileError(path, "bad codec parameters: " + av_error_string(ret));
+    dec->pkt_timebase = time_base;
+    // One thread: no frame delay, so a frame comes out as soon as its packet goes in. The player runs
+    // many readers in parallel instead.
+    dec->thread_count = 1;
+    ret = avcodec_open2(dec, codec, nullptr);
+    if (ret < 0) throw FileError(path, "cannot open the video decoder: " + av_error_string(ret));
+
+    std::size_t max_size = 0;
+    for (const auto& pi : packets) max_size = std::max(max_size, std::size_t(pi.size));
+    storage = av_buffer_allocz(int(max_size + AV_INPUT_BUFFER_PADDING_SIZE));
+    frame = av_frame_alloc();
+    pkt = av_packet_alloc();
+    if (!storage || !frame || !pkt) throw Error("out of memory");
+
+    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
+    crop_width = coded_width;
+    crop_height = coded_height;
+  }
+
+  void send_packet(int k) {
+    const PacketInfo& pi = packets[k];
+    if (!av_buffer_is_writable(storage)) {  // the decoder still holds the previous packet's bytes
+      AVBufferRef* fresh = av_buffer_allocz(storage->size);
+      if (!fresh) throw Error("out of memory");
+      av_buffer_unref(&storage);
+      storage = fresh;
+    }
+    std::int64_t done = 0;
+    while (done < pi.size) {
+      const ssize_t n = ::pread(fd, storage->data + done, std::size_t(pi.size - done), pi.pos + done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw FileError(path, "cannot read frame data at byte " + std::to_string(pi.pos + done) + ": " +
+                                            (n < 0 ? errno_string(errno) : "file shrank"));
+      done += n;
+    }
+    std::memset(storage->data + pi.size, 0, AV_INPUT_BUFFER_PADDING_SIZE);
+    pkt->buf = av_buffer_ref(storage);
+    if (!pkt->buf) throw Error("out of memory");
+    pkt->data = storage->data;
+    pkt->size = pi.size;
+    pkt->pts = pi.pts;
+    pkt->dts = pi.dts;
+    pkt->flags = pi.key ? AV_PKT_FLAG_KEY : 0;
+    const int ret = avcodec_send_packet(dec, pkt);
+    av_packet_unref(pkt);
+    ++packets_sent;
+    // A damaged packet is not fatal by itself: the frame it carried simply never comes out.
+    if (ret < 0 && ret != AVERROR_INVALIDDATA)
+      throw Error("movie " + path + ": decoder refused packet " + std::to_string(k) + ": " + av_error_string(ret));
+  }
+
+  void seek_to(int start_packet) {
+    avcodec_flush_buffers(dec);
+    next_packet = start_packet;
+    current_frame = -1;
+    draining = false;
+  }
+
+  // Leaves frame `index` in `frame`.
+  void decode(int index) {
+    if (index < 0 || index >= int(frame_pts.size()))
+      throw Error("movie " + path + ": frame " + std::to_string(index) + " is out of range (the movie has " +
+                  std::to_string(frame_pts.size()) + " frames)");
+    if (index == current_frame && next_packet >= 0) return;
+    // Decoding on from where we are is never slower than seeking when the frame's keyframe has
+    // already been sent; otherwise jump to that keyframe.
+    if (!(next_packet >= 0 && current_frame < index && frame_start[index] <= next_packet))
+      seek_to(frame_start[index]);
+    try {
+      for (;;) {
+        int ret = avcodec_receive_frame(dec, frame);
+        if (ret == 0) {
+          const std::int64_t pts = frame->pts != AV_NOPTS_VALUE ? frame->pts : frame->best_effort_timestamp;
+          const int f = frame_of_pts(pts);
+          if (f < 0) continue;  // not a frame of the index (e.g. from a dropped, truncated packet)
+          current_frame = f;
+          if (f == index) return;
+          if (f > index) break;  // frame `index` was skipped by the decoder: damaged
+          continue;
+        }
+        if (ret == AVERROR(EAGAIN)) {
+          if (next_packet < int(packets.size())) {
+            send_packet(next_packet++);
+          } else if (!draining) {
+            draining = true;
+            ret = avcodec_send_packet(dec, nullptr);
+            if (ret < 0 && ret != AVERROR_EOF) break;
+          } else {
+            break;
+          }
+          continue;
+        }
+        if (ret == AVERROR_EOF) break;
+        if (ret == AVERROR_INVALIDDATA) continue;
+        throw Error("movie " + path + ": decoding failed: " + av_error_string(ret));
+      }
+    } catch (...) {
+      next_packet = -1;
+      current_frame = -1;
+      throw;
+    }
+    next_packet = -1;
+    current_frame = -1;
+    throw Error("movie " + path + ": frame " + std::to_string(index) + " cannot be decoded (damaged data)");
+  }
+
+  void export_yuv(YuvFrame& out) {
+    const int w = crop_width, h = crop_height;
+    const int cw = (w + 1) / 2, ch = (h + 1) / 2;
+    out.width = w;
+    out.height = h;
+    out.index = current_frame;
+    out.y.resize(std::size_t(w) * h);
+    out.u.resize(std::size_t(cw) * ch);
+    out.v.resize(std::size_t(cw) * ch);
+    if (frame->format == AV_PIX_FMT_YUV420P && frame->width >= w && frame->height >= h) {
+      for (int y = 0; y < h; ++y) std::memcpy(out.y.data() + std::size_t(y) * w, frame->data[0] + y * frame->linesize[0], w);
+      for (int y = 0; y < ch; ++y) {
+        std::memcpy(out.u.data() + std::size_t(y) * cw, frame->data[1] + y * frame->linesize[1], cw);
+        std::memcpy(out.v.data() + std::size_t(y) * cw, frame->data[2] + y * frame->linesize[2], cw);
+      }
+      return;
+    }
+    // Other decoder outputs (full-range, 4:2:2, 10-bit, ...) are converted to what YuvFrame promises.
+    if (frame->width < w || frame->height < h)
+      throw Error("movie " + path + ": decoded frame is smaller than the crop");
+    sws_yuv = sws_getCachedContext(sws_yuv, w, h, AVPixelFormat(frame->format), w, h, AV_PIX_FMT_YUV420P,
+                                   SWS_BILINEAR | SWS_ACCURATE_RND, nullptr, nullptr, nullptr);
+    if (!sws_yuv) throw Error("movie " + path + ": cannot convert its pixel format to yuv420p");
+    std::uint8_t* dst[3] = {out.y.data(), out.u.data(), out.v.data()};
+    int dst_stride[3] = {w, cw, cw};
+    sws_scale(sws_yuv, frame->data, frame->linesize, 0, h, dst, dst_stride);
+  }
+};
+
+MovieReader::MovieReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  quiet_ffmpeg_logs();
+  impl_->path = path;
+  impl_->build_index();
+}
+
+MovieReader::~MovieReader() = default;
+
+void MovieReader::set_crop(int width, int height) {
+  Impl& m = *impl_;
+  if (width < 1 || height < 1 || width > m.coded_width || height > m.coded_height)
+    throw Error("movie " + m.path + ": crop " + std::to_string(width) + "x" + std::to_string(height) +
+                " does not fit the coded size " + std::to_string(m.coded_width) + "x" +
+                std::to_string(m.coded_height));
+  m.crop_width = width;
+  m.crop_height = height;
+}
+
+int MovieReader::frame_count() const { return int(impl_->frame_pts.size()); }
+double MovieReader::fps() const { return impl_->fps; }
+double MovieReader::duration() const { return impl_->fps > 0 ? frame_count() / impl_->fps : 0; }
+int MovieReader::width() const { return impl_->crop_width; }
+int MovieReader::height() const { return impl_->crop_height; }
+int MovieReader::coded_width() const { return impl_->coded_width; }
+int MovieReader::coded_height() const { return impl_->coded_height; }
+const std::string& MovieReader::path() const { return impl_->path; }
+
+bool MovieReader::is_keyframe(int index) const {
+  const Impl& m = *impl_;
+  if (index < 0 || index >= frame_count()) return false;
+  return m.packets[m.frame_packet[index]].key;
+}
+
+std::int64_t MovieReader::packets_decoded() const { return impl_->packets_sent; }
+
+void MovieReader::read(int index, YuvFrame& out) {
+  impl_->decode(index);
+  impl_->export_yuv(out);
+}
+
+Image MovieReader::read_rgba(int index) {
+  read(index, impl_->scratch);
+  return to_rgba(impl_->scratch);
+}
+
+Image MovieReader::to_rgba(const YuvFrame& f) {
+  const int cw = (f.width + 1) / 2, ch = (f.height + 1) / 2;
+  if (f.width < 1 || f.height < 1 || f.y.size() < std::size_t(f.width) * f.height ||
+      f.u.size() < std::size_t(cw) * ch || f.v.size() < std::size_t(cw) * ch)
+    throw Error("to_rgba: YUV frame planes do not match its size " + std::to_string(f.width) + "x" +
+                std::to_string(f.height));
+  // One converter per thread, reused while the size stays the same.
+  struct Cache {
+    SwsContext* ctx = nullptr;
+    ~Cache() { sws_freeContext(ctx); }
+  };
+  thread_local Cache cache;
+  SwsContext* ctx = sws_getCachedContext(cache.ctx, f.width, f.height, AV_PIX_FMT_YUV420P, f.width, f.height,
+                                         AV_PIX_FMT_RGBA, SWS_BILINEAR | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT,
+                                         nullptr, nullptr, nullptr);
+  if (!ctx) throw Error("to_rgba: cannot create the YUV to RGB converter");
+  if (ctx != cache.ctx) {
+    cache.ctx = ctx;
+    const int* coeffs = sws_getCoefficients(SWS_CS_ITU601);
+    sws_setColorspaceDetails(ctx, coeffs, 0, coeffs, 1, 0, 1 << 16, 1 << 16);
+  }
+  Image img(f.width, f.height, 4);
+  const std::uint8_t* src[3] = {f.y.data(), f.u.data(), f.v.data()};
+  const int src_stride[3] = {f.width, cw, cw};
+  std::uint8_t* dst[1] = {img.pixels.data()};
+  const int dst_stride[1] = {int(img.stride())};
+  sws_scale(ctx, src, src_stride, 0, f.height, dst, dst_stride);
+  return img;
+}
+
+}  // namespace panoptes::video

@@ -1,0 +1,295 @@
+#include "video/movie_writer.hpp"
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
+#include <libavutil/imgutils.h>
+#include <libavutil/opt.h>
+#include <libswscale/swscale.h>
+}
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "video/ffmpeg_util.hpp"
+
+namespace panoptes::video {
+
+struct MovieWriter::Impl {
+  std::string path;
+  int width = 0, height = 0, padded_width = 0, padded_height = 0;
+  VideoSettings settings;
+
+  AVFormatContext* fmt = nullptr;
+  AVStream* stream = nullptr;
+  AVCodecContext* enc = nullptr;
+  AVFrame* frame = nullptr;
+  AVPacket* pkt = nullptr;
+  SwsContext* sws_rgb = nullptr;
+  SwsContext* sws_rgba = nullptr;
+  std::vector<std::uint8_t> padded;  // odd sizes only: the frame with its last column/row repeated
+
+  std::int64_t frames_in = 0;    // frames sent to the encoder
+  std::int64_t packets_out = 0;  // packets handed to the muxer
+  bool open = false;
+  bool encoder_finished = false;  // drained by flush(); a new encoder is opened on the next append
+  bool failed = false;            // a write failed: the file is no longer extended
+
+  ~Impl() { release(); }
+
+  void release() {
+    if (fmt) {
+      if (fmt->pb) avio_closep(&fmt->pb);
+      avformat_free_context(fmt);
+      fmt = nullptr;
+    }
+    avcodec_free_context(&enc);
+    av_frame_free(&frame);
+    av_packet_free(&pkt);
+    sws_freeContext(sws_rgb);
+    sws_freeContext(sws_rgba);
+    sws_rgb = sws_rgba = nullptr;
+    open = false;
+  }
+
+  [[noreturn]] void fail_write(const std::string& what, int err) {
+    failed = true;
+    throw FileError(path, what + ": " + av_error_string(err));
+  }
+
+  void check_io(const std::string& what) {
+    if (fmt->pb && fmt->pb->error < 0) fail_write(what, fmt->pb->error);
+  }
+
+  void open_encoder() {
+    const AVCodec* codec = avcodec_find_encoder_by_name("libx264");
+    if (!codec) throw Error("movie " + path + ": FFmpeg has no libx264 encoder");
+    avcodec_free_context(&enc);
+    enc = avcodec_alloc_context3(codec);
+    if (!enc) throw Error("movie " + path + ": out of memory");
+    enc->width = padded_width;
+    enc->height = padded_height;
+    enc->pix_fmt = AV_PIX_FMT_YUV420P;
+    const AVRational rate = av_d2q(settings.fps, 1 << 20);
+    enc->framerate = rate;
+    enc->time_base = av_inv_q(rate);
+    enc->gop_size = settings.gop;
+    enc->keyint_min = settings.gop;
+    // No B-frames: every packet leaves the encoder as soon as its frame is sent (flush() has nothing
+    // to drain), decode order is display order and random access decodes only what precedes the frame.
+    enc->max_b_frames = 0;
+    enc->thread_count = settings.threads;
+    // Slice threads add no frame delay; frame threads would hold `threads` frames back.
+    enc->thread_type = FF_THREAD_SLICE;
+    enc->color_range = AVCOL_RANGE_MPEG;
+    enc->colorspace = AVCOL_SPC_SMPTE170M;
+    enc->color_primaries = AVCOL_PRI_SMPTE170M;
+    enc->color_trc = AVCOL_TRC_SMPTE170M;
+    if (fmt->oformat->flags & AVFMT_GLOBALHEADER) enc->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+
+    AVDictionary* opts = nullptr;
+    av_dict_set(&opts, "preset", settings.preset.c_str(), 0);
+    av_dict_set(&opts, "crf", std::to_string(settings.crf).c_str(), 0);
+    // rc-lookahead=0 / sync-lookahead=0: no look-ahead queue (it both delays frames and costs a
+    // full-size frame of memory per entry; it also turns off mb-tree). scenecut=0 keeps keyframes at
+    // exact multiples of the GOP, so the worst-case random-access cost is known.
+    av_dict_set(&opts, "x264-params", "rc-lookahead=0:sync-lookahead=0:scenecut=0:bframes=0", 0);
+    const int ret = avcodec_open2(enc, codec, &opts);
+    av_dict_free(&opts);
+    if (ret < 0) throw Error("movie " + path + ": cannot open the libx264 encoder: " + av_error_string(ret));
+    encoder_finished = false;
+  }
+
+  void start() {
+    int ret = avformat_alloc_output_context2(&fmt, nullptr, "mp4", path.c_str());
+    if (ret < 0 || !fmt) throw Error("movie " + path + ": cannot allocate the MP4 muxer: " + av_error_string(ret));
+    ret = avio_open(&fmt->pb, path.c_str(), AVIO_FLAG_WRITE);
+    if (ret < 0) throw FileError(path, "cannot create the movie: " + av_error_string(ret));
+    open_encoder();
+    stream = avformat_new_stream(fmt, nullptr);
+    if (!stream) throw Error("movie " + path + ": out of memory");
+    stream->time_base = enc->time_base;
+    stream->avg_frame_rate = enc->framerate;
+    ret = avcodec_parameters_from_context(stream->codecpar, enc);
+    if (ret < 0) throw Error("movie " + path + ": " + av_error_string(ret));
+
+    AVDictionary* opts = nullptr;
+    // Fragmented MP4: the moov (without samples) is written first and every fragment (moof+mdat) is
+    // self-describing, so the file is a valid movie up to its last complete fragment at any moment.
+    av_dict_set(&opts, "movflags", "frag_keyframe+empty_moov+default_base_moof", 0);
+    ret = avformat_write_header(fmt, &opts);
+    av_dict_free(&opts);
+    if (ret < 0) fail_write("cannot write the movie header", ret);
+    avio_flush(fmt->pb);
+    check_io("cannot write the movie header");
+
+    frame = av_frame_alloc();
+    pkt = av_packet_alloc();
+    if (!frame || !pkt) throw Error("movie " + path + ": out of memory");
+    frame->format = AV_PIX_FMT_YUV420P;
+    frame->width = padded_width;
+    frame->height = padded_height;
+    frame->color_range = AVCOL_RANGE_MPEG;
+    frame->colorspace = AVCOL_SPC_SMPTE170M;
+    ret = av_frame_get_buffer(frame, 0);
+    if (ret < 0) throw Error("movie " + path + ": out of memory for a frame");
+    open = true;
+  }
+
+  // Hands every packet the encoder has ready to the muxer.
+  void drain_packets() {
+    for (;;) {
+      int ret = avcodec_receive_packet(enc, pkt);
+      if (ret == AVERROR(EAGAIN) || ret == AVERROR_EOF) return;
+      if (ret < 0) throw Error("movie " + path + ": encoding failed: " + av_error_string(ret));
+      if (pkt->duration <= 0) pkt->duration = 1;  // one frame; the muxer needs it for the last sample
+      av_packet_rescale_ts(pkt, enc->time_base, stream->time_base);
+      pkt->stream_index = stream->index;
+      ret = av_write_frame(fmt, pkt);
+      av_packet_unref(pkt);
+      if (ret < 0) fail_write("cannot write frame " + std::to_string(packets_out), ret);
+      ++packets_out;
+      check_io("cannot write frame " + std::to_string(packets_out - 1));
+    }
+  }
+
+  void finish_encoder() {
+    int ret = avcodec_send_frame(enc, nullptr);
+    if (ret < 0 && ret != AVERROR_EOF) throw Error("movie " + path + ": " + av_error_string(ret));
+    drain_packets();
+    encoder_finished = true;
+  }
+
+  SwsContext* converter(int channels) {
+    SwsContext*& ctx = channels == 4 ? sws_rgba : sws_rgb;
+    if (!ctx) {
+      // Full-resolution chroma input (FULL_CHR_H_INP) and accurate rounding: sharp coloured edges of
+      // rendered images survive 4:2:0 better; the cost is small next to the encoder.
+      ctx = sws_getContext(padded_width, padded_height, channels == 4 ? AV_PIX_FMT_RGBA : AV_PIX_FMT_RGB24,
+                           padded_width, padded_height, AV_PIX_FMT_YUV420P,
+                           SWS_BILINEAR | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INP, nullptr, nullptr, nullptr);
+      if (!ctx) throw Error("movie " + path + ": cannot create the RGB to YUV converter");
+      // BT.601, full-range RGB in, limited-range YUV out: what the stream's colour tags say.
+      const int* coeffs = sws_getCoefficients(SWS_CS_ITU601);
+      sws_setColorspaceDetails(ctx, coeffs, 1, coeffs, 0, 0, 1 << 16, 1 << 16);
+    }
+    return ctx;
+  }
+};
+
+MovieWriter::MovieWriter(const std::string& path, int width, int height, const VideoSettings& settings)
+    : impl_(std::make_unique<Impl>()) {
+  settings.validate();
+  if (width < 1 || height < 1 || width > 16384 || height > 16384)
+    throw Error("movie " + path + ": frame size " + std::to_string(width) + "x" + std::to_string(height) +
+                " is outside 1x1..16384x16384");
+  quiet_ffmpeg_logs();
+  impl_->path = path;
+  impl_->width = width;
+  impl_->height = height;
+  impl_->padded_width = width + (width & 1);
+  impl_->padded_height = height + (height & 1);
+  impl_->settings = settings;
+  impl_->start();
+}
+
+MovieWriter::~MovieWriter() {
+  try {
+    close();
+  } catch (...) {
+    // A destructor must not throw; the error was the caller's to see by calling close().
+  }
+}
+
+void MovieWriter::append(const Image& image) {
+  Impl& m = *impl_;
+  if (!m.open) throw Error("movie " + m.path + ": append after close");
+  if (image.channels != 3 && image.channels != 4)
+    throw Error("movie " + m.path + ": frame has " + std::to_string(image.channels) +
+                " channels, expected 3 (RGB) or 4 (RGBA)");
+  if (image.width != m.width || image.height != m.height)
+    throw Error("movie " + m.path + ": frame is " + std::to_string(image.width) + "x" +
+                std::to_string(image.height) + ", expected " + std::to_string(m.width) + "x" +
+                std::to_string(m.height));
+  if (image.pixels.size() < image.stride() * std::size_t(image.height))
+    throw Error("movie " + m.path + ": frame pixel buffer is smaller than its size says");
+  if (m.failed) throw FileError(m.path, "an earlier write failed; the movie ends at its last flushed frame");
+  if (m.encoder_finished) m.open_encoder();
+
+  const std::uint8_t* src = image.pixels.data();
+  int src_stride = int(image.stride());
+  if (m.padded_width != m.width || m.padded_height != m.height) {
+    const int c = image.channels;
+    const std::size_t pstride = std::size_t(m.padded_width) * c;
+    m.padded.resize(pstride * m.padded_height);
+    for (int y = 0; y < m.padded_height; ++y) {
+      const std::uint8_t* in = image.row(std::min(y, m.height - 1));
+      std::uint8_t* out = m.padded.data() + y * pstride;
+      std::memcpy(out, in, image.stride());
+      if (m.padded_width != m.width) std::memcpy(out + image.stride(), in + image.stride() - c, c);
+    }
+    src = m.padded.data();
+    src_stride = int(pstride);
+  }
+
+  int ret = av_frame_make_writable(m.frame);
+  if (ret < 0) throw Error("movie " + m.path + ": out of memory for a frame");
+  const std::uint8_t* planes[1] = {src};
+  sws_scale(m.converter(image.channels), planes, &src_stride, 0, m.padded_height, m.frame->data,
+            m.frame->linesize);
+  m.frame->pts = m.frames_in;
+  ret = avcodec_send_frame(m.enc, m.frame);
+  if (ret < 0) throw Error("movie " + m.path + ": encoder refused frame " + std::to_string(m.frames_in) + ": " +
+                           av_error_string(ret));
+  ++m.frames_in;
+  m.drain_packets();
+}
+
+void MovieWriter::flush() {
+  Impl& m = *impl_;
+  if (!m.open) return;
+  if (m.failed) throw FileError(m.path, "an earlier write failed; the movie ends at its last flushed frame");
+  // With the settings of open_encoder() x264 returns each packet at once; should a configuration
+  // ever hold frames back, drain it (a fresh encoder starts with a keyframe at the next append).
+  if (m.packets_out < m.frames_in) m.finish_encoder();
+  if (m.packets_out < m.frames_in)
+    throw Error("movie " + m.path + ": the encoder kept " + std::to_string(m.frames_in - m.packets_out) +
+                " frames after draining");
+  // A null packet makes the MP4 muxer close the current fragment (moof+mdat) now.
+  int ret = av_write_frame(m.fmt, nullptr);
+  if (ret < 0) m.fail_write("cannot write a fragment", ret);
+  avio_flush(m.fmt->pb);
+  m.check_io("cannot write a fragment");
+}
+
+void MovieWriter::close() {
+  Impl& m = *impl_;
+  if (!m.open) return;
+  try {
+    if (!m.failed) {
+      if (!m.encoder_finished) m.finish_encoder();
+      int ret = av_write_trailer(m.fmt);
+      if (ret < 0) m.fail_write("cannot finish the movie", ret);
+      avio_flush(m.fmt->pb);
+      m.check_io("cannot finish the movie");
+      ret = avio_closep(&m.fmt->pb);
+      if (ret < 0) m.fail_write("cannot close the movie", ret);
+    }
+  } catch (...) {
+    m.release();
+    throw;
+  }
+  m.release();
+}
+
+int MovieWriter::frames_written() const { return int(impl_->frames_in); }
+int MovieWriter::width() const { return impl_->width; }
+int MovieWriter::height() const { return impl_->height; }
+int MovieWriter::padded_width() const { return impl_->padded_width; }
+int MovieWriter::padded_height() const { return impl_->padded_height; }
+const std::string& MovieWriter::path() const { return impl_->path; }
+
+}  // namespace panoptes::video
