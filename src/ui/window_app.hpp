@@ -1,0 +1,59 @@
+#pragma once
+// The interactive front end: an SDL2 window showing the player engine's current frame (YUV planes
+// uploaded to a streaming GPU texture, no CPU colour conversion) under a Dear ImGui HUD.
+// `panoptes play DB` (src/app/cmd_play.cpp) calls run_window() unless --headless is given.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+namespace panoptes::ui {
+
+/// Options of run_window(). Defaults suit an interactive session.
+struct WindowOptions {
+  /// Initial window size in pixels; 0 = the database's frame size (clamped to the screen).
+  int width = 0, height = 0;
+  bool fullscreen = false;
+  /// Use SDL's software renderer even if an accelerated one exists (tests under Xvfb, remote X).
+  bool software_renderer = false;
+  /// Synchronise presentation with the display's refresh (off: render as fast as possible).
+  bool vsync = true;
+
+  /// Where playback starts.
+  int camera = 0, task = 0, frame = 0;
+  /// Playback speed factor (¼ … 8) and whether playback starts running / loops at the end.
+  double speed = 1.0;
+  bool paused = false;
+  bool loop = true;
+  /// Frame cache cap for the engine in bytes; 0 = the engine's default for this machine.
+  std::size_t cache_bytes = 0;
+
+  /// A script of timed key presses in the player's script format (e.g. `t=0.5 key=Right`), injected as
+  /// if typed: for demos and the window test. Empty = none.
+  std::filesystem::path script;
+  /// Close the window by itself after this many presented frames (0 = run until the user closes it).
+  int max_frames = 0;
+  /// When closing, save the window's final rendered image (frame + HUD) as PNG here. Empty = none.
+  std::filesystem::path screenshot_on_exit;
+  /// Directory for screenshots taken with S and recordings made with R (default: current directory).
+  std::filesystem::path output_dir = ".";
+  /// Show the HUD at start (H / F1 toggles the help; Tab-free key `I` toggles the HUD).
+  bool show_hud = true;
+};
+
+/// What the session ended with (for tests and for the command to print a summary).
+struct WindowResult {
+  int frames_presented = 0;     ///< window frames drawn
+  int camera = -1, task = -1;   ///< selection shown last
+  int frame = -1;               ///< database frame shown last
+  double zoom = 1.0;            ///< magnification at exit (1 = whole frame fitted to the window)
+  int view_x = 0, view_y = 0, view_w = 0, view_h = 0;  ///< where the frame was drawn at exit (pixels)
+  bool hud_drawn = false;       ///< the HUD window was submitted to ImGui in the last frame
+  std::string summary;          ///< one-paragraph statistics (switch latency, fps, cache hits)
+};
+
+/// Opens the database at `db`, shows it in a window and runs until the user closes the window (or
+/// max_frames is reached). Throws panoptes::FileError if db is not a database or is empty, and
+/// panoptes::Error if no display is available (message suggests `--headless` or `xvfb-run`).
+WindowResult run_window(const std::filesystem::path& db, const WindowOptions& options = {});
+
+}  // namespace panoptes::ui
