@@ -1,0 +1,86 @@
+#pragma once
+// Scripted, window-less playback: a script of timed commands runs through the Engine on a virtual
+// clock at the database's frame rate, so a run is deterministic (the same frames are shown whatever
+// the machine's speed). Used by `panoptes play --headless`, `panoptes export-path`, tests, benchmarks.
+//
+// Script format (one command per line; '#' starts a comment; blank lines ignored):
+//   t=SECONDS key=NAME           a key of the key table (keys.hpp), e.g. key=Right, key=Shift+Tab, key=3
+//   t=SECONDS seek=FRAME         jump to a frame
+//   t=SECONDS camera=ID          jump to a camera
+//   t=SECONDS task=ID|NAME       select a task by id or by name
+//   t=SECONDS axis=NAME:DELTA    step parameter axis NAME by DELTA (e.g. axis=isovalue:+1)
+//   t=SECONDS snap=X,Y,Z         snap to the camera nearest the direction (as a mouse drag does)
+//   t=SECONDS speed=FACTOR       playback speed (0.25 .. 8)
+//   t=SECONDS play | pause       set the play state
+//   t=SECONDS end                stop the run here (else it ends one frame after the last command)
+// Times are virtual seconds from the start and must not decrease.
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/vec3.hpp"
+#include "player/engine.hpp"
+#include "player/keys.hpp"
+
+namespace panoptes::player {
+
+/// One parsed script line.
+struct ScriptCommand {
+  enum class Kind { key, seek, camera, task, axis, snap, speed, play, pause, end };
+  double t = 0;
+  Kind kind = Kind::key;
+  Action action = Action::none;  ///< kind == key
+  std::string key;               ///< kind == key: the key name as written
+  int value = 0;                 ///< seek frame, camera id, task id (-1: by name), axis delta
+  std::string name;              ///< task name or axis name
+  Vec3 direction;                ///< kind == snap
+  double speed = 1;              ///< kind == speed
+  int line = 0;                  ///< 1-based line number in the script
+};
+
+/// Parses a script. `source` names it in errors. Throws Error naming the line and the bad text.
+std::vector<ScriptCommand> parse_script(const std::string& text, const std::string& source = "script");
+/// Reads and parses a script file. Throws FileError when it cannot be read, Error on bad syntax.
+std::vector<ScriptCommand> read_script(const std::filesystem::path& path);
+
+/// One displayed frame of a headless run.
+struct DisplayedFrame {
+  int index = 0;        ///< display tick (0, 1, 2, ...)
+  double t = 0;         ///< virtual time of the tick, seconds
+  ShownFrame shown;
+};
+
+/// Options of run_headless.
+struct HeadlessOptions {
+  EngineOptions engine;           ///< time_source is replaced by the run's virtual clock
+  std::vector<ScriptCommand> script;
+  /// Run length in virtual seconds; unset = until an `end` command, else one display tick after the
+  /// last command.
+  std::optional<double> duration;
+  /// Writes every displayed frame as DIR/frame_NNNNNN.png (NNNNNN = display tick) if set.
+  std::optional<std::filesystem::path> frames_out;
+  /// Writes the statistics JSON (engine statistics + the list of displayed frames) if set.
+  std::optional<std::filesystem::path> stats_out;
+  /// Called for every displayed frame (e.g. to encode it), after frames_out is written.
+  std::function<void(const DisplayedFrame&)> on_frame;
+  /// Simulated display: wait for prefetch to go idle before each tick, as a real display would give
+  /// the prefetch threads one frame period of time (makes cache hits on switches reproducible).
+  bool wait_prefetch_each_tick = true;
+};
+
+/// Summary of a headless run.
+struct HeadlessResult {
+  int frames_displayed = 0;
+  int placeholders = 0;   ///< displayed frames whose status was not ok
+  Statistics statistics;
+  std::vector<Selection> shown;  ///< selection of every displayed frame, in order
+};
+
+/// Runs a script through an Engine over the database in dir. Display ticks are at t = k / fps
+/// (k = 0, 1, ...); at tick k the playback clock advances to t, then every command with time ≤ t
+/// is applied in order, then the frame is taken (so `t=1 seek=10` shows frame 10 at t = 1). Throws FileError/Error for a bad database or an unwritable output.
+HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOptions& options);
+
+}  // namespace panoptes::player

@@ -1,0 +1,71 @@
+#pragma once
+// The player's key bindings: one table shared by the window front end (ui) and the headless mode, so
+// a script line `key=Right` does exactly what pressing → does in the window.
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace panoptes::player {
+
+/// Everything a key can ask for. The engine executes the engine actions (Engine::apply); the
+/// front-end-only actions (zoom, pan reset, full screen, screenshot, record, help) are executed by the
+/// window and ignored by Engine::apply (it returns false for them).
+enum class Action {
+  none,
+  // playback
+  play_pause,      ///< Space
+  frame_forward,   ///< Period ('.'): pause and step one frame forward
+  frame_back,      ///< Comma (','): pause and step one frame back
+  first_frame,     ///< Home
+  last_frame,      ///< End
+  toggle_loop,     ///< L
+  faster,          ///< Shift+Period ('>'): double the speed (max ×8)
+  slower,          ///< Shift+Comma ('<'): halve the speed (min ×¼)
+  reverse,         ///< J: toggle playback direction (forward/backward)
+  // cameras (the manifest's navigation graph)
+  camera_left,     ///< Left
+  camera_right,    ///< Right
+  camera_up,       ///< Up
+  camera_down,     ///< Down
+  shell_in,        ///< Z: closer shell (graph edge `in`)
+  shell_out,       ///< X: farther shell (graph edge `out`)
+  // tasks and parameter axes
+  next_task,       ///< Tab
+  previous_task,   ///< Shift+Tab
+  task_1, task_2, task_3, task_4, task_5, task_6, task_7, task_8, task_9,  ///< digit keys 1..9: task 0..8
+  axis_up,         ///< PageUp or ']': step the active parameter axis up, keeping the other axes
+  axis_down,       ///< PageDown or '[': step the active parameter axis down
+  next_axis,       ///< A: make the next parameter axis the active one
+  // front end only (Engine::apply ignores these)
+  zoom_in,         ///< '+' / '=' (and the mouse wheel): magnify around the cursor
+  zoom_out,        ///< '-'
+  zoom_reset,      ///< 0: magnification 1, no pan
+  fullscreen,      ///< F
+  screenshot,      ///< S: save the shown frame as PNG
+  record,          ///< R: start/stop recording what is shown to an MP4
+  help,            ///< H or F1: help overlay
+  quit,            ///< Escape or Q
+};
+
+/// One row of the key table.
+struct KeyBinding {
+  std::string_view key;          ///< canonical key name, as written in scripts: "Right", "Shift+Tab", "1"
+  Action action;
+  std::string_view description;  ///< one line for the help overlay and docs/player.md
+};
+
+/// The full key table, in the order the help overlay lists it. Several keys may map to one action.
+std::span<const KeyBinding> key_bindings();
+
+/// The action of a key name (case-sensitive canonical names as in key_bindings(); single letters are
+/// also accepted in lower case, e.g. "l"). std::nullopt for an unknown name.
+std::optional<Action> action_for_key(std::string_view key);
+
+/// Stable lower-case name of an action (e.g. "camera_left"), for statistics and logs.
+std::string_view to_string(Action action);
+
+/// True for actions the engine executes (false for front-end-only ones and none).
+bool is_engine_action(Action action);
+
+}  // namespace panoptes::player
