@@ -1,0 +1,125 @@
+#include "ui/sdl_window.hpp"
+
+#include <SDL.h>
+#include <imgui.h>
+
+#include <cstdlib>
+
+#include "backends/imgui_impl_sdl.h"
+#include "backends/imgui_impl_sdlrenderer.h"
+#include "core/error.hpp"
+
+namespace panoptes::ui {
+namespace {
+
+std::string no_display_hint() {
+  return " (no display available? run `panoptes play --headless ...` for batch use, or start the "
+         "window under a virtual display: `xvfb-run -a panoptes play ...`)";
+}
+
+SDL_Renderer* create_renderer(SDL_Window* window, bool software, bool vsync) {
+  Uint32 flags = software ? SDL_RENDERER_SOFTWARE : SDL_RENDERER_ACCELERATED;
+  if (vsync && !software) flags |= SDL_RENDERER_PRESENTVSYNC;
+  SDL_Renderer* r = SDL_CreateRenderer(window, -1, flags);
+  // Xvfb and remote X often have no usable GL: fall back to the software renderer.
+  if (!r && !software) r = SDL_CreateRenderer(window, -1, SDL_RENDERER_SOFTWARE);
+  return r;
+}
+
+}  // namespace
+
+SdlWindow::SdlWindow(const SdlWindowOptions& options) {
+#if defined(__linux__)
+  const char* display = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  const char* driver = std::getenv("SDL_VIDEODRIVER");
+  if ((!display || !*display) && (!wayland || !*wayland) && (!driver || !*driver))
+    throw Error("cannot open a window: neither DISPLAY nor WAYLAND_DISPLAY is set" + no_display_hint());
+#endif
+  // Keep the compositor on (SDL disables it by default for fullscreen games), and let the window
+  // receive the first click that focuses it (mini-map clicks).
+  SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
+  SDL_SetHint(SDL_HINT_MOUSE_FOCUS_CLICKTHROUGH, "1");
+  if (SDL_Init(SDL_INIT_VIDEO | SDL_INIT_TIMER | SDL_INIT_EVENTS) != 0)
+    throw Error(std::string("cannot initialize SDL video: ") + SDL_GetError() + no_display_hint());
+
+  Uint32 wflags = SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI;
+  if (options.fullscreen) wflags |= SDL_WINDOW_FULLSCREEN_DESKTOP;
+  window_ = SDL_CreateWindow(options.title.c_str(), SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED,
+                             options.width, options.height, wflags);
+  if (!window_) {
+    const std::string why = SDL_GetError();
+    SDL_Quit();
+    throw Error("cannot create a " + std::to_string(options.width) + "x" + std::to_string(options.height) +
+                " window: " + why + no_display_hint());
+  }
+  fullscreen_ = options.fullscreen;
+  renderer_ = create_renderer(window_, options.software_renderer, options.vsync);
+  if (!renderer_) {
+    const std::string why = SDL_GetError();
+    SDL_DestroyWindow(window_);
+    SDL_Quit();
+    throw Error("cannot create an SDL renderer for the window: " + why);
+  }
+  SDL_RendererInfo info{};
+  if (SDL_GetRendererInfo(renderer_, &info) == 0 && info.name) renderer_name_ = info.name;
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // no imgui.ini littered into the user's working directory
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().Alpha = 0.92f;
+  imgui_sdl_ = ImGui_ImplSDL2_InitForSDLRenderer(window_);
+  imgui_renderer_ = imgui_sdl_ && ImGui_ImplSDLRenderer_Init(renderer_);
+  if (!imgui_renderer_) {
+    if (imgui_sdl_) ImGui_ImplSDL2_Shutdown();
+    ImGui::DestroyContext();
+    SDL_DestroyRenderer(renderer_);
+    SDL_DestroyWindow(window_);
+    SDL_Quit();
+    throw Error("cannot initialize the Dear ImGui SDL backends");
+  }
+}
+
+SdlWindow::~SdlWindow() {
+  ImGui_ImplSDLRenderer_Shutdown();
+  ImGui_ImplSDL2_Shutdown();
+  ImGui::DestroyContext();
+  SDL_DestroyRenderer(renderer_);
+  SDL_DestroyWindow(window_);
+  SDL_Quit();
+}
+
+void SdlWindow::output_size(int& w, int& h) const {
+  if (SDL_GetRendererOutputSize(renderer_, &w, &h) != 0) SDL_GetWindowSize(window_, &w, &h);
+}
+
+void SdlWindow::set_fullscreen(bool on) {
+  if (SDL_SetWindowFullscreen(window_, on ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0) == 0) fullscreen_ = on;
+}
+
+void SdlWindow::begin_imgui_frame() {
+  ImGui_ImplSDLRenderer_NewFrame();
+  ImGui_ImplSDL2_NewFrame();
+  ImGui::NewFrame();
+}
+
+void SdlWindow::render_imgui() {
+  ImGui::Render();
+  ImGui_ImplSDLRenderer_RenderDrawData(ImGui::GetDrawData());
+}
+
+Image SdlWindow::read_pixels() const {
+  int w = 0, h = 0;
+  output_size(w, h);
+  Image img(w, h, 4);
+  // RGBA32 is SDL's alias for "bytes R,G,B,A in memory" whatever the endianness, matching Image.
+  if (SDL_RenderReadPixels(renderer_, nullptr, SDL_PIXELFORMAT_RGBA32, img.pixels.data(), int(img.stride())) != 0)
+    throw Error(std::string("cannot read the window's pixels: ") + SDL_GetError());
+  return img;
+}
+
+void SdlWindow::present() { SDL_RenderPresent(renderer_); }
+
+}  // namespace panoptes::ui

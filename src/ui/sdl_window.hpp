@@ -1,0 +1,62 @@
+#pragma once
+// RAII ownership of SDL (video subsystem), one window, its 2-D renderer and the Dear ImGui context
+// bound to them through the SDL / SDL_Renderer backends.
+#include <string>
+
+#include "core/image.hpp"
+
+struct SDL_Window;
+struct SDL_Renderer;
+
+namespace panoptes::ui {
+
+/// How to open the window.
+struct SdlWindowOptions {
+  std::string title = "Panoptes";
+  int width = 960, height = 720;
+  bool fullscreen = false;
+  bool software_renderer = false;  ///< force SDL's software renderer
+  bool vsync = true;
+};
+
+/// The window, its renderer and the ImGui context. Only one may exist at a time (ImGui's backends
+/// keep global state). Must be used from the thread that created it.
+class SdlWindow {
+ public:
+  /// Initializes SDL video, creates the window and renderer (accelerated if available, else
+  /// software), and ImGui. Throws panoptes::Error when there is no display (the message suggests
+  /// `--headless` or `xvfb-run`) or when SDL fails (with SDL's reason).
+  explicit SdlWindow(const SdlWindowOptions& options);
+  ~SdlWindow();
+  SdlWindow(const SdlWindow&) = delete;
+  SdlWindow& operator=(const SdlWindow&) = delete;
+
+  SDL_Window* window() const { return window_; }
+  SDL_Renderer* renderer() const { return renderer_; }
+  /// Renderer name as SDL reports it (e.g. "opengl", "software").
+  const std::string& renderer_name() const { return renderer_name_; }
+  /// Size of the renderer's output in pixels (may differ from the window size on HiDPI screens).
+  void output_size(int& w, int& h) const;
+
+  /// Toggles desktop full screen.
+  void set_fullscreen(bool on);
+  bool fullscreen() const { return fullscreen_; }
+
+  /// Starts an ImGui frame (call once per frame, after the events were given to process_event).
+  void begin_imgui_frame();
+  /// Renders ImGui's draw data with the renderer (before present()).
+  void render_imgui();
+  /// Reads back what has been rendered so far in this frame (before present()) as RGBA. Throws
+  /// panoptes::Error if the renderer cannot read pixels.
+  Image read_pixels() const;
+  void present();
+
+ private:
+  SDL_Window* window_ = nullptr;
+  SDL_Renderer* renderer_ = nullptr;
+  std::string renderer_name_;
+  bool fullscreen_ = false;
+  bool imgui_sdl_ = false, imgui_renderer_ = false;
+};
+
+}  // namespace panoptes::ui

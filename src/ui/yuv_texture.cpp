@@ -1,0 +1,41 @@
+#include "ui/yuv_texture.hpp"
+
+#include <SDL.h>
+
+#include <string>
+
+#include "core/error.hpp"
+
+namespace panoptes::ui {
+
+YuvTexture::~YuvTexture() {
+  if (texture_) SDL_DestroyTexture(texture_);
+}
+
+void YuvTexture::set_pixelated(bool on) {
+  if (texture_ && on != pixelated_) SDL_SetTextureScaleMode(texture_, on ? SDL_ScaleModeNearest : SDL_ScaleModeLinear);
+  pixelated_ = on;
+}
+
+void YuvTexture::upload(const YuvPlanes& p) {
+  if (p.width <= 0 || p.height <= 0 || !p.y || !p.u || !p.v)
+    throw Error("YUV frame to display is empty (" + std::to_string(p.width) + "x" + std::to_string(p.height) + ")");
+  if (!texture_ || p.width != width_ || p.height != height_) {
+    if (texture_) SDL_DestroyTexture(texture_);
+    // The movies are BT.601 limited range (see video::YuvFrame); tell SDL so its conversion matches.
+    SDL_SetYUVConversionMode(SDL_YUV_CONVERSION_BT601);
+    texture_ = SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_IYUV, SDL_TEXTUREACCESS_STREAMING, p.width, p.height);
+    if (!texture_)
+      throw Error("cannot create a " + std::to_string(p.width) + "x" + std::to_string(p.height) +
+                  " YUV texture: " + SDL_GetError());
+    width_ = p.width;
+    height_ = p.height;
+    pixelated_ = !pixelated_;
+    set_pixelated(!pixelated_);
+  }
+  if (SDL_UpdateYUVTexture(texture_, nullptr, p.y, p.y_pitch, p.u, p.u_pitch, p.v, p.v_pitch) != 0)
+    throw Error(std::string("cannot upload a YUV frame to the GPU: ") + SDL_GetError());
+  ++uploads_;
+}
+
+}  // namespace panoptes::ui
