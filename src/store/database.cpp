@@ -76,6 +76,7 @@ struct DatabaseWriter::Impl {
   struct Stream {
     std::unique_ptr<video::MovieWriter> writer;
     int frames = 0;
+    bool closed = false;
   };
 
   fs::path dir;
@@ -282,6 +283,9 @@ DatabaseWriter::~DatabaseWriter() {
 
 void DatabaseWriter::append(int camera, int task, const Image& frame) {
   auto& s = impl_->stream(camera, task);
+  if (s.closed)
+    throw Error(impl_->dir.string() + ": stream camera " + std::to_string(camera) + ", task " + std::to_string(task) +
+                " was closed; cannot append");
   const auto& im = impl_->manifest.image;
   if (frame.width != im.width || frame.height != im.height)
     throw Error(impl_->dir.string() + ": frame for camera " + std::to_string(camera) + ", task " + std::to_string(task) +
@@ -308,6 +312,15 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
   }
   s.writer->append(frame);
   ++s.frames;
+}
+
+void DatabaseWriter::close_stream(int camera, int task) {
+  auto& s = impl_->stream(camera, task);
+  if (s.writer) {
+    s.writer->close();
+    s.writer.reset();
+  }
+  s.closed = true;
 }
 
 void DatabaseWriter::set_time(int frame, double time) {

@@ -70,6 +70,11 @@ class DatabaseWriter {
   /// size (nothing is written then; earlier frames stay readable); FileError if writing fails.
   void append(int camera, int task, const Image& frame);
 
+  /// Closes one stream's movie now (for offline writers that produce stream after stream, so memory
+  /// does not grow with the number of streams). Its frame count is final: further appends to it
+  /// throw. May run concurrently for different streams, like append().
+  void close_stream(int camera, int task);
+
   /// Records the simulation time of a frame (stored in Manifest::times at the next checkpoint).
   void set_time(int frame, double time);
 

@@ -1,0 +1,70 @@
+// Store benchmarks: database open time (manifest only, no movie opened) for 10^2 .. 10^5 streams, and
+// manifest size. Only manifests are written in the fixture: open() never touches a movie, which is
+// exactly the claim measured here (open time independent of the number of streams).
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "store/database.hpp"
+#include "store/test_support.hpp"
+
+namespace {
+
+using namespace panoptes::store;
+
+// One database directory per (cameras, tasks), created on first use and kept for the whole run.
+const std::filesystem::path& database_dir(int cameras, int tasks) {
+  static std::map<std::pair<int, int>, std::unique_ptr<testing::TempDir>> dirs;
+  auto& d = dirs[{cameras, tasks}];
+  if (!d) {
+    d = std::make_unique<testing::TempDir>("bench");
+    Manifest m = testing::sample_manifest(cameras, tasks, 920, 896);
+    m.frames_written = 60;
+    m.status = Status::complete;
+    for (int i = 0; i < 60; ++i) m.times.push_back(0.1 * i);
+    write_manifest_atomic(d->path / kManifestFileName, m);
+  }
+  return d->path;
+}
+
+// Args: cameras, tasks. Streams = cameras × tasks.
+void BM_DatabaseOpen(benchmark::State& state) {
+  const int cameras = int(state.range(0)), tasks = int(state.range(1));
+  const auto& dir = database_dir(cameras, tasks);
+  std::int64_t streams = 0;
+  for (auto _ : state) {
+    Database db = Database::open(dir);
+    streams = db.stream_count();
+    benchmark::DoNotOptimize(db);
+  }
+  state.counters["streams"] = double(streams);
+  state.counters["manifest_bytes"] = double(std::filesystem::file_size(dir / kManifestFileName));
+  state.counters["bytes_per_stream"] = double(std::filesystem::file_size(dir / kManifestFileName)) / double(streams);
+}
+BENCHMARK(BM_DatabaseOpen)
+    ->ArgNames({"cameras", "tasks"})
+    ->Args({10, 10})        // 10^2 streams
+    ->Args({130, 3})        // the paper's 390 movies
+    ->Args({100, 100})      // 10^4
+    ->Args({1000, 100})     // 10^5, many cameras and parameters
+    ->Args({100, 1000})     // 10^5, thousands of parameters per camera
+    ->Args({10000, 10})     // 10^5, very many cameras (worst case: size ∝ cameras)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Writing a checkpoint's manifest (temp + fsync + rename) for 10^5 streams.
+void BM_ManifestAtomicWrite(benchmark::State& state) {
+  const int cameras = int(state.range(0)), tasks = int(state.range(1));
+  testing::TempDir dir("bench-write");
+  const Manifest m = testing::sample_manifest(cameras, tasks, 920, 896);
+  for (auto _ : state) write_manifest_atomic(dir.path / kManifestFileName, m);
+  state.counters["manifest_bytes"] = double(std::filesystem::file_size(dir.path / kManifestFileName));
+}
+BENCHMARK(BM_ManifestAtomicWrite)->ArgNames({"cameras", "tasks"})->Args({1000, 100})->Args({10000, 10})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,171 @@
+#include "store/synthetic.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/frame_stamp.hpp"
+#include "store/database.hpp"
+
+namespace panoptes::store {
+
+Manifest synthetic_manifest(const SyntheticOptions& o) {
+  if (o.cameras <= 0 || o.tasks <= 0 || o.frames <= 0)
+    throw Error("synthetic database: cameras (" + std::to_string(o.cameras) + "), tasks (" + std::to_string(o.tasks) +
+                ") and frames (" + std::to_string(o.frames) + ") must be positive");
+  if (std::uint32_t(o.cameras - 1) > kStampMaxCamera || std::uint32_t(o.tasks - 1) > kStampMaxTask ||
+      std::uint32_t(o.frames - 1) > kStampMaxFrame)
+    throw Error("synthetic database: at most 2^24 cameras, 2^16 tasks and 2^20 frames fit in the frame stamp");
+  stamp_geometry(o.width, o.height);  // throws with the minimum size if the frame cannot hold a stamp
+  Manifest m;
+  m.title = o.title;
+  m.provenance.program = "panoptes synth-db";
+  m.provenance.version = "0.1.0";
+  {
+    char buf[32];
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    m.provenance.created = buf;
+    char host[256] = {};
+    ::gethostname(host, sizeof host - 1);
+    m.provenance.host = host;
+  }
+  m.provenance.command_line = o.command_line;
+  m.domain.dims = {64, 64, 64};
+  m.domain.origin = {-1, -1, -1};
+  m.domain.spacing = {2.0 / 63, 2.0 / 63, 2.0 / 63};
+  m.image.width = o.width;
+  m.image.height = o.height;
+  m.video = o.video;
+  for (int f = 0; f < o.frames; ++f) m.times.push_back(0.1 * f);
+  m.rig.kind = "fibonacci";
+  m.rig.parameters = {{"count", o.cameras}, {"radius", 3.0}, {"note", "synthetic; graph is a ring by index"}};
+  const double golden = M_PI * (3 - std::sqrt(5.0));
+  for (int c = 0; c < o.cameras; ++c) {
+    const double z = 1 - (2.0 * c + 1) / o.cameras, r = std::sqrt(std::max(0.0, 1 - z * z));
+    const double phi = golden * c;
+    CameraEntry e;
+    e.id = c;
+    e.position = {3 * r * std::cos(phi), 3 * r * std::sin(phi), 3 * z};
+    e.look_at = {0, 0, 0};
+    e.up = {0, 0, 1};
+    e.fov_y_deg = 30;
+    e.labels.patch = "fibonacci";
+    e.labels.lat_deg = std::asin(z) * 180 / M_PI;
+    e.labels.lon_deg = std::remainder(phi * 180 / M_PI, 360.0);
+    m.cameras.push_back(e);
+    Neighbours n;
+    if (o.cameras > 1) {
+      n.left = (c + o.cameras - 1) % o.cameras;
+      n.right = (c + 1) % o.cameras;
+    }
+    m.graph.neighbours.push_back(n);
+  }
+  ParameterAxis axis{"isovalue", {}, ""};
+  for (int t = 0; t < o.tasks; ++t) axis.values.push_back(double(t + 1) / (o.tasks + 1));
+  m.axes.push_back(axis);
+  for (int t = 0; t < o.tasks; ++t) {
+    TaskEntry e;
+    e.id = t;
+    e.name = "isovalue " + std::to_string(t);
+    e.method = "synthetic";
+    e.fields = {"synthetic"};
+    e.parameters = {{"isovalue", axis.values[std::size_t(t)]}};
+    e.axes = {{"isovalue", t}};
+    m.tasks.push_back(e);
+  }
+  return m;
+}
+
+void draw_synthetic_frame(Image& img, int camera, int task, int frame) {
+  const int w = img.width, h = img.height, ch = img.channels;
+  // Background: hue by task, brightness ramp by camera, so neighbouring streams look different.
+  const double hue = std::fmod(task * 0.13, 1.0) * 6.0;
+  const double rgb[3] = {0.5 + 0.5 * std::cos(hue), 0.5 + 0.5 * std::cos(hue - 2.094), 0.5 + 0.5 * std::cos(hue + 2.094)};
+  const double shade = 0.35 + 0.3 * std::fmod(camera * 0.618034, 1.0);
+  // A disc circling the centre: its angle advances with the frame and starts at the camera's phase.
+  const double angle = frame * 0.35 + camera * 0.7;
+  const double cx = w * (0.5 + 0.28 * std::cos(angle)), cy = h * (0.55 + 0.28 * std::sin(angle));
+  const double radius = std::max(3.0, std::min(w, h) * 0.12), r2 = radius * radius;
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* p = img.row(y);
+    const double ramp = shade * (0.6 + 0.4 * y / double(h));
+    for (int x = 0; x < w; ++x, p += ch) {
+      const double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
+      if (dx * dx + dy * dy < r2) {
+        p[0] = 250, p[1] = 240, p[2] = 90;
+      } else {
+        p[0] = std::uint8_t(255 * rgb[0] * ramp);
+        p[1] = std::uint8_t(255 * rgb[1] * ramp);
+        p[2] = std::uint8_t(255 * rgb[2] * ramp);
+      }
+      if (ch == 4) p[3] = 255;
+    }
+  }
+  draw_frame_stamp(img, {std::uint32_t(camera), std::uint32_t(task), std::uint32_t(frame)});
+}
+
+Image synthetic_frame(int camera, int task, int frame, int width, int height) {
+  Image img(width, height, 4);
+  draw_synthetic_frame(img, camera, task, frame);
+  return img;
+}
+
+void write_synthetic_database(const std::filesystem::path& dir, const SyntheticOptions& o,
+                              const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  Manifest m = synthetic_manifest(o);
+  DatabaseWriter writer = DatabaseWriter::create(dir, m, o.overwrite);
+  const std::int64_t total = m.stream_count();
+  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = int(std::min<std::int64_t>(threads, total));
+  std::atomic<std::int64_t> next{0}, done{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  // Stream after stream per thread: each movie is written whole and closed, so at most `threads`
+  // encoders are alive at once whatever the number of streams.
+  auto work = [&] {
+    Image img(o.width, o.height, 4);
+    for (std::int64_t s; (s = next.fetch_add(1)) < total;) {
+      const int camera = int(s / o.tasks), task = int(s % o.tasks);
+      try {
+        for (int f = 0; f < o.frames; ++f) {
+          draw_synthetic_frame(img, camera, task, f);
+          writer.append(camera, task, img);
+        }
+        writer.close_stream(camera, task);
+      } catch (...) {
+        std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = total;
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+  if (progress) {
+    while (done.load() < total) {
+      progress(done.load(), total);
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      std::lock_guard lock(error_mutex);
+      if (error) break;
+    }
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);  // the writer's destructor marks the database interrupted
+  if (progress) progress(total, total);
+  writer.finalize();
+}
+
+}  // namespace panoptes::store

@@ -1,0 +1,45 @@
+#pragma once
+// Synthetic databases: every frame carries the stamp of its (camera, task, frame) plus some visible
+// moving content, so player tests and benchmarks can verify *which* frame is shown.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "core/image.hpp"
+#include "store/manifest.hpp"
+#include "video/video_settings.hpp"
+
+namespace panoptes::store {
+
+/// What to generate.
+struct SyntheticOptions {
+  int cameras = 8;
+  int tasks = 2;
+  int frames = 10;
+  int width = 64, height = 64;
+  video::VideoSettings video;   ///< encoder settings of every stream
+  bool overwrite = false;
+  int threads = 0;              ///< streams encoded in parallel (0 = hardware concurrency)
+  std::string title = "synthetic database";
+  std::string command_line;     ///< recorded in the provenance
+};
+
+/// The manifest of a synthetic database: cameras on a Fibonacci sphere (radius 3, looking at the
+/// origin, labelled with latitude/longitude), a ring navigation graph (left/right = previous/next
+/// camera), tasks on one "isovalue" axis, times 0.1 s apart. Throws Error on non-positive counts.
+Manifest synthetic_manifest(const SyntheticOptions& options);
+
+/// Frame `frame` of stream (camera, task): coloured background, a disc moving with time and camera,
+/// and the frame stamp in the top-left corner. RGBA.
+Image synthetic_frame(int camera, int task, int frame, int width, int height);
+/// Same, drawn into an existing image of the right size (no allocation; for hot loops).
+void draw_synthetic_frame(Image& image, int camera, int task, int frame);
+
+/// Writes the database (every stream in parallel, each movie closed as soon as it is complete, so
+/// memory stays bounded by the number of threads). progress(done_streams, total) is called from one
+/// thread now and then. Throws like DatabaseWriter.
+void write_synthetic_database(const std::filesystem::path& dir, const SyntheticOptions& options,
+                              const std::function<void(std::int64_t, std::int64_t)>& progress = {});
+
+}  // namespace panoptes::store
