@@ -3,6 +3,7 @@
 #include <SDL.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "backends/imgui_impl_sdl.h"
@@ -43,14 +44,22 @@ SdlWindow::SdlWindow(const SdlWindowOptions& options) {
   if (SDL_Init(SDL_INIT_VIDEO | SDL_INIT_TIMER | SDL_INIT_EVENTS) != 0)
     throw Error(std::string("cannot initialize SDL video: ") + SDL_GetError() + no_display_hint());
 
+  // A database of 4K frames must still open in a window that fits the screen.
+  int width = options.width, height = options.height;
+  SDL_Rect usable{};
+  if (SDL_GetDisplayUsableBounds(0, &usable) == 0 && usable.w > 0 && usable.h > 0) {
+    const double shrink = std::min({1.0, 0.95 * usable.w / width, 0.9 * usable.h / height});
+    width = std::max(64, int(width * shrink));
+    height = std::max(64, int(height * shrink));
+  }
   Uint32 wflags = SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI;
   if (options.fullscreen) wflags |= SDL_WINDOW_FULLSCREEN_DESKTOP;
   window_ = SDL_CreateWindow(options.title.c_str(), SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED,
-                             options.width, options.height, wflags);
+                             width, height, wflags);
   if (!window_) {
     const std::string why = SDL_GetError();
     SDL_Quit();
-    throw Error("cannot create a " + std::to_string(options.width) + "x" + std::to_string(options.height) +
+    throw Error("cannot create a " + std::to_string(width) + "x" + std::to_string(height) +
                 " window: " + why + no_display_hint());
   }
   fullscreen_ = options.fullscreen;

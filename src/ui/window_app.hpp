@@ -26,6 +26,11 @@ struct WindowOptions {
   bool loop = true;
   /// Frame cache cap for the engine in bytes; 0 = the engine's default for this machine.
   std::size_t cache_bytes = 0;
+  /// Background prefetch of the neighbouring streams (off: every switch decodes on the display path).
+  bool prefetch = true;
+  /// Run playback and the script on a virtual clock that advances one database frame period per
+  /// presented window frame (deterministic: tests, recorded demos). Off: wall-clock time.
+  bool virtual_time = false;
 
   /// A script of timed key presses in the player's script format (e.g. `t=0.5 key=Right`), injected as
   /// if typed: for demos and the window test. Empty = none.
@@ -36,8 +41,10 @@ struct WindowOptions {
   std::filesystem::path screenshot_on_exit;
   /// Directory for screenshots taken with S and recordings made with R (default: current directory).
   std::filesystem::path output_dir = ".";
-  /// Show the HUD at start (H / F1 toggles the help; Tab-free key `I` toggles the HUD).
+  /// Show the HUD at start (key I toggles it; H / F1 toggle the help overlay).
   bool show_hud = true;
+  /// Show the help overlay at start.
+  bool show_help = false;
 };
 
 /// What the session ended with (for tests and for the command to print a summary).

@@ -1,0 +1,70 @@
+#pragma once
+// The Dear ImGui overlay: status panel, rig mini-map, time slider, help overlay and short messages.
+// It only reads a HudInfo snapshot and returns what the user asked for; the window applies it.
+#include <string>
+#include <vector>
+
+#include "player/engine.hpp"
+#include "store/manifest.hpp"
+#include "ui/minimap.hpp"
+
+namespace panoptes::ui {
+
+/// Everything the HUD shows, gathered by the window once per frame.
+struct HudInfo {
+  const store::Manifest* manifest = nullptr;
+  player::Selection selection;
+  int frame_count = 0;
+  double sim_time = 0;
+  int active_axis = -1;
+  double speed = 1;
+  bool playing = false, loop = true;
+  int direction = 1;
+  double display_fps = 0;
+  bool have_switch = false;       ///< a switch has happened (latency below is meaningful)
+  double last_switch_ms = 0;
+  bool last_switch_hit = false;   ///< the last switch was served from the cache (prefetched)
+  double switch_p99_ms = 0;
+  std::int64_t cache_hits = 0, cache_misses = 0;
+  std::size_t cache_bytes = 0, cache_capacity = 0;
+  double zoom = 1;
+  bool recording = false;
+  std::string recording_path;
+  std::string renderer;
+  player::FrameStatus status = player::FrameStatus::ok;
+  std::string status_message;
+  std::vector<int> neighbours;    ///< graph neighbours of the current camera (mini-map)
+};
+
+/// What the user did in the HUD this frame.
+struct HudRequests {
+  int seek = -1;         ///< time slider moved to this frame
+  int jump_camera = -1;  ///< mini-map click
+  bool toggle_play = false;
+};
+
+/// The overlay. Call draw() between SdlWindow::begin_imgui_frame() and render_imgui().
+class Hud {
+ public:
+  /// Camera directions and shells for the mini-map (from the manifest).
+  explicit Hud(const store::Manifest& manifest);
+
+  HudRequests draw(const HudInfo& info, float viewport_w, float viewport_h);
+
+  bool show_panel = true;  ///< status panel + mini-map + slider
+  bool show_help = false;
+  /// Shows `text` for a few seconds at the bottom centre (screenshot saved, recording errors, ...).
+  void notify(std::string text, bool error = false);
+  /// True if the status panel was submitted in the last draw() (the window test checks it).
+  bool panel_drawn() const { return panel_drawn_; }
+
+ private:
+  void draw_help(float viewport_w, float viewport_h);
+  MiniMap minimap_;
+  std::string message_;
+  bool message_error_ = false;
+  double message_until_ = 0;
+  bool panel_drawn_ = false;
+};
+
+}  // namespace panoptes::ui

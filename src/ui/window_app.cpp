@@ -1,0 +1,497 @@
+#include "ui/window_app.hpp"
+
+#include <SDL.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "backends/imgui_impl_sdl.h"
+#include "core/error.hpp"
+#include "core/png.hpp"
+#include "player/engine.hpp"
+#include "player/headless.hpp"
+#include "ui/drag_rotation.hpp"
+#include "ui/hud.hpp"
+#include "ui/sdl_keys.hpp"
+#include "ui/sdl_window.hpp"
+#include "ui/view_transform.hpp"
+#include "ui/yuv_texture.hpp"
+#include "video/movie_writer.hpp"
+
+namespace panoptes::ui {
+namespace {
+
+double wall_seconds() {
+  using clock = std::chrono::steady_clock;
+  return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
+}
+
+// Local time stamp for output file names, e.g. 20261121-224801.
+std::string time_tag() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
+  return buf;
+}
+
+/// Recording "what is shown": the window's picture (without the HUD) sampled at the database's frame
+/// rate into an MP4 of the window's size at the start of the recording.
+class Recorder {
+ public:
+  bool active() const { return writer_ != nullptr; }
+  const std::string& path() const { return path_; }
+
+  void start(const std::filesystem::path& path, int width, int height, double fps, double now) {
+    video::VideoSettings settings;
+    settings.fps = fps;
+    settings.crf = 20;
+    settings.gop = std::max(1, int(std::lround(fps)));
+    writer_ = std::make_unique<video::MovieWriter>(path.string(), width, height, settings);
+    path_ = path.string();
+    width_ = width;
+    height_ = height;
+    period_ = 1.0 / fps;
+    next_ = now;
+  }
+  /// True if a frame is due at `now` (the caller then reads the pixels and calls add()).
+  bool due(double now) const { return writer_ && now >= next_; }
+  bool size_matches(int width, int height) const { return width == width_ && height == height_; }
+  void add(const Image& picture, double now) {
+    writer_->append(picture);
+    // Catch up without bursts if the display fell behind the movie's frame rate.
+    next_ = std::max(next_ + period_, now - period_);
+  }
+  /// Closes the movie; returns the number of frames written.
+  int stop() {
+    if (!writer_) return 0;
+    const int n = writer_->frames_written();
+    auto w = std::move(writer_);
+    w->close();
+    return n;
+  }
+
+ private:
+  std::unique_ptr<video::MovieWriter> writer_;
+  std::string path_;
+  int width_ = 0, height_ = 0;
+  double period_ = 1.0 / 30, next_ = 0;
+};
+
+class WindowApp {
+ public:
+  WindowApp(player::Engine& engine, SdlWindow& window, const WindowOptions& options,
+            std::vector<player::ScriptCommand> script, player::VirtualClock& vclock)
+      : engine_(engine),
+        window_(window),
+        options_(options),
+        script_(std::move(script)),
+        vclock_(vclock),
+        texture_(window.renderer()),
+        hud_(engine.manifest()) {
+    hud_.show_panel = options.show_hud;
+    hud_.show_help = options.show_help;
+  }
+
+  WindowResult run();
+
+ private:
+  double now() const { return options_.virtual_time ? vclock_.now() : wall_seconds() - t0_; }
+  void run_due_script_commands();
+  void handle_event(const SDL_Event& e);
+  void do_action(player::Action action);
+  void zoom_by(double factor);
+  void apply_hud_requests(const HudRequests& req);
+  HudInfo gather_hud_info(const player::ShownFrame& shown);
+  void refresh_statistics();
+  void toggle_recording();
+  void save_screenshot(const Image& picture);
+  std::filesystem::path output_path(const std::string& stem, const char* ext) const;
+
+  player::Engine& engine_;
+  SdlWindow& window_;
+  const WindowOptions& options_;
+  std::vector<player::ScriptCommand> script_;
+  std::size_t next_command_ = 0;
+  player::VirtualClock& vclock_;
+  YuvTexture texture_;
+  Hud hud_;
+  ViewTransform view_;
+  DragRotation drag_;
+  Recorder recorder_;
+
+  double t0_ = wall_seconds();
+  bool quit_ = false;
+  bool left_down_ = false, right_down_ = false;
+  bool screenshot_pending_ = false;
+  int shot_counter_ = 0;
+  const video::YuvFrame* uploaded_ = nullptr;
+  std::shared_ptr<const video::YuvFrame> shown_frame_;  // keeps the uploaded frame alive
+  // Window → renderer-output pixel ratio (HiDPI), and sizes of this frame.
+  double px_x_ = 1, px_y_ = 1;
+  int out_w_ = 1, out_h_ = 1, win_w_ = 1, win_h_ = 1;
+
+  // HUD statistics, refreshed a few times per second (Engine::statistics() copies its sample lists).
+  double next_stats_ = 0;
+  double display_fps_ = 0, last_present_ = 0;
+  player::Statistics stats_;
+  double switch_p99_ = 0;
+};
+
+void WindowApp::run_due_script_commands() {
+  using Kind = player::ScriptCommand::Kind;
+  const double t = now();
+  while (next_command_ < script_.size() && script_[next_command_].t <= t) {
+    const auto& c = script_[next_command_++];
+    switch (c.kind) {
+      case Kind::key:
+        // Through SDL's queue, so a scripted key takes exactly the path of a typed one.
+        if (auto e = key_event_for_name(c.key)) {
+          SDL_Event ev = *e;
+          ev.key.windowID = SDL_GetWindowID(window_.window());
+          ev.key.timestamp = SDL_GetTicks();
+          SDL_PushEvent(&ev);
+        } else {
+          do_action(c.action);  // a key name SDL has no key for: apply its action directly
+        }
+        break;
+      case Kind::seek: engine_.seek(c.value); break;
+      case Kind::camera: engine_.jump_to_camera(c.value); break;
+      case Kind::task: engine_.set_task(c.value >= 0 ? c.value : engine_.manifest().find_task(c.name)); break;
+      case Kind::axis: engine_.step_axis(engine_.manifest().find_axis(c.name), c.value); break;
+      case Kind::snap: engine_.snap_to_direction(c.direction); break;
+      case Kind::speed: engine_.set_speed(c.speed); break;
+      case Kind::play: engine_.set_playing(true); break;
+      case Kind::pause: engine_.set_playing(false); break;
+      case Kind::end: quit_ = true; break;
+    }
+  }
+}
+
+void WindowApp::zoom_by(double factor) {
+  int mx = 0, my = 0;
+  const Uint32 focus = SDL_GetWindowFlags(window_.window()) & SDL_WINDOW_MOUSE_FOCUS;
+  SDL_GetMouseState(&mx, &my);
+  // Around the cursor when it is over the window, else around the centre.
+  if (focus)
+    view_.zoom_at(factor, mx * px_x_, my * px_y_);
+  else
+    view_.zoom_at(factor, out_w_ / 2.0, out_h_ / 2.0);
+}
+
+void WindowApp::do_action(player::Action action) {
+  using player::Action;
+  switch (action) {
+    case Action::zoom_in: zoom_by(1.25); break;
+    case Action::zoom_out: zoom_by(0.8); break;
+    case Action::zoom_reset: view_.reset(); break;
+    case Action::fullscreen: window_.set_fullscreen(!window_.fullscreen()); break;
+    case Action::screenshot: screenshot_pending_ = true; break;
+    case Action::record: toggle_recording(); break;
+    case Action::help: hud_.show_help = !hud_.show_help; break;
+    case Action::quit: quit_ = true; break;
+    case Action::none: break;
+    default: engine_.apply(action); break;
+  }
+}
+
+void WindowApp::handle_event(const SDL_Event& e) {
+  ImGui_ImplSDL2_ProcessEvent(&e);
+  const ImGuiIO& io = ImGui::GetIO();
+  switch (e.type) {
+    case SDL_QUIT: quit_ = true; break;
+    case SDL_WINDOWEVENT:
+      if (e.window.event == SDL_WINDOWEVENT_CLOSE && e.window.windowID == SDL_GetWindowID(window_.window())) quit_ = true;
+      break;
+    case SDL_KEYDOWN: {
+      if (io.WantTextInput) break;
+      if (auto action = action_for_event(e.key)) {
+        // Holding a key repeats navigation and frame steps, but not toggles.
+        const bool toggle = *action == player::Action::play_pause || *action == player::Action::fullscreen ||
+                            *action == player::Action::record || *action == player::Action::help ||
+                            *action == player::Action::screenshot || *action == player::Action::toggle_loop;
+        if (!(e.key.repeat && toggle)) do_action(*action);
+      } else if (e.key.keysym.sym == SDLK_i && !e.key.repeat) {
+        hud_.show_panel = !hud_.show_panel;  // front-end only, not in the shared key table
+      }
+      break;
+    }
+    case SDL_MOUSEBUTTONDOWN:
+      if (io.WantCaptureMouse) break;
+      if (e.button.button == SDL_BUTTON_LEFT) {
+        const auto& cam = engine_.manifest().cameras[std::size_t(engine_.selection().camera)];
+        drag_.begin(cam.position, cam.up, cam.look_at);
+        left_down_ = true;
+      } else if (e.button.button == SDL_BUTTON_RIGHT) {
+        right_down_ = true;
+      }
+      break;
+    case SDL_MOUSEBUTTONUP:
+      if (e.button.button == SDL_BUTTON_LEFT) {
+        left_down_ = false;
+        drag_.end();
+      } else if (e.button.button == SDL_BUTTON_RIGHT) {
+        right_down_ = false;
+      }
+      break;
+    case SDL_MOUSEMOTION:
+      if (left_down_ && drag_.active()) {
+        drag_.move(e.motion.xrel * px_x_, e.motion.yrel * px_y_, out_h_);
+        engine_.snap_to_direction(drag_.direction());
+      } else if (right_down_) {
+        view_.pan(e.motion.xrel * px_x_, e.motion.yrel * px_y_);
+      }
+      break;
+    case SDL_MOUSEWHEEL:
+      if (io.WantCaptureMouse) break;
+      if (e.wheel.preciseY != 0) zoom_by(std::pow(1.2, double(e.wheel.preciseY)));
+      break;
+    default: break;
+  }
+}
+
+void WindowApp::apply_hud_requests(const HudRequests& req) {
+  if (req.seek >= 0) engine_.seek(req.seek);
+  if (req.jump_camera >= 0) engine_.jump_to_camera(req.jump_camera);
+  if (req.toggle_play) engine_.toggle_playing();
+}
+
+void WindowApp::refresh_statistics() {
+  stats_ = engine_.statistics();
+  std::vector<double> lat;
+  lat.reserve(stats_.switches.size());
+  for (const auto& s : stats_.switches) lat.push_back(s.latency_ms);
+  switch_p99_ = player::summarize(std::move(lat)).p99;
+  stats_.decode_ms.clear();  // not shown; drop the copy
+}
+
+HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
+  HudInfo h;
+  const auto& m = engine_.manifest();
+  h.manifest = &m;
+  h.selection = shown.selection;
+  h.frame_count = engine_.frame_count();
+  h.sim_time = shown.time;
+  h.active_axis = engine_.active_axis();
+  h.speed = engine_.speed();
+  h.playing = engine_.playing();
+  h.loop = engine_.loop();
+  h.direction = engine_.direction();
+  h.display_fps = display_fps_;
+  if (!stats_.switches.empty()) {
+    h.have_switch = true;
+    h.last_switch_ms = stats_.switches.back().latency_ms;
+    h.last_switch_hit = stats_.switches.back().cache_hit;
+    h.switch_p99_ms = switch_p99_;
+  }
+  h.cache_hits = stats_.cache_hits;
+  h.cache_misses = stats_.cache_misses;
+  h.cache_bytes = stats_.cache_bytes;
+  h.cache_capacity = stats_.cache_capacity;
+  h.zoom = view_.zoom();
+  h.recording = recorder_.active();
+  h.recording_path = recorder_.path();
+  h.renderer = window_.renderer_name();
+  h.status = shown.status;
+  h.status_message = shown.message;
+  if (!m.graph.empty()) {
+    const auto& n = m.graph.neighbours[std::size_t(shown.selection.camera)];
+    for (int id : {n.left, n.right, n.up, n.down, n.in, n.out})
+      if (id >= 0) h.neighbours.push_back(id);
+  }
+  return h;
+}
+
+std::filesystem::path WindowApp::output_path(const std::string& stem, const char* ext) const {
+  std::error_code ec;
+  std::filesystem::create_directories(options_.output_dir, ec);
+  // A new name each time: never overwrite an earlier screenshot or recording.
+  for (int i = 0;; ++i) {
+    auto p = options_.output_dir / (stem + (i ? "-" + std::to_string(i) : std::string()) + ext);
+    if (!std::filesystem::exists(p, ec)) return p;
+  }
+}
+
+void WindowApp::toggle_recording() {
+  try {
+    if (recorder_.active()) {
+      const std::string path = recorder_.path();
+      const int n = recorder_.stop();
+      hud_.notify("recorded " + std::to_string(n) + " frames to " + path);
+    } else {
+      const auto path = output_path("panoptes-recording-" + time_tag(), ".mp4");
+      recorder_.start(path, out_w_, out_h_, engine_.fps(), now());
+      hud_.notify("recording to " + path.string() + " (R stops)");
+    }
+  } catch (const std::exception& ex) {
+    hud_.notify(std::string("recording failed: ") + ex.what(), true);
+  }
+}
+
+void WindowApp::save_screenshot(const Image& picture) {
+  const auto sel = engine_.selection();
+  char stem[96];
+  std::snprintf(stem, sizeof stem, "panoptes-c%d-t%d-f%d", sel.camera, sel.task, sel.frame);
+  try {
+    const auto path = output_path(stem, ".png");
+    write_png(path.string(), picture);
+    hud_.notify("screenshot saved to " + path.string());
+  } catch (const std::exception& ex) {
+    hud_.notify(std::string("screenshot failed: ") + ex.what(), true);
+  }
+}
+
+WindowResult WindowApp::run() {
+  WindowResult result;
+  const double frame_period = 1.0 / engine_.fps();
+  bool last = false;
+  while (!last) {
+    run_due_script_commands();
+    SDL_Event e;
+    while (SDL_PollEvent(&e)) handle_event(e);
+    last = quit_ || (options_.max_frames > 0 && result.frames_presented + 1 >= options_.max_frames);
+
+    engine_.tick();
+    const player::ShownFrame shown = engine_.current_frame();
+    if (shown.frame.get() != uploaded_) {
+      const auto& f = *shown.frame;
+      const int cw = (f.width + 1) / 2;
+      texture_.upload({f.width, f.height, f.y.data(), f.u.data(), f.v.data(), f.width, cw, cw});
+      uploaded_ = shown.frame.get();
+      shown_frame_ = shown.frame;
+    }
+
+    window_.output_size(out_w_, out_h_);
+    SDL_GetWindowSize(window_.window(), &win_w_, &win_h_);
+    px_x_ = win_w_ > 0 ? double(out_w_) / win_w_ : 1;
+    px_y_ = win_h_ > 0 ? double(out_h_) / win_h_ : 1;
+    view_.set_sizes(out_w_, out_h_, texture_.width(), texture_.height());
+    texture_.set_pixelated(view_.scale() >= 3);
+
+    SDL_Renderer* r = window_.renderer();
+    SDL_SetRenderDrawColor(r, 16, 17, 20, 255);
+    SDL_RenderClear(r);
+    const Rect fr = view_.frame_rect();
+    const SDL_FRect dst{float(fr.x), float(fr.y), float(fr.w), float(fr.h)};
+    SDL_RenderCopyF(r, texture_.texture(), nullptr, &dst);
+
+    // Screenshots and recordings hold what is shown of the data, without the HUD on top.
+    if (screenshot_pending_ || recorder_.due(now())) {
+      try {
+        const Image picture = window_.read_pixels();
+        if (screenshot_pending_) save_screenshot(picture);
+        if (recorder_.due(now())) {
+          if (recorder_.size_matches(picture.width, picture.height)) {
+            recorder_.add(picture, now());
+          } else {
+            const std::string path = recorder_.path();
+            const int n = recorder_.stop();
+            hud_.notify("window size changed: recording stopped after " + std::to_string(n) + " frames (" + path + ")",
+                        true);
+          }
+        }
+      } catch (const std::exception& ex) {
+        if (recorder_.active()) recorder_.stop();
+        hud_.notify(std::string("capture failed: ") + ex.what(), true);
+      }
+      screenshot_pending_ = false;
+    }
+
+    const double wall = wall_seconds();
+    if (wall >= next_stats_) {
+      refresh_statistics();
+      next_stats_ = wall + 0.5;
+    }
+    window_.begin_imgui_frame();
+    const HudRequests req = hud_.draw(gather_hud_info(shown), float(win_w_), float(win_h_));
+    window_.render_imgui();
+    apply_hud_requests(req);
+
+    if (last && !options_.screenshot_on_exit.empty()) write_png(options_.screenshot_on_exit.string(), window_.read_pixels());
+    window_.present();
+
+    ++result.frames_presented;
+    if (last_present_ > 0) {
+      const double dt = wall - last_present_;
+      if (dt > 0) display_fps_ = display_fps_ > 0 ? 0.9 * display_fps_ + 0.1 / dt : 1 / dt;
+    }
+    last_present_ = wall;
+    if (options_.virtual_time) vclock_.advance(frame_period);
+
+    result.camera = shown.selection.camera;
+    result.task = shown.selection.task;
+    result.frame = shown.selection.frame;
+    result.zoom = view_.zoom();
+    result.view_x = int(std::lround(fr.x));
+    result.view_y = int(std::lround(fr.y));
+    result.view_w = int(std::lround(fr.w));
+    result.view_h = int(std::lround(fr.h));
+    result.hud_drawn = hud_.panel_drawn();
+  }
+  if (recorder_.active()) {
+    const std::string path = recorder_.path();
+    const int n = recorder_.stop();
+    std::fprintf(stderr, "panoptes: recorded %d frames to %s\n", n, path.c_str());
+  }
+
+  const player::Statistics st = engine_.statistics();
+  std::vector<double> lat;
+  int hits = 0;
+  for (const auto& s : st.switches) {
+    lat.push_back(s.latency_ms);
+    hits += s.cache_hit ? 1 : 0;
+  }
+  const player::Summary sw = player::summarize(lat);
+  const player::Summary dec = player::summarize(st.decode_ms);
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%d window frames; %zu switches (%d prefetched), latency p50 %.2f ms p99 %.2f ms max %.2f ms; "
+                "%lld frames decoded, %.2f ms each (p50); cache hits %lld of %lld shown frames",
+                result.frames_presented, sw.count, hits, sw.p50, sw.p99, sw.max, (long long)dec.count, dec.p50,
+                (long long)st.cache_hits, (long long)st.frames_shown);
+  result.summary = buf;
+  return result;
+}
+
+}  // namespace
+
+WindowResult run_window(const std::filesystem::path& db, const WindowOptions& options) {
+  // The database and script are checked before any window opens, so their errors need no display.
+  std::vector<player::ScriptCommand> script;
+  if (!options.script.empty()) script = player::read_script(options.script);
+  player::VirtualClock vclock;
+  player::EngineOptions eo;
+  eo.cache_bytes = options.cache_bytes;
+  eo.prefetch = options.prefetch;
+  eo.start_playing = !options.paused;
+  eo.loop = options.loop;
+  eo.camera = options.camera;
+  eo.task = options.task;
+  eo.frame = options.frame;
+  if (options.virtual_time) eo.time_source = vclock.source();
+  player::Engine engine(db, eo);
+  engine.set_speed(options.speed);
+
+  const auto& m = engine.manifest();
+  SdlWindowOptions wo;
+  wo.title = "Panoptes - " + (m.title.empty() ? db.filename().string() : m.title);
+  wo.width = options.width > 0 ? options.width : m.image.width;
+  wo.height = options.height > 0 ? options.height : m.image.height;
+  wo.fullscreen = options.fullscreen;
+  wo.software_renderer = options.software_renderer;
+  wo.vsync = options.vsync;
+  SdlWindow window(wo);
+  WindowApp app(engine, window, options, std::move(script), vclock);
+  return app.run();
+}
+
+}  // namespace panoptes::ui
