@@ -1,0 +1,207 @@
+// Real-window test of the front end, run under Xvfb (`xvfb-run -a ui_window_test`, see CMakeLists.txt):
+// a small stamped database is written, the window plays it with a script of key presses injected
+// through SDL's event queue, and the window's own rendered pixels (SDL_RenderReadPixels) are checked
+// for the expected (camera, task, frame) stamp and for the HUD drawn over the frame.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/frame_stamp.hpp"
+#include "core/png.hpp"
+#include "store/database.hpp"
+#include "ui/window_app.hpp"
+
+namespace panoptes::ui {
+namespace {
+
+constexpr int kW = 480, kH = 360, kCameras = 4, kTasks = 2, kFrames = 6;
+constexpr std::uint8_t kGrey = 96;
+
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    std::random_device rd;
+    path = std::filesystem::temp_directory_path() /
+           ("panoptes-ui-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
+
+// Four cameras on the equator (z up), a left/right ring graph, two tasks on an "iso" axis.
+store::Manifest test_manifest() {
+  store::Manifest m;
+  m.title = "ui window test";
+  m.provenance.program = "ui_window_test";
+  m.image.width = kW;
+  m.image.height = kH;
+  m.video.gop = 3;
+  m.video.crf = 18;
+  m.video.fps = 30;
+  m.rig.kind = "ring";
+  store::ParameterAxis iso{"iso", {0.25, 0.5}, ""};
+  m.axes.push_back(iso);
+  for (int c = 0; c < kCameras; ++c) {
+    const double lon = 2 * M_PI * c / kCameras;
+    store::CameraEntry e;
+    e.id = c;
+    e.position = {3 * std::cos(lon), 3 * std::sin(lon), 0};
+    e.up = {0, 0, 1};
+    e.labels.lon_deg = lon * 180 / M_PI;
+    m.cameras.push_back(e);
+    store::Neighbours n;
+    n.left = (c + kCameras - 1) % kCameras;
+    n.right = (c + 1) % kCameras;
+    m.graph.neighbours.push_back(n);
+  }
+  for (int t = 0; t < kTasks; ++t) {
+    store::TaskEntry e;
+    e.id = t;
+    e.name = "iso " + std::to_string(iso.values[std::size_t(t)]);
+    e.method = "synthetic";
+    e.axes.push_back({"iso", t});
+    m.tasks.push_back(e);
+  }
+  return m;
+}
+
+// Uniform grey frames with their stamp in the top-left corner.
+void write_database(const std::filesystem::path& dir) {
+  auto writer = store::DatabaseWriter::create(dir, test_manifest(), true);
+  Image img(kW, kH, 3);
+  for (int f = 0; f < kFrames; ++f) {
+    for (int c = 0; c < kCameras; ++c)
+      for (int t = 0; t < kTasks; ++t) {
+        std::fill(img.pixels.begin(), img.pixels.end(), kGrey);
+        draw_frame_stamp(img, {std::uint32_t(c), std::uint32_t(t), std::uint32_t(f)});
+        writer.append(c, t, img);
+      }
+    writer.set_time(f, 0.5 * f);
+    writer.checkpoint();
+  }
+  writer.finalize();
+}
+
+Image crop(const Image& src, int x0, int y0, int w, int h) {
+  Image out(w, h, src.channels);
+  for (int y = 0; y < h; ++y) std::copy_n(src.at(x0, y0 + y), std::size_t(w) * src.channels, out.row(y));
+  return out;
+}
+
+class WindowTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new TempDir;
+    write_database(dir_->path / "db");
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static bool have_display() {
+    const char* d = std::getenv("DISPLAY");
+    return d && *d;
+  }
+  static TempDir* dir_;
+};
+TempDir* WindowTest::dir_ = nullptr;
+
+TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  const auto script = dir_->path / "keys.txt";
+  // Paused at frame 0 of camera 0, task 0. Every key goes through SDL's event queue and the shared
+  // key table: → (camera 1), → (camera 2), ← (camera 1), Tab (task 1), '.' '.' (frame 2),
+  // + then 0 (zoom in and back to 1, so the frame is shown 1:1 again), F1 twice (help on and off).
+  std::ofstream(script) << "# ui window test\n"
+                           "t=0.10 key=Right\nt=0.20 key=Right\nt=0.30 key=Left\n"
+                           "t=0.40 key=Tab\nt=0.50 key=Period\nt=0.60 key=Period\n"
+                           "t=0.70 key=+\nt=0.80 key=0\nt=0.90 key=F1\nt=1.00 key=F1\n";
+  WindowOptions o;
+  o.software_renderer = true;  // Xvfb has no GL worth testing; SDL's software path is deterministic
+  o.vsync = false;
+  o.paused = true;
+  o.virtual_time = true;
+  o.script = script;
+  o.max_frames = 40;  // 40 ticks of 1/30 s: the script ends at t = 1.0 s (tick 30)
+  o.screenshot_on_exit = dir_->path / "window.png";
+  o.output_dir = dir_->path;
+  const WindowResult r = run_window(dir_->path / "db", o);
+
+  EXPECT_EQ(r.frames_presented, 40);
+  EXPECT_EQ(r.camera, 1);
+  EXPECT_EQ(r.task, 1);
+  EXPECT_EQ(r.frame, 2);
+  EXPECT_DOUBLE_EQ(r.zoom, 1.0);
+  EXPECT_TRUE(r.hud_drawn);
+  // The window opens at the frame size, so zoom 1 shows the frame 1:1 filling the window.
+  EXPECT_EQ(r.view_x, 0);
+  EXPECT_EQ(r.view_y, 0);
+  EXPECT_EQ(r.view_w, kW);
+  EXPECT_EQ(r.view_h, kH);
+  EXPECT_NE(r.summary.find("switches"), std::string::npos);
+
+  const Image shot = read_png(o.screenshot_on_exit.string());
+  ASSERT_EQ(shot.width, kW);
+  ASSERT_EQ(shot.height, kH);
+  const Image shown = crop(shot, r.view_x, r.view_y, r.view_w, r.view_h);
+  const auto stamp = read_frame_stamp(shown);
+  ASSERT_TRUE(stamp) << "no stamp in the window's top-left corner; see " << o.screenshot_on_exit;
+  EXPECT_EQ(*stamp, (FrameStamp{1, 1, 2}));
+
+  // The HUD: the frame itself is uniform grey outside the stamp, so every pixel that is clearly not
+  // grey in the top-right status panel and along the bottom time slider was drawn by ImGui.
+  auto differing = [&](int x0, int y0, int x1, int y1) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        const std::uint8_t* p = shot.at(x, y);
+        if (std::abs(p[0] - kGrey) > 24 || std::abs(p[1] - kGrey) > 24 || std::abs(p[2] - kGrey) > 24) ++n;
+      }
+    return n;
+  };
+  const int panel = differing(kW / 2, 0, kW, kH / 3);
+  const int slider = differing(0, kH - 20, kW / 2, kH);
+  const int middle_left = differing(60, kH / 3, kW / 4, kH / 2);  // nothing is drawn there
+  EXPECT_GT(panel, 2000) << "status panel not drawn";
+  EXPECT_GT(slider, 1000) << "time slider not drawn";
+  EXPECT_EQ(middle_left, 0) << "frame area disturbed";
+}
+
+TEST_F(WindowTest, MissingDisplayIsAClearError) {
+  const char* saved = std::getenv("DISPLAY");
+  const std::string display = saved ? saved : "";
+  const char* wl = std::getenv("WAYLAND_DISPLAY");
+  const std::string wayland = wl ? wl : "";
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  std::string message;
+  try {
+    WindowOptions o;
+    o.software_renderer = true;
+    run_window(dir_->path / "db", o);
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  if (!display.empty()) ::setenv("DISPLAY", display.c_str(), 1);
+  if (!wayland.empty()) ::setenv("WAYLAND_DISPLAY", wayland.c_str(), 1);
+  if (std::getenv("SDL_VIDEODRIVER")) GTEST_SKIP() << "SDL_VIDEODRIVER set: SDL may open a window anyway";
+  EXPECT_NE(message.find("--headless"), std::string::npos) << message;
+  EXPECT_NE(message.find("xvfb-run"), std::string::npos) << message;
+}
+
+TEST_F(WindowTest, NotADatabaseIsReportedBeforeAnyWindowOpens) {
+  WindowOptions o;
+  EXPECT_THROW(run_window(dir_->path / "no-such-db", o), FileError);
+}
+
+}  // namespace
+}  // namespace panoptes::ui
