@@ -1,0 +1,146 @@
+// Bricks composite to the single-brick image; one march for K tasks equals K marches; skipping
+// does not change images.
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "render/render_test_util.hpp"
+#include "render/synthetic_fields.hpp"
+
+using namespace panoptes;
+using namespace panoptes::render;
+using panoptes::render::testing::max_diff;
+using panoptes::render::testing::render_bricked;
+
+namespace {
+
+struct Scene {
+  GridGeometry grid{{41, 37, 33}, {-20, -21.6, -12.8}, {1.0, 1.2, 0.8}};
+  std::vector<float> p, s;
+  std::vector<FieldView> views;
+  std::vector<TaskSpec> tasks;
+  Scene() {
+    const WaveFront pf[] = {{{-4, 3, 1}, 14, 2.5, 1.0}, {{6, -5, -2}, 8, 2, -0.8}};
+    const WaveFront sf[] = {{{-4, 3, 1}, 8, 2, 0.9}};
+    p = wave_field(grid, pf);
+    s = wave_field(grid, sf);
+    views = {FieldView::whole(grid, p.data()), FieldView::whole(grid, s.data())};
+    tasks = {
+        TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
+        TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
+                          TransferFunction::preset("s-wave"), ValueWindow::relative_to(0, 1.0), 1.0, 0.9),
+        TaskSpec::volume(0, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1)),
+        TaskSpec::isosurface(0, 0.4f, {1, 0.6f, 0.2f}),
+        TaskSpec::isosurface(1, -0.2f, {0.3f, 0.9f, 0.4f}),
+        TaskSpec::slice(0, 2, 1.3, TransferFunction::preset("diverging"), ValueWindow::absolute(-1, 1)),
+        TaskSpec::slice(1, 0, -3.7, TransferFunction::preset("rainbow"), ValueWindow::absolute(-1, 1)),
+    };
+  }
+  std::vector<Brick> slabs(int axis, int n) const {
+    std::vector<Brick> b;
+    for (int i = 0; i < n; ++i) b.push_back(Brick::slab(grid, axis, n, i));
+    return b;
+  }
+};
+
+const camera::Camera kCams[] = {
+    camera::Camera({45, -60, 30}, {0, 0, 0}, {0, 0, 1}, 40, 64, 60),
+    camera::Camera({-10, 8, -70}, {1, -1, 0}, {0, 1, 0}, 45, 60, 64),
+    camera::Camera({-80, 5, 3}, {0, 0, 0}, {0, 0, 1}, 35, 64, 64),
+};
+
+}  // namespace
+
+TEST(Compositing, BricksAlongZAndXMatchTheSingleBrickImage) {
+  const Scene sc;
+  for (const auto& cam : kCams) {
+    const auto ref = render_bricked(cam, sc.views, sc.tasks, {Brick::whole(sc.grid)});
+    for (int axis : {2, 0})
+      for (int n : {2, 3, 4}) {
+        const auto img = render_bricked(cam, sc.views, sc.tasks, sc.slabs(axis, n));
+        for (std::size_t t = 0; t < sc.tasks.size(); ++t)
+          EXPECT_LE(max_diff(img[t], ref[t]), 1) << "axis " << axis << ", " << n << " bricks, task " << t;
+      }
+  }
+}
+
+TEST(Compositing, BlockDecompositionInVisibilityOrderMatches) {
+  const Scene sc;
+  std::vector<Brick> blocks;  // 2 × 2 × 2 blocks of unequal size
+  const int cx[] = {0, 17, 40}, cy[] = {0, 20, 36}, cz[] = {0, 11, 32};
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) blocks.push_back({{cx[i], cy[j], cz[k]}, {cx[i + 1], cy[j + 1], cz[k + 1]}});
+  for (const auto& cam : kCams) {
+    const auto ref = render_bricked(cam, sc.views, sc.tasks, {Brick::whole(sc.grid)});
+    const auto by_depth = render_bricked(cam, sc.views, sc.tasks, blocks);
+    const auto ordered = render_bricked(cam, sc.views, sc.tasks, blocks, {}, true);
+    for (std::size_t t = 0; t < sc.tasks.size(); ++t) {
+      EXPECT_LE(max_diff(by_depth[t], ref[t]), 1) << "task " << t;
+      EXPECT_LE(max_diff(ordered[t], ref[t]), 1) << "task " << t;
+    }
+  }
+}
+
+TEST(Compositing, OneMarchForKTasksEqualsKMarches) {
+  const Scene sc;
+  const auto& cam = kCams[0];
+  std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  std::vector<PartialImage> together(sc.tasks.size());
+  const RenderStats st = render_brick(cam, fields, sc.tasks, together);
+  std::uint64_t separate_marched = 0;
+  for (std::size_t t = 0; t < sc.tasks.size(); ++t) {
+    std::vector<PartialImage> one(1);
+    separate_marched += render_brick(cam, fields, std::span(&sc.tasks[t], 1), one).marched_samples;
+    EXPECT_EQ(one[0].rgba, together[t].rgba) << "task " << t;
+  }
+  EXPECT_LT(st.marched_samples, separate_marched);
+}
+
+TEST(Compositing, EmptySpaceSkippingDoesNotChangeImagesAndSkips) {
+  const Scene sc;
+  const auto& cam = kCams[1];
+  std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  for (std::size_t t = 0; t < sc.tasks.size(); ++t) {
+    std::vector<PartialImage> a(1), b(1);
+    RenderOptions on, off;
+    off.skip_empty = false;
+    const auto sa = render_brick(cam, fields, std::span(&sc.tasks[t], 1), a, on);
+    const auto sb = render_brick(cam, fields, std::span(&sc.tasks[t], 1), b, off);
+    EXPECT_EQ(sa.samples, sb.samples);
+    for (std::size_t i = 0; i < a[0].rgba.size(); ++i) ASSERT_NEAR(a[0].rgba[i], b[0].rgba[i], 1e-5) << "task " << t;
+    if (sc.tasks[t].kind == TaskKind::volume) {
+      EXPECT_LT(sa.marched_samples, sb.marched_samples) << "task " << t;
+    }
+  }
+}
+
+TEST(Compositing, ManyTasksAreSplitIntoGroupsOfMarches) {
+  GridGeometry g{{9, 9, 9}, {-4, -4, -4}, {1, 1, 1}};
+  std::vector<float> v(9 * 9 * 9, 0.5f);
+  std::vector<PreparedField> fields{PreparedField(FieldView::whole(g, v.data()))};
+  std::vector<TaskSpec> tasks;
+  for (int i = 0; i < 70; ++i)
+    tasks.push_back(TaskSpec::volume(0, TransferFunction::constant({1, 1, 1}, 0.01f * (i + 1)), ValueWindow::absolute(0, 1)));
+  std::vector<PartialImage> out(tasks.size());
+  camera::Camera cam({0, 0, 30}, {0, 0, 0}, {0, 1, 0}, 30, 9, 9);
+  render_brick(cam, fields, tasks, out);
+  const float* a1 = out[0].rgba_at(4, 4);
+  const float* a70 = out[69].rgba_at(4, 4);
+  EXPECT_NEAR(a1[3], 1 - std::exp(-0.01 * 8), 1e-3);
+  EXPECT_NEAR(a70[3], 1 - std::exp(-0.70 * 8), 1e-3);
+}
+
+TEST(Compositing, RejectsInconsistentInput) {
+  const Scene sc;
+  std::vector<PreparedField> fields{PreparedField(sc.views[0].subview(Brick::slab(sc.grid, 2, 2, 0))),
+                                    PreparedField(sc.views[1])};
+  std::vector<PartialImage> out(1);
+  EXPECT_THROW(render_brick(kCams[0], fields, std::span(&sc.tasks[0], 1), out), Error);
+  std::vector<PartialImage> none;
+  EXPECT_THROW(render_brick(kCams[0], std::span(fields.data(), 1), std::span(&sc.tasks[0], 1), none), Error);
+  FieldView bad = sc.views[0].subview(Brick::slab(sc.grid, 2, 2, 0));
+  bad.points.lo[2] += 1;  // a ghost layer missing
+  EXPECT_THROW(bad.validate(), Error);
+  const TaskSpec wrong_field = TaskSpec::isosurface(5, 0.1f);
+  EXPECT_THROW(render_brick(kCams[0], std::span(fields.data() + 1, 1), std::span(&wrong_field, 1), out), Error);
+}

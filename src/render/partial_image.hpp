@@ -1,0 +1,90 @@
+#pragma once
+// Premultiplied partial images of bricks, the front-to-back compositing operator, the visibility
+// order of bricks, and the final RGBA8 image with the domain's outline box.
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "camera/camera.hpp"
+#include "core/image.hpp"
+#include "render/field_view.hpp"
+#include "render/transfer_function.hpp"
+
+namespace panoptes::render {
+
+/// Pixel rectangle [x0, x1) × [y0, y1).
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+  bool operator==(const PixelRect&) const = default;
+};
+
+/// What one brick contributes to one (camera, task) image: premultiplied RGBA floats for the pixels
+/// of `rect` (the brick's screen footprint; pixels outside it are transparent), and per pixel the
+/// depth — the ray parameter (world distance from the camera) where the ray ENTERS the brick, +∞
+/// when it misses. Bricks are convex and disjoint, so sorting a pixel's partials by this depth is
+/// their exact front-to-back order.
+struct PartialImage {
+  static constexpr float kNoDepth = std::numeric_limits<float>::infinity();
+  int width = 0, height = 0;  ///< full image size
+  PixelRect rect;
+  std::vector<float> rgba;   ///< 4 floats per pixel of rect, row-major, premultiplied by alpha
+  std::vector<float> depth;  ///< 1 float per pixel of rect
+
+  /// Resizes to a w×h image holding `r` (clipped to the image), all transparent, depth +∞.
+  /// Reuses the buffers' capacity (no allocation once warm).
+  void reset(int w, int h, PixelRect r);
+  float* rgba_at(int x, int y) { return rgba.data() + 4 * (std::size_t(y - rect.y0) * rect.width() + (x - rect.x0)); }
+  const float* rgba_at(int x, int y) const {
+    return rgba.data() + 4 * (std::size_t(y - rect.y0) * rect.width() + (x - rect.x0));
+  }
+  float depth_at(int x, int y) const {
+    return rect.contains(x, y) ? depth[std::size_t(y - rect.y0) * rect.width() + (x - rect.x0)] : kNoDepth;
+  }
+};
+
+/// The compositing operator, front-to-back "over" on premultiplied colour:
+/// acc ← acc + (1 − acc.α)·back. Associative, so partials may be merged pairwise in any grouping
+/// as long as their front-to-back order is kept.
+inline void over(float* acc, const float* back) {
+  const float w = 1.0f - acc[3];
+  acc[0] += w * back[0];
+  acc[1] += w * back[1];
+  acc[2] += w * back[2];
+  acc[3] += w * back[3];
+}
+
+/// Merges partial images of disjoint bricks of the same (camera, task) into one, ordering them per
+/// pixel by depth (exact for any brick decomposition). The result covers the union of the rects;
+/// its depth is the nearest. Throws panoptes::Error if the image sizes differ.
+PartialImage composite(std::span<const PartialImage* const> parts);
+/// Merges partial images already in front-to-back order (e.g. from visibility_order()).
+PartialImage composite_ordered(std::span<const PartialImage* const> front_to_back);
+
+/// A front-to-back order of bricks for a camera: indices into `bricks` sorted by the sum over axes
+/// of the world distance from the camera to the brick's extent along that axis (0 when the camera
+/// lies within it). Valid for bricks cut on common planes (slabs, rectilinear block
+/// decompositions, as MPI codes use); for arbitrary boxes use composite() (per-pixel depth).
+std::vector<int> visibility_order(const camera::Camera& cam, const GridGeometry& grid, std::span<const Brick> bricks);
+
+/// The domain's outline box in final images.
+struct OutlineStyle {
+  bool enabled = true;
+  Rgb colour{0.75f, 0.75f, 0.75f};
+  float width = 1.5f;  ///< line width in pixels (anti-aliased)
+};
+
+/// The final RGBA8 image (alpha 255): `composited` over the background colour, with the outline of
+/// `grid`'s domain box drawn depth-correctly. The box is convex and its edges lie on the domain
+/// surface, so an edge is either where rays ENTER the volume (an edge of a face turned towards the
+/// camera: drawn over the volume) or where they LEAVE it (both adjacent faces turned away: drawn
+/// behind the volume and attenuated by its full opacity). `composited` may cover only part of the
+/// image (its rect). Throws panoptes::Error when its size differs from the camera's.
+Image finish_image(const PartialImage& composited, const camera::Camera& cam, const GridGeometry& grid,
+                   Rgb background = {0, 0, 0}, const OutlineStyle& outline = {});
+
+}  // namespace panoptes::render

@@ -1,0 +1,572 @@
+#include "render/renderer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace panoptes::render {
+
+TaskSpec TaskSpec::volume(int field, TransferFunction tf, ValueWindow window, double reference) {
+  TaskSpec t;
+  t.kind = TaskKind::volume;
+  t.field = field;
+  t.tf = std::move(tf);
+  t.window = window;
+  t.reference = reference;
+  return t;
+}
+
+TaskSpec TaskSpec::volume2(int field, TransferFunction tf, ValueWindow window, int field2, TransferFunction tf2,
+                           ValueWindow window2, double reference, double reference2) {
+  TaskSpec t = volume(field, std::move(tf), window, reference);
+  t.field2 = field2;
+  t.tf2 = std::move(tf2);
+  t.window2 = window2;
+  t.reference2 = reference2;
+  return t;
+}
+
+TaskSpec TaskSpec::isosurface(int field, float isovalue, Rgb colour) {
+  TaskSpec t;
+  t.kind = TaskKind::isosurface;
+  t.field = field;
+  t.isovalue = isovalue;
+  t.surface_colour = colour;
+  return t;
+}
+
+TaskSpec TaskSpec::slice(int field, int axis, double position, TransferFunction colour_map, ValueWindow window,
+                         double reference) {
+  TaskSpec t;
+  t.kind = TaskKind::slice;
+  t.field = field;
+  t.slice_axis = axis;
+  t.slice_position = position;
+  t.tf = std::move(colour_map);
+  t.window = window;
+  t.reference = reference;
+  return t;
+}
+
+namespace {
+
+// Raw access to one field for the hot loop: global point (i, j, k) is data[off0 + i·sx + j·sy + k·sz].
+struct FieldAcc {
+  const float* data;
+  std::int64_t sx, sy, sz, off0;
+  int ilo[3], ihi[3];    // clamp range of a cell's lower corner: [points.lo, points.hi − 2]
+  float plo[3], phi[3];  // clamp range of positions: [points.lo, points.hi − 1]
+};
+
+FieldAcc make_acc(const FieldView& v) {
+  FieldAcc a;
+  a.data = v.data;
+  a.sx = v.stride[0];
+  a.sy = v.stride[1];
+  a.sz = v.stride[2];
+  a.off0 = -(v.points.lo[0] * a.sx + v.points.lo[1] * a.sy + v.points.lo[2] * a.sz);
+  for (int k = 0; k < 3; ++k) {
+    a.ilo[k] = v.points.lo[k];
+    a.ihi[k] = std::max(v.points.lo[k], v.points.hi[k] - 2);
+    a.plo[k] = float(v.points.lo[k]);
+    a.phi[k] = float(v.points.hi[k] - 1);
+  }
+  return a;
+}
+
+// Trilinear interpolation at index-space position (x, y, z). The cell index is clamped so float
+// rounding at the brick faces can never read outside the data.
+inline float interp(const FieldAcc& f, float x, float y, float z) {
+  int i = int(x), j = int(y), k = int(z);
+  i = std::min(std::max(i, f.ilo[0]), f.ihi[0]);
+  j = std::min(std::max(j, f.ilo[1]), f.ihi[1]);
+  k = std::min(std::max(k, f.ilo[2]), f.ihi[2]);
+  const float fx = x - float(i), fy = y - float(j), fz = z - float(k);
+  const float* c = f.data + (f.off0 + i * f.sx + j * f.sy + k * f.sz);
+  const std::int64_t sx = f.sx, sy = f.sy, sz = f.sz;
+  const float c00 = c[0] + fx * (c[sx] - c[0]);
+  const float c10 = c[sy] + fx * (c[sy + sx] - c[sy]);
+  const float c01 = c[sz] + fx * (c[sz + sx] - c[sz]);
+  const float c11 = c[sz + sy] + fx * (c[sz + sy + sx] - c[sz + sy]);
+  const float c0 = c00 + fy * (c10 - c00);
+  const float c1 = c01 + fy * (c11 - c01);
+  return c0 + fz * (c1 - c0);
+}
+
+// Interpolation at an arbitrary position (clamped into the data): off the hot path.
+inline float interp_clamped(const FieldAcc& f, double x, double y, double z) {
+  const float px = std::clamp(float(x), f.plo[0], f.phi[0]);
+  const float py = std::clamp(float(y), f.plo[1], f.phi[1]);
+  const float pz = std::clamp(float(z), f.plo[2], f.phi[2]);
+  return interp(f, px, py, pz);
+}
+
+enum class RtKind : std::uint8_t { volume1, volume2, iso, slice };
+
+// A task prepared for the hot loop: field slots, LUT pointers and windows, isovalue, slice plane.
+struct TaskRt {
+  RtKind kind;
+  int s1 = 0, s2 = 0;  // slots in the march's field list
+  const LutEntry* lut1 = nullptr;
+  const LutEntry* lut2 = nullptr;
+  float lo1 = 0, sc1 = 1, last1 = 0, lo2 = 0, sc2 = 1, last2 = 0;
+  bool abs1 = false, abs2 = false;
+  float iso = 0;
+  float colour[3] = {0, 0, 0};
+  int axis = 2;
+  double plane = 0;  // slice plane in index coordinates
+  float opacity = 1;
+};
+
+inline int lut_bin(float v, float lo, float sc, float last, bool absv) {
+  if (absv) v = std::fabs(v);
+  float u = (v - lo) * sc;
+  u = u > 0 ? u : 0.0f;
+  u = u < last ? u : last;
+  return int(u);
+}
+
+// Ray–box intersection in index space; returns false when the ray misses.
+inline bool slab(const double O[3], const double D[3], const double lo[3], const double hi[3], double& t0, double& t1) {
+  t0 = -INFINITY;
+  t1 = INFINITY;
+  for (int a = 0; a < 3; ++a) {
+    if (D[a] == 0) {
+      if (O[a] < lo[a] || O[a] > hi[a]) return false;
+      continue;
+    }
+    double ta = (lo[a] - O[a]) / D[a], tb = (hi[a] - O[a]) / D[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t1 >= t0;
+}
+
+struct Shared {
+  const camera::Camera* cam;
+  GridGeometry grid;
+  Brick brick;
+  std::vector<FieldAcc> acc;  // per march slot
+  std::vector<const MacroCells*> cells;
+  std::vector<TaskRt> rt;
+  std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
+  std::uint64_t march_mask = 0, iso_mask = 0;
+  std::vector<int> slices;
+  double dt = 0;
+  float termination = 0.998f;
+  int mc = 8;
+  Index3 mcount{};
+  PartialImage* out = nullptr;  // first of rt.size() outputs
+  Vec3 spacing;
+};
+
+// Lit colour of an isosurface hit at index-space position p seen along world direction dir.
+void shade_hit(const Shared& S, const FieldAcc& f, const double p[3], const Vec3& dir, const TaskRt& T, float* a) {
+  double g[3];
+  for (int ax = 0; ax < 3; ++ax) {
+    double q1[3] = {p[0], p[1], p[2]}, q0[3] = {p[0], p[1], p[2]};
+    q1[ax] = std::min(q1[ax] + 0.5, double(S.grid.dims[ax] - 1));
+    q0[ax] = std::max(q0[ax] - 0.5, 0.0);
+    const double h = (q1[ax] - q0[ax]) * S.spacing[ax];
+    g[ax] = h > 0 ? (interp_clamped(f, q1[0], q1[1], q1[2]) - interp_clamped(f, q0[0], q0[1], q0[2])) / h : 0.0;
+  }
+  Vec3 n = normalize(Vec3{g[0], g[1], g[2]});
+  double ndl = -dot(n, dir);  // headlight: light comes from the camera
+  ndl = std::abs(ndl);        // two-sided lighting
+  if (norm(n) == 0) ndl = 1;
+  const float diffuse = float(0.15 + 0.85 * ndl);
+  const float spec = float(0.25 * std::pow(ndl, 32.0));
+  for (int k = 0; k < 3; ++k) a[k] = std::min(1.0f, T.colour[k] * diffuse + spec);
+  a[3] = 1.0f;
+}
+
+// Marches one ray through the brick for all march tasks; fills acc[i] (premultiplied) per task.
+// Returns the effective and marched sample counts through the references.
+void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3& dir, double t0, double tg1,
+               double tb0, double tb1, float (*acc)[4], std::uint64_t& effective, std::uint64_t& marched) {
+  const double dt = S.dt;
+  const Brick& B = S.brick;
+  const std::int64_t kg_last = std::int64_t(std::ceil((tg1 - t0) / dt)) - 1;
+  std::int64_t ks = std::max<std::int64_t>(0, std::int64_t(std::ceil((tb0 - t0) / dt)) - 1);
+  std::int64_t ke = std::min(kg_last, std::int64_t(std::floor((tb1 - t0) / dt)) + 1);
+  // Exact membership, computed identically by every brick of a decomposition: half-open [lo, hi),
+  // closed at the upper faces of the global domain so every sample of the domain has one owner.
+  // Samples 0 … kg_last lie in the domain by construction; clamping undoes rounding at its faces.
+  auto inside = [&](std::int64_t k) {
+    const double t = t0 + double(k) * dt;
+    for (int a = 0; a < 3; ++a) {
+      const double p = std::clamp(O[a] + t * D[a], 0.0, double(S.grid.dims[a] - 1));
+      if (!(p >= B.lo[a] && (p < B.hi[a] || (p == B.hi[a] && B.hi[a] == S.grid.dims[a] - 1)))) return false;
+    }
+    return true;
+  };
+  while (ks <= ke && !inside(ks)) ++ks;
+  while (ke >= ks && !inside(ke)) --ke;
+  if (ks > ke) return;
+  effective += std::uint64_t(ke - ks + 1);
+  // The last sample of the ray in the whole domain stands for a shorter segment.
+  std::int64_t k_partial = -1;
+  float partial = 1;
+  if (ke == kg_last) {
+    const double f = (tg1 - (t0 + double(kg_last) * dt)) / dt;
+    if (f < 1 - 1e-6) {
+      k_partial = kg_last;
+      partial = float(std::max(0.0, f));
+    }
+  }
+
+  const int nslots = int(S.acc.size());
+  std::uint64_t live = S.march_mask;
+  float prev[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  bool have_prev = false;
+  const float Sx = float(dt * D[0]), Sy = float(dt * D[1]), Sz = float(dt * D[2]);
+  const int M = S.mc;
+  const float thr = S.termination;
+
+  std::int64_t k = ks;
+  while (k <= ke && live) {
+    const double t = t0 + double(k) * dt;
+    const double p[3] = {O[0] + t * D[0], O[1] + t * D[1], O[2] + t * D[2]};
+    int mi[3];
+    double texit = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+      mi[a] = std::clamp(int((p[a] - B.lo[a]) / M), 0, S.mcount[a] - 1);
+      if (D[a] != 0) {
+        const double c0 = B.lo[a] + mi[a] * M, c1 = std::min(c0 + M, double(B.hi[a]));
+        texit = std::min(texit, ((D[a] > 0 ? c1 : c0) - O[a]) / D[a]);
+      }
+    }
+    std::int64_t kend = std::int64_t(std::ceil((texit - t0) / dt)) - 1;
+    kend = std::clamp(kend, k, ke);
+    const std::uint64_t mask = S.active[std::size_t(mi[0] + S.mcount[0] * (mi[1] + S.mcount[1] * mi[2]))];
+    if (!(mask & live)) {  // empty macro-cell for every live task
+      k = kend + 1;
+      have_prev = false;
+      continue;
+    }
+    if (!have_prev && (live & S.iso_mask) && k > 0) {
+      // The sample before this run (maybe in the previous brick: within the ghost layers).
+      const double tp = t - dt;
+      for (int s = 0; s < nslots; ++s)
+        prev[s] = interp_clamped(S.acc[std::size_t(s)], O[0] + tp * D[0], O[1] + tp * D[1], O[2] + tp * D[2]);
+      have_prev = true;
+    }
+    const float px0 = float(p[0]), py0 = float(p[1]), pz0 = float(p[2]);
+    std::int64_t kk = k;
+    for (; kk <= kend; ++kk) {
+      const float j = float(kk - k);
+      const float x = px0 + j * Sx, y = py0 + j * Sy, z = pz0 + j * Sz;
+      float v[8];
+      for (int s = 0; s < nslots; ++s) v[s] = interp(S.acc[std::size_t(s)], x, y, z);
+      std::uint64_t m = mask & live;
+      while (m) {
+        const int i = std::countr_zero(m);
+        m &= m - 1;
+        const TaskRt& T = S.rt[std::size_t(i)];
+        float* a = acc[i];
+        switch (T.kind) {
+          case RtKind::volume1: {
+            const LutEntry& e = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
+            float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
+            if (kk == k_partial) [[unlikely]] {
+              const float a2 = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
+              const float s = al > 0 ? a2 / al : 0.0f;
+              pr *= s, pg *= s, pb *= s, al = a2;
+            }
+            const float w = 1.0f - a[3];
+            a[0] += w * pr;
+            a[1] += w * pg;
+            a[2] += w * pb;
+            a[3] += w * al;
+            if (a[3] >= thr) live &= ~(std::uint64_t(1) << i);
+            break;
+          }
+          case RtKind::volume2: {
+            const LutEntry& e1 = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
+            const LutEntry& e2 = T.lut2[lut_bin(v[T.s2], T.lo2, T.sc2, T.last2, T.abs2)];
+            const float tau = e1.tau + e2.tau;
+            if (tau <= 0) break;
+            float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
+            if (kk == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
+            const float s = al / tau;
+            const float w = 1.0f - a[3];
+            a[0] += w * s * (e1.tau * e1.r + e2.tau * e2.r);
+            a[1] += w * s * (e1.tau * e1.g + e2.tau * e2.g);
+            a[2] += w * s * (e1.tau * e1.b + e2.tau * e2.b);
+            a[3] += w * al;
+            if (a[3] >= thr) live &= ~(std::uint64_t(1) << i);
+            break;
+          }
+          case RtKind::iso: {
+            const float d = v[T.s1] - T.iso;
+            if (!have_prev) break;
+            float dp = prev[T.s1] - T.iso;
+            if ((dp < 0) == (d < 0)) break;
+            // First crossing between samples kk−1 and kk: linear estimate, one regula-falsi step.
+            const FieldAcc& f = S.acc[std::size_t(T.s1)];
+            double ta = t0 + double(kk - 1) * dt, tb = ta + dt;
+            double dpa = dp, dpb = d;
+            double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+            const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - T.iso;
+            if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+            else tb = th, dpb = vh;
+            if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+            const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+            shade_hit(S, f, ph, dir, T, a);
+            live &= ~(std::uint64_t(1) << i);
+            break;
+          }
+          case RtKind::slice:
+            break;
+        }
+      }
+      for (int s = 0; s < nslots; ++s) prev[s] = v[s];
+      have_prev = true;
+      if (!live) {
+        ++kk;
+        break;
+      }
+    }
+    marched += std::uint64_t(kk - k);
+    k = kend + 1;
+  }
+}
+
+}  // namespace
+
+RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedField> fields,
+                         std::span<const TaskSpec> tasks, std::span<PartialImage> out, const RenderOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  if (out.size() != tasks.size())
+    throw Error("render: " + std::to_string(tasks.size()) + " tasks but " + std::to_string(out.size()) + " output images");
+  if (fields.empty()) throw Error("render: no fields given");
+  if (!(opt.sample_distance > 0 && opt.sample_distance <= 16))
+    throw Error("render: sample distance " + std::to_string(opt.sample_distance) + " voxels; expected 0 < d <= 16");
+  if (opt.tile < 1) throw Error("render: tile size " + std::to_string(opt.tile) + "; expected >= 1");
+  const FieldView& f0 = fields[0].view;
+  for (const PreparedField& f : fields) {
+    f.view.validate();
+    if (f.view.grid.dims != f0.grid.dims || !(f.view.grid.origin == f0.grid.origin) ||
+        !(f.view.grid.spacing == f0.grid.spacing) || !(f.view.brick == f0.brick) ||
+        f.cells.size() != fields[0].cells.size() || f.cells.counts() != fields[0].cells.counts())
+      throw Error("render: all fields of one call must share grid, brick and macro-cell size");
+  }
+  RenderStats stats;
+  if (tasks.size() > std::size_t(kMaxTasksPerMarch)) {
+    for (std::size_t g = 0; g < tasks.size(); g += kMaxTasksPerMarch) {
+      const std::size_t n = std::min<std::size_t>(kMaxTasksPerMarch, tasks.size() - g);
+      const RenderStats s = render_brick(cam, fields, tasks.subspan(g, n), out.subspan(g, n), opt);
+      stats.rays = std::max(stats.rays, s.rays);
+      stats.samples += s.samples;
+      stats.marched_samples += s.marched_samples;
+    }
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+  }
+
+  Shared S;
+  S.cam = &cam;
+  S.grid = f0.grid;
+  S.brick = f0.brick;
+  S.spacing = f0.grid.spacing;
+  S.dt = opt.sample_distance * f0.grid.voxel();
+  S.termination = opt.termination_alpha;
+  S.mc = fields[0].cells.size();
+  S.mcount = fields[0].cells.counts();
+
+  // Fields read by the tasks get march slots (interpolated once per sample, whatever K is).
+  std::vector<int> slot_of(fields.size(), -1);
+  std::vector<int> field_of_slot;
+  auto slot = [&](int f) {
+    if (f < 0 || std::size_t(f) >= fields.size())
+      throw Error("render: task refers to field " + std::to_string(f) + " but " + std::to_string(fields.size()) +
+                  " fields were given");
+    if (slot_of[std::size_t(f)] < 0) {
+      slot_of[std::size_t(f)] = int(field_of_slot.size());
+      field_of_slot.push_back(f);
+      S.acc.push_back(make_acc(fields[std::size_t(f)].view));
+      S.cells.push_back(&fields[std::size_t(f)].cells);
+    }
+    return slot_of[std::size_t(f)];
+  };
+
+  std::vector<TransferLut> luts(2 * tasks.size());
+  S.rt.resize(tasks.size());
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    const TaskSpec& t = tasks[i];
+    TaskRt& r = S.rt[i];
+    const std::uint64_t bit = std::uint64_t(1) << i;
+    auto bake = [&](const TransferFunction& tf, const ValueWindow& w, double ref, int which) -> TransferLut& {
+      luts[2 * i + std::size_t(which)] = TransferLut(tf, w.resolve(ref), opt.sample_distance);
+      return luts[2 * i + std::size_t(which)];
+    };
+    switch (t.kind) {
+      case TaskKind::volume: {
+        r.kind = t.field2 >= 0 ? RtKind::volume2 : RtKind::volume1;
+        r.s1 = slot(t.field);
+        const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
+        r.lut1 = &l1.entry(0);
+        r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
+        if (t.field2 >= 0) {
+          r.s2 = slot(t.field2);
+          const TransferLut& l2 = bake(t.tf2, t.window2, t.reference2, 1);
+          r.lut2 = &l2.entry(0);
+          r.lo2 = l2.lo(), r.sc2 = l2.scale(), r.last2 = float(l2.bins() - 1), r.abs2 = l2.absolute_value();
+        }
+        S.march_mask |= bit;
+        break;
+      }
+      case TaskKind::isosurface:
+        if (!std::isfinite(t.isovalue)) throw Error("render: isovalue is not finite");
+        r.kind = RtKind::iso;
+        r.s1 = slot(t.field);
+        r.iso = t.isovalue;
+        r.colour[0] = t.surface_colour.r, r.colour[1] = t.surface_colour.g, r.colour[2] = t.surface_colour.b;
+        S.march_mask |= bit;
+        S.iso_mask |= bit;
+        break;
+      case TaskKind::slice: {
+        if (t.slice_axis < 0 || t.slice_axis > 2)
+          throw Error("render: slice axis " + std::to_string(t.slice_axis) + "; expected 0 (x), 1 (y) or 2 (z)");
+        if (!(t.slice_opacity >= 0 && t.slice_opacity <= 1))
+          throw Error("render: slice opacity " + std::to_string(t.slice_opacity) + "; expected [0, 1]");
+        r.kind = RtKind::slice;
+        r.s1 = slot(t.field);
+        const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
+        r.lut1 = &l1.entry(0);
+        r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
+        r.axis = t.slice_axis;
+        const int a = t.slice_axis;
+        r.plane = (t.slice_position - S.grid.origin[a]) / S.spacing[a];  // index coordinates
+        r.opacity = t.slice_opacity;
+        S.slices.push_back(int(i));
+        break;
+      }
+    }
+  }
+  if (S.acc.size() > 8) throw Error("render: tasks of one call read " + std::to_string(S.acc.size()) + " fields; at most 8");
+
+  // Per macro-cell: which tasks see anything there (volume: non-zero opacity somewhere in the
+  // cell's value range; isosurface: the isovalue inside it).
+  const int nmc = fields[0].cells.total();
+  S.active.assign(std::size_t(nmc), 0);
+  for (int m = 0; m < nmc; ++m) {
+    std::uint64_t bits = 0;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      const TaskRt& r = S.rt[i];
+      const std::uint64_t bit = std::uint64_t(1) << i;
+      if (!(S.march_mask & bit)) continue;
+      if (!opt.skip_empty) {
+        bits |= bit;
+        continue;
+      }
+      const MacroCells& c1 = *S.cells[std::size_t(r.s1)];
+      if (r.kind == RtKind::iso) {
+        if (c1.min(m) <= r.iso && r.iso <= c1.max(m)) bits |= bit;
+      } else {
+        bool vis = luts[2 * i].visible(c1.min(m), c1.max(m));
+        if (!vis && r.kind == RtKind::volume2) {
+          const MacroCells& c2 = *S.cells[std::size_t(r.s2)];
+          vis = luts[2 * i + 1].visible(c2.min(m), c2.max(m));
+        }
+        if (vis) bits |= bit;
+      }
+    }
+    S.active[std::size_t(m)] = bits;
+  }
+
+  // The brick's screen footprint.
+  const int W = cam.width(), H = cam.height();
+  PixelRect rect{W, H, 0, 0};
+  bool all = false;
+  for (int c = 0; c < 8; ++c) {
+    Vec3 p;
+    for (int a = 0; a < 3; ++a)
+      p[a] = S.grid.origin[a] + ((c >> a) & 1 ? S.brick.hi[a] : S.brick.lo[a]) * S.spacing[a];
+    double px, py;
+    if (!cam.project(p, px, py)) {
+      all = true;
+      break;
+    }
+    rect.x0 = std::min(rect.x0, int(std::floor(std::max(px, -1.0))) - 1);
+    rect.y0 = std::min(rect.y0, int(std::floor(std::max(py, -1.0))) - 1);
+    rect.x1 = std::max(rect.x1, int(std::ceil(std::min(px, W + 1.0))) + 1);
+    rect.y1 = std::max(rect.y1, int(std::ceil(std::min(py, H + 1.0))) + 1);
+  }
+  if (all) rect = {0, 0, W, H};
+  for (PartialImage& o : out) o.reset(W, H, rect);
+  rect = out.empty() ? PixelRect{} : out[0].rect;
+  if (tasks.empty()) return stats;
+
+  const int tile = opt.tile;
+  const int ntx = (rect.width() + tile - 1) / tile, nty = (rect.height() + tile - 1) / tile;
+  const int K = int(tasks.size());
+  const double glo[3] = {0, 0, 0};
+  const double ghi[3] = {double(S.grid.dims[0] - 1), double(S.grid.dims[1] - 1), double(S.grid.dims[2] - 1)};
+  const double blo[3] = {double(S.brick.lo[0]), double(S.brick.lo[1]), double(S.brick.lo[2])};
+  const double bhi[3] = {double(S.brick.hi[0]), double(S.brick.hi[1]), double(S.brick.hi[2])};
+  std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0;
+
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : n_rays, n_eff, n_marched)
+  for (int ti = 0; ti < ntx * nty; ++ti) {
+    alignas(64) float acc[kMaxTasksPerMarch][4];
+    const int tx0 = rect.x0 + (ti % ntx) * tile, ty0 = rect.y0 + (ti / ntx) * tile;
+    const int tx1 = std::min(tx0 + tile, rect.x1), ty1 = std::min(ty0 + tile, rect.y1);
+    for (int y = ty0; y < ty1; ++y)
+      for (int x = tx0; x < tx1; ++x) {
+        const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
+        double O[3], D[3];
+        for (int a = 0; a < 3; ++a) {
+          O[a] = (ray.origin[a] - S.grid.origin[a]) / S.spacing[a];
+          D[a] = ray.direction[a] / S.spacing[a];
+        }
+        double tg0, tg1, tb0, tb1;
+        if (!slab(O, D, glo, ghi, tg0, tg1)) continue;
+        const double t0 = std::max(tg0, 0.0);
+        if (tg1 <= t0) continue;
+        if (!slab(O, D, blo, bhi, tb0, tb1)) continue;
+        tb0 = std::max(tb0, t0);
+        tb1 = std::min(tb1, tg1);
+        if (tb1 < tb0) continue;
+        ++n_rays;
+        for (int i = 0; i < K; ++i) acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
+        if (S.march_mask) march_ray(S, O, D, ray.direction, t0, tg1, tb0, tb1, acc, n_eff, n_marched);
+        for (int i : S.slices) {
+          const TaskRt& r = S.rt[std::size_t(i)];
+          const int a = r.axis;
+          if (D[a] == 0) continue;
+          const double t = (r.plane - O[a]) / D[a];
+          if (!(t >= t0)) continue;
+          double p[3] = {O[0] + t * D[0], O[1] + t * D[1], O[2] + t * D[2]};
+          p[a] = r.plane;
+          bool in = true;  // the march's ownership rule: half-open, closed at the domain's upper faces
+          for (int b = 0; b < 3; ++b)
+            in = in && p[b] >= blo[b] && (p[b] < bhi[b] || (p[b] == bhi[b] && bhi[b] == ghi[b]));
+          if (!in) continue;
+          const float v = interp_clamped(S.acc[std::size_t(r.s1)], p[0], p[1], p[2]);
+          const LutEntry& e = r.lut1[lut_bin(v, r.lo1, r.sc1, r.last1, r.abs1)];
+          acc[i][0] = e.r * r.opacity, acc[i][1] = e.g * r.opacity, acc[i][2] = e.b * r.opacity, acc[i][3] = r.opacity;
+        }
+        for (int i = 0; i < K; ++i) {
+          PartialImage& o = out[std::size_t(i)];
+          float* dst = o.rgba_at(x, y);
+          dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
+          o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = float(tb0);
+        }
+      }
+  }
+  stats.rays = n_rays;
+  stats.samples = n_eff;
+  stats.marched_samples = n_marched;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace panoptes::render

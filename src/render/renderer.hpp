@@ -1,0 +1,83 @@
+#pragma once
+// The brick ray caster: one march per camera serves K tasks (volume, isosurface, slice).
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "camera/camera.hpp"
+#include "render/macro_cells.hpp"
+#include "render/partial_image.hpp"
+#include "render/transfer_function.hpp"
+
+namespace panoptes::render {
+
+/// What one image shows.
+enum class TaskKind {
+  volume,      ///< emission–absorption volume rendering of one field, or two fields mixed per sample
+  isosurface,  ///< the first crossing of one isovalue, lit (headlight, Lambert + specular)
+  slice,       ///< an axis-aligned plane coloured by a colour map
+};
+
+/// One visualization task (one image per camera). Fields are indices into the `fields` span of
+/// render_brick(). Windows may be relative; `reference` / `reference2` resolve them (see
+/// ValueWindow). Build with the named constructors.
+struct TaskSpec {
+  TaskKind kind = TaskKind::volume;
+  int field = 0;
+  TransferFunction tf;  ///< volume: colour + extinction; slice: colour map
+  ValueWindow window;
+  double reference = 1;
+  int field2 = -1;  ///< volume only: second field, composited with the first at every sample
+  TransferFunction tf2;
+  ValueWindow window2;
+  double reference2 = 1;
+  float isovalue = 0;
+  Rgb surface_colour{0.85f, 0.85f, 0.85f};
+  int slice_axis = 2;         ///< 0 = x, 1 = y, 2 = z
+  double slice_position = 0;  ///< world coordinate of the plane along slice_axis
+  float slice_opacity = 1;
+
+  static TaskSpec volume(int field, TransferFunction tf, ValueWindow window, double reference = 1);
+  /// Two fields in one image (the paper's p-wave orange + s-wave green): per sample the extinctions
+  /// add and the colours mix in proportion to them.
+  static TaskSpec volume2(int field, TransferFunction tf, ValueWindow window, int field2, TransferFunction tf2,
+                          ValueWindow window2, double reference = 1, double reference2 = 1);
+  static TaskSpec isosurface(int field, float isovalue, Rgb colour = {0.85f, 0.85f, 0.85f});
+  static TaskSpec slice(int field, int axis, double position, TransferFunction colour_map, ValueWindow window,
+                        double reference = 1);
+};
+
+/// Ray-casting parameters shared by all tasks of a march.
+struct RenderOptions {
+  /// Distance between samples along a ray, in voxels (GridGeometry::voxel()). Opacity is corrected
+  /// for it exactly (α = 1 − exp(−σ·Δ)). Isosurfaces are exactly compositable across bricks for
+  /// values ≤ 1 (the ghost layers cover one step).
+  double sample_distance = 0.5;
+  bool skip_empty = true;            ///< empty-space skipping with macro-cells
+  float termination_alpha = 0.998f;  ///< early ray termination (the rest adds < 1/255)
+  int tile = 16;                     ///< tile edge in pixels (OpenMP dynamic schedule over tiles)
+};
+
+/// Counters of one render_brick() call.
+struct RenderStats {
+  std::uint64_t rays = 0;              ///< rays that have samples in the brick
+  std::uint64_t samples = 0;           ///< effective samples: inside the brick along those rays, marched or skipped
+  std::uint64_t marched_samples = 0;   ///< samples actually interpolated and classified
+  double seconds = 0;
+};
+
+/// Maximum tasks served by one march; longer task lists are processed in groups of this size.
+inline constexpr int kMaxTasksPerMarch = 64;
+
+/// Renders the brick shared by `fields` (all on the same grid and brick) for every task in one ray
+/// march per group of kMaxTasksPerMarch tasks: each sample is interpolated once per field and
+/// classified by every task still live. `out[i]` receives task i's premultiplied partial image
+/// (resized; capacity reused). Sample k of a ray lies at t0 + k·Δ, where t0 is where the ray enters
+/// the GLOBAL domain box (or 0 if the camera is inside), and a brick takes the samples inside its
+/// half-open cell range — so partial images of a brick decomposition composite (composite()) to the
+/// single-brick image. Throws panoptes::Error on inconsistent fields, bad task parameters or
+/// out.size() != tasks.size().
+RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedField> fields,
+                         std::span<const TaskSpec> tasks, std::span<PartialImage> out, const RenderOptions& options = {});
+
+}  // namespace panoptes::render

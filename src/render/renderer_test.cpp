@@ -1,0 +1,242 @@
+// Known-answer tests of the ray caster.
+#include "render/renderer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "render/render_test_util.hpp"
+#include "render/synthetic_fields.hpp"
+
+using namespace panoptes;
+using namespace panoptes::render;
+using panoptes::render::testing::max_diff;
+
+namespace {
+
+std::vector<PartialImage> render_whole(const camera::Camera& cam, const FieldView& f, const std::vector<TaskSpec>& tasks,
+                                       const RenderOptions& opt = {}) {
+  std::vector<PreparedField> fields{PreparedField(f)};
+  std::vector<PartialImage> out(tasks.size());
+  render_brick(cam, fields, tasks, out, opt);
+  return out;
+}
+
+// World path length of a ray through an axis-aligned box (0 if it misses).
+double path_length(const camera::Ray& r, const Vec3& lo, const Vec3& hi) {
+  double t0 = 0, t1 = 1e300;
+  for (int a = 0; a < 3; ++a) {
+    if (r.direction[a] == 0) continue;
+    double ta = (lo[a] - r.origin[a]) / r.direction[a], tb = (hi[a] - r.origin[a]) / r.direction[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return std::max(0.0, t1 - t0);
+}
+
+}  // namespace
+
+TEST(Renderer, HomogeneousSlabHasOpacityOneMinusExpSigmaL) {
+  // Anisotropic spacing: the voxel (unit of extinction and sample distance) is the smallest, 0.5.
+  const GridGeometry g{{12, 10, 7}, {-2.75, -3.6, -1.5}, {0.5, 0.8, 0.5}};
+  std::vector<float> v(12 * 10 * 7, 1.0f);
+  const FieldView f = FieldView::whole(g, v.data());
+  const float sigma = 0.35f;  // per voxel length
+  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::constant({1, 1, 1}, sigma), ValueWindow::absolute(0, 2))};
+  const camera::Camera cams[] = {camera::Camera({0, 0, 40}, {0, 0, 0}, {0, 1, 0}, 10, 33, 33),
+                                 camera::Camera({9, -14, 20}, {0.3, 0.2, -0.1}, {0, 0, 1}, 30, 40, 36)};
+  for (const auto& cam : cams)
+    for (double step : {0.5, 0.37, 1.0, 0.1}) {
+      RenderOptions opt;
+      opt.sample_distance = step;
+      opt.termination_alpha = 1.01f;  // no early termination: compare the full integral
+      const auto out = render_whole(cam, f, tasks, opt);
+      int checked = 0;
+      for (int y = 0; y < cam.height(); ++y)
+        for (int x = 0; x < cam.width(); ++x) {
+          const double L = path_length(cam.ray(x + 0.5, y + 0.5), g.domain_lo(), g.domain_hi()) / g.voxel();
+          if (L < 1) continue;  // grazing rays: the tolerance is relative
+          const double expected = 1 - std::exp(-sigma * L);
+          const float alpha = out[0].rgba_at(x, y)[3];
+          ASSERT_NEAR(alpha, expected, 0.01 * expected) << "pixel " << x << "," << y << " step " << step;
+          ++checked;
+        }
+      EXPECT_GT(checked, 50);
+    }
+}
+
+TEST(Renderer, SampleDistanceCorrectionMakesImagesNearlyStepIndependent) {
+  const GridGeometry g{{48, 40, 36}, {-23.5, -19.5, -17.5}, {1, 1, 1}};
+  const WaveFront wf[] = {{{2, -1, 0}, 12, 3, 1.0}};
+  const auto v = wave_field(g, wf);
+  const FieldView f = FieldView::whole(g, v.data());
+  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1))};
+  const camera::Camera cam({50, 40, 30}, {0, 0, 0}, {0, 0, 1}, 40, 64, 64);
+  auto image = [&](double step) {
+    RenderOptions opt;
+    opt.sample_distance = step;
+    const auto out = render_whole(cam, f, tasks, opt);
+    return finish_image(out[0], cam, g, {0, 0, 0}, {false});
+  };
+  const Image ref = image(0.125);
+  for (double step : {0.25, 0.5, 1.0}) {
+    const Image img = image(step);
+    EXPECT_GT(psnr(img, ref), step < 1 ? 38.0 : 32.0) << "step " << step;
+  }
+}
+
+TEST(Renderer, SphereIsosurfaceProjectsToThePredictedCircle) {
+  const int n = 48;
+  const GridGeometry g{{n, n, n}, {-23.5, -23.5, -23.5}, {1, 1, 1}};
+  std::vector<float> v(std::size_t(n) * n * n);
+  const Vec3 c{1.3, -0.7, 0.4};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        v[std::size_t(i + n * (j + n * k))] = float(norm(Vec3{i - 23.5, j - 23.5, k - 23.5} - c));
+  const FieldView f = FieldView::whole(g, v.data());
+  const double R = 15;
+  const std::vector<TaskSpec> tasks{TaskSpec::isosurface(0, float(R))};
+  const Vec3 dir = normalize(Vec3{0.6, -0.5, 0.62});
+  const double D = 70;
+  const camera::Camera cam(c + dir * D, c, {0, 0, 1}, 40, 96, 90);
+  const auto out = render_whole(cam, f, tasks);
+  double cx, cy;
+  ASSERT_TRUE(cam.project(c, cx, cy));
+  // The silhouette of a sphere seen from its axis is a circle of angular radius asin(R/D).
+  const double r_px = std::tan(std::asin(R / D)) / std::tan(cam.fov_y_degrees() * std::numbers::pi / 360) * cam.height() / 2;
+  int inside = 0, mismatches = 0;
+  for (int y = 0; y < cam.height(); ++y)
+    for (int x = 0; x < cam.width(); ++x) {
+      const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);
+      const bool hit = out[0].rect.contains(x, y) && out[0].rgba_at(x, y)[3] > 0.5f;
+      inside += hit;
+      if (std::abs(d - r_px) <= 1.0) continue;  // within one pixel of the circle
+      if (hit != (d < r_px)) ++mismatches;
+    }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_NEAR(inside, std::numbers::pi * r_px * r_px, 2 * std::numbers::pi * r_px);
+}
+
+namespace {
+struct RotScene {
+  static constexpr int n = 24, m = 17;
+  GridGeometry g{{n, n, m}, {-11.5, -11.5, -8}, {1, 1, 1}};
+  std::vector<float> f, rot;
+  RotScene() {
+    // An asymmetric field: two fronts off-centre.
+    const WaveFront wf[] = {{{4, 2, 1}, 6, 2, 1.0}, {{-5, 3, -2}, 3, 1.5, -0.7}};
+    f = wave_field(g, wf);
+    // g'(i, j, k) = f(j, n−1−i, k): the field rotated by +90° about z.
+    rot.resize(f.size());
+    for (int k = 0; k < m; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) rot[std::size_t(i + n * (j + n * k))] = f[std::size_t(j + n * ((n - 1 - i) + n * k))];
+  }
+};
+const std::vector<TaskSpec> kRotTasks{
+    TaskSpec::volume(0, TransferFunction::preset("diverging", 2), ValueWindow::absolute(-1, 1)),
+    TaskSpec::isosurface(0, 0.5f),
+};
+}  // namespace
+
+TEST(Renderer, RotatingFieldAndCameraGivesTheSameImage) {
+  const RotScene s;
+  const Vec3 p{30, -22, 18};
+  const camera::Camera cam(p, {0, 0, 0}, {0, 0, 1}, 45, 48, 48);
+  const camera::Camera cam_r({-p.y, p.x, p.z}, {0, 0, 0}, {0, 0, 1}, 45, 48, 48);
+  const auto a = render_whole(cam, FieldView::whole(s.g, s.f.data()), kRotTasks);
+  const auto b = render_whole(cam_r, FieldView::whole(s.g, s.rot.data()), kRotTasks);
+  for (std::size_t t = 0; t < kRotTasks.size(); ++t)
+    EXPECT_LE(max_diff(finish_image(a[t], cam, s.g), finish_image(b[t], cam_r, s.g)), 1) << "task " << t;
+}
+
+TEST(Renderer, RotatingTheFieldUnderAnAxialCameraRotatesTheImage) {
+  const RotScene s;
+  const camera::Camera cam({0, 0, 60}, {0, 0, 0}, {0, 1, 0}, 40, 48, 48);
+  const auto a = render_whole(cam, FieldView::whole(s.g, s.f.data()), kRotTasks);
+  const auto b = render_whole(cam, FieldView::whole(s.g, s.rot.data()), kRotTasks);
+  for (std::size_t t = 0; t < kRotTasks.size(); ++t) {
+    const Image ia = finish_image(a[t], cam, s.g), ib = finish_image(b[t], cam, s.g);
+    int worst = 0, nonblack = 0;
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 48; ++x)
+        for (int c = 0; c < 3; ++c) {
+          // Counter-clockwise by 90° on screen: new(x, y) = old(W − 1 − y, x).
+          worst = std::max(worst, std::abs(int(ib.at(x, y)[c]) - int(ia.at(47 - y, x)[c])));
+          nonblack += ib.at(x, y)[c] > 20;
+        }
+    EXPECT_LE(worst, 1) << "task " << t;
+    EXPECT_GT(nonblack, 100) << "task " << t;
+  }
+}
+
+TEST(Renderer, EmptyFieldGivesBackgroundOnlyAndTheOutlineWhenEnabled) {
+  const GridGeometry g{{20, 16, 12}, {-9.5, -7.5, -5.5}, {1, 1, 1}};
+  std::vector<float> v(20 * 16 * 12, 0.0f);
+  const std::vector<TaskSpec> tasks{
+      TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1)),
+      TaskSpec::isosurface(0, 0.5f),
+  };
+  const camera::Camera cam({30, -25, 20}, {0, 0, 0}, {0, 0, 1}, 40, 64, 48);
+  const auto out = render_whole(cam, FieldView::whole(g, v.data()), tasks);
+  const Rgb bg{0.2f, 0.3f, 0.4f};
+  const std::uint8_t bg8[3] = {51, 77, 102};
+  for (std::size_t t = 0; t < tasks.size(); ++t) {
+    const Image off = finish_image(out[t], cam, g, bg, {false});
+    for (int y = 0; y < off.height; ++y)
+      for (int x = 0; x < off.width; ++x)
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(off.at(x, y)[c], bg8[c]) << x << "," << y;
+    // With the outline: changed pixels lie within 2 px of a projected box edge, and there are some.
+    const Image on = finish_image(out[t], cam, g, bg);
+    std::vector<std::array<double, 4>> edges;
+    const Vec3 lo = g.domain_lo(), hi = g.domain_hi();
+    for (int e = 0; e < 12; ++e) {
+      const int a = e / 4, b = (a + 1) % 3, d = (a + 2) % 3;
+      Vec3 p = lo, q = lo;
+      p[b] = q[b] = (e & 1) ? hi[b] : lo[b];
+      p[d] = q[d] = (e & 2) ? hi[d] : lo[d];
+      q[a] = hi[a];
+      double ax, ay, bx, by;
+      ASSERT_TRUE(cam.project(p, ax, ay) && cam.project(q, bx, by));
+      edges.push_back({ax, ay, bx, by});
+    }
+    int changed = 0;
+    for (int y = 0; y < on.height; ++y)
+      for (int x = 0; x < on.width; ++x) {
+        if (on.at(x, y)[0] == bg8[0] && on.at(x, y)[1] == bg8[1] && on.at(x, y)[2] == bg8[2]) continue;
+        ++changed;
+        double dmin = 1e9;
+        for (const auto& s : edges) {
+          const double dx = s[2] - s[0], dy = s[3] - s[1];
+          double u = ((x + 0.5 - s[0]) * dx + (y + 0.5 - s[1]) * dy) / (dx * dx + dy * dy);
+          u = std::clamp(u, 0.0, 1.0);
+          dmin = std::min(dmin, std::hypot(x + 0.5 - s[0] - u * dx, y + 0.5 - s[1] - u * dy));
+        }
+        EXPECT_LE(dmin, 2.0) << x << "," << y;
+      }
+    EXPECT_GT(changed, 100);
+  }
+}
+
+TEST(Renderer, OutlineBehindAnOpaqueVolumeIsHidden) {
+  const GridGeometry g{{20, 16, 12}, {-9.5, -7.5, -5.5}, {1, 1, 1}};
+  std::vector<float> v(20 * 16 * 12, 1.0f);
+  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::constant({1, 0, 0}, 5), ValueWindow::absolute(0, 2))};
+  const camera::Camera cam({40, -12, 8}, {0, 0, 0}, {0, 0, 1}, 40, 64, 48);
+  const auto out = render_whole(cam, FieldView::whole(g, v.data()), tasks);
+  const Image on = finish_image(out[0], cam, g, {0, 0, 0}, {true, {0, 1, 0}, 1.5f});
+  // The corner farthest from the camera (−x, +y, −z) joins three back edges and projects inside the
+  // volume's footprint: it must show the (red) volume, not the (green) outline.
+  double bx, by;
+  ASSERT_TRUE(cam.project({g.domain_lo().x, g.domain_hi().y, g.domain_lo().z}, bx, by));
+  const std::uint8_t* px = on.at(int(bx), int(by));
+  EXPECT_GT(px[0], 200);
+  EXPECT_LT(px[1], 10);
+  // A front (silhouette-free) edge stays visible: the corner nearest the camera (+x, −y, +z).
+  double fx, fy;
+  ASSERT_TRUE(cam.project({g.domain_hi().x, g.domain_lo().y, g.domain_hi().z}, fx, fy));
+  EXPECT_GT(on.at(int(fx), int(fy))[1], 150);
+}
