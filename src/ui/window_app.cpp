@@ -316,7 +316,10 @@ std::filesystem::path WindowApp::output_path(const std::string& stem, const char
   std::filesystem::create_directories(options_.output_dir, ec);
   // A new name each time: never overwrite an earlier screenshot or recording.
   for (int i = 0;; ++i) {
-    auto p = options_.output_dir / (stem + (i ? "-" + std::to_string(i) : std::string()) + ext);
+    std::string name = stem;
+    if (i > 0) name.append("-").append(std::to_string(i));
+    name += ext;
+    auto p = options_.output_dir / name;
     if (!std::filesystem::exists(p, ec)) return p;
   }
 }

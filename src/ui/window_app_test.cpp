@@ -149,6 +149,10 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   EXPECT_EQ(r.view_h, kH);
   EXPECT_NE(r.summary.find("switches"), std::string::npos);
 
+  // PANOPTES_UI_TEST_KEEP=DIR keeps the screenshot for a human to look at.
+  if (const char* keep = std::getenv("PANOPTES_UI_TEST_KEEP"))
+    std::filesystem::copy_file(o.screenshot_on_exit, std::filesystem::path(keep) / "ui_window_test.png",
+                               std::filesystem::copy_options::overwrite_existing);
   const Image shot = read_png(o.screenshot_on_exit.string());
   ASSERT_EQ(shot.width, kW);
   ASSERT_EQ(shot.height, kH);
