@@ -12,7 +12,9 @@
 //   t=SECONDS snap=X,Y,Z         snap to the camera nearest the direction (as a mouse drag does)
 //   t=SECONDS speed=FACTOR       playback speed (0.25 .. 8)
 //   t=SECONDS play | pause       set the play state
-//   t=SECONDS end                stop the run here (else it ends one frame after the last command)
+//   t=SECONDS end                stop the run here (no frame is shown at this time)
+// Without `end` (and without an explicit duration) the run ends once the last command's effect has
+// been shown; without any command it plays the database once.
 // Times are virtual seconds from the start and must not decrease.
 #include <filesystem>
 #include <functional>
@@ -56,8 +58,8 @@ struct DisplayedFrame {
 struct HeadlessOptions {
   EngineOptions engine;           ///< time_source is replaced by the run's virtual clock
   std::vector<ScriptCommand> script;
-  /// Run length in virtual seconds; unset = until an `end` command, else one display tick after the
-  /// last command.
+  /// Run length in virtual seconds (ticks with t < duration are shown); unset = until an `end`
+  /// command, else through the tick that shows the last command, else frame_count / fps.
   std::optional<double> duration;
   /// Writes every displayed frame as DIR/frame_NNNNNN.png (NNNNNN = display tick) if set.
   std::optional<std::filesystem::path> frames_out;

@@ -1,0 +1,717 @@
+#include "player/engine.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "core/error.hpp"
+#include "player/frame_cache.hpp"
+#include "player/reader_pool.hpp"
+
+namespace panoptes::player {
+namespace {
+
+double steady_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+constexpr double kMinSpeed = 0.25, kMaxSpeed = 8.0;
+
+}  // namespace
+
+TimeSource steady_time_source() { return [] { return steady_seconds(); }; }
+
+std::size_t default_cache_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  const std::size_t two_gib = std::size_t(2) << 30, min_bytes = std::size_t(64) << 20;
+  if (pages <= 0 || page <= 0) return std::size_t(512) << 20;
+  const std::size_t eighth = std::size_t(pages) * std::size_t(page) / 8;
+  return std::max(min_bytes, std::min(eighth, two_gib));
+}
+
+std::string_view to_string(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::ok: return "ok";
+    case FrameStatus::missing: return "missing";
+    case FrameStatus::unreadable: return "unreadable";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(Direction direction) {
+  switch (direction) {
+    case Direction::left: return "left";
+    case Direction::right: return "right";
+    case Direction::up: return "up";
+    case Direction::down: return "down";
+    case Direction::in: return "in";
+    case Direction::out: return "out";
+  }
+  return "unknown";
+}
+
+Summary summarize(std::vector<double> values) {
+  Summary s;
+  s.count = values.size();
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  double sum = 0;
+  for (double v : values) sum += v;
+  s.mean = sum / double(values.size());
+  const auto pick = [&](double q) {
+    const std::size_t i = std::min(values.size() - 1, std::size_t(std::ceil(q * double(values.size()))) - (q > 0 ? 1 : 0));
+    return values[i];
+  };
+  s.p50 = pick(0.50);
+  s.p99 = pick(0.99);
+  s.max = values.back();
+  return s;
+}
+
+nlohmann::json to_json(const Statistics& st) {
+  const auto summary = [](const std::vector<double>& v) {
+    const Summary s = summarize(v);
+    return nlohmann::json{{"count", s.count}, {"mean_ms", s.mean}, {"p50_ms", s.p50}, {"p99_ms", s.p99}, {"max_ms", s.max}};
+  };
+  std::vector<double> latencies;
+  latencies.reserve(st.switches.size());
+  nlohmann::json switches = nlohmann::json::array();
+  for (const auto& s : st.switches) {
+    latencies.push_back(s.latency_ms);
+    switches.push_back({{"command", s.command},
+                        {"from", {{"camera", s.from.camera}, {"task", s.from.task}, {"frame", s.from.frame}}},
+                        {"to", {{"camera", s.to.camera}, {"task", s.to.task}, {"frame", s.to.frame}}},
+                        {"latency_ms", s.latency_ms},
+                        {"cache_hit", s.cache_hit}});
+  }
+  return {{"frames_shown", st.frames_shown},
+          {"cache", {{"hits", st.cache_hits},
+                     {"misses", st.cache_misses},
+                     {"waited_for_prefetch", st.waited_for_prefetch},
+                     {"evictions", st.cache_evictions},
+                     {"bytes", st.cache_bytes},
+                     {"capacity_bytes", st.cache_capacity}}},
+          {"decodes", {{"prefetch", st.prefetch_decodes}, {"display", st.display_decodes}}},
+          {"readers", {{"opened", st.readers_opened}, {"evicted", st.readers_evicted},
+                       {"open", st.readers_open}, {"capacity", st.reader_capacity}}},
+          {"placeholders_shown", st.placeholders_shown},
+          {"decode_time", summary(st.decode_ms)},
+          {"switch_latency", summary(latencies)},
+          {"switches", switches}};
+}
+
+// ------------------------------------------------------------------------------------------------
+
+struct Engine::Impl {
+  store::Database db;
+  EngineOptions options;
+  TimeSource now;
+  int cameras = 0, tasks = 0, frames = 0;
+  double fps = 30;
+  std::vector<Vec3> directions;  // unit vectors look_at → position, for nearest_camera
+  std::vector<int> shells;
+
+  // Selection and clock (display thread only).
+  Selection sel;
+  double position = 0;      // frame position at anchor_time
+  double anchor_time = 0;   // time source value the position refers to
+  bool is_playing = true;
+  double speed_factor = 1;
+  int dir = 1;
+  bool looping = true;
+  int axis = -1;
+
+  // Switch measurement (display thread only).
+  bool switch_pending = false;
+  double switch_start = 0;
+  Selection switch_from;
+  std::string switch_command;
+  std::int64_t last_stream = -1;
+
+  // Decoding machinery (shared with prefetch threads).
+  ReaderPool pool;
+  FrameCache cache;
+  struct BadStream {
+    FrameStatus status;
+    std::string message;
+  };
+  mutable std::mutex bad_mutex;
+  std::unordered_map<std::int64_t, BadStream> bad_streams;
+
+  mutable std::mutex stats_mutex;
+  Statistics stats;
+
+  // Placeholder memo: regenerating a full-size placeholder every displayed frame would cost
+  // milliseconds on the display path while a broken stream is shown.
+  std::int64_t placeholder_stream = -1;
+  FrameStatus placeholder_status = FrameStatus::ok;
+  std::shared_ptr<const video::YuvFrame> placeholder;
+
+  // Prefetch.
+  std::mutex job_mutex;
+  std::condition_variable job_ready, job_idle;
+  std::vector<Selection> jobs;  // consumed from the front (index job_next)
+  std::size_t job_next = 0;
+  int busy = 0;
+  bool stopping = false;
+  std::vector<std::thread> workers;
+  Selection scheduled{-1, -1, -1};
+  bool scheduled_valid = false;
+
+  Impl(store::Database database, EngineOptions opts)
+      : db(std::move(database)),
+        options(std::move(opts)),
+        pool(db, std::max(1, options.reader_pool_capacity)),
+        cache(options.cache_bytes ? options.cache_bytes : default_cache_bytes()) {}
+
+  std::int64_t stream_of(int camera, int task) const { return std::int64_t(camera) * tasks + task; }
+
+  struct Decoded {
+    FrameStatus status = FrameStatus::ok;
+    std::string message;
+    std::shared_ptr<const video::YuvFrame> frame;
+  };
+
+  void mark_bad(std::int64_t stream, FrameStatus status, const std::string& message) {
+    std::lock_guard lock(bad_mutex);
+    bad_streams.emplace(stream, BadStream{status, message});
+  }
+
+  // Decodes one frame with a pooled reader. Any thread. Never throws for stream problems.
+  Decoded decode(const Selection& s, bool prefetching) {
+    const std::int64_t stream = stream_of(s.camera, s.task);
+    {
+      std::lock_guard lock(bad_mutex);
+      if (auto it = bad_streams.find(stream); it != bad_streams.end()) return {it->second.status, it->second.message, nullptr};
+    }
+    std::unique_ptr<video::MovieReader> reader;
+    try {
+      reader = pool.acquire(s.camera, s.task);
+    } catch (const std::exception& e) {
+      std::error_code ec;
+      const auto path = db.stream_path(s.camera, s.task);
+      const bool exists = std::filesystem::exists(path, ec);
+      const FrameStatus status = exists ? FrameStatus::unreadable : FrameStatus::missing;
+      const std::string message = exists ? std::string(e.what()) : path.string() + ": movie file is missing";
+      mark_bad(stream, status, message);
+      return {status, message, nullptr};
+    }
+    if (s.frame >= reader->frame_count()) {
+      const std::string message = reader->path() + ": truncated: holds " + std::to_string(reader->frame_count()) +
+                                  " frames, frame " + std::to_string(s.frame) + " requested";
+      pool.release(s.camera, s.task, std::move(reader));
+      return {FrameStatus::unreadable, message, nullptr};
+    }
+    auto frame = std::make_shared<video::YuvFrame>();
+    const double t0 = steady_seconds();
+    try {
+      reader->read(s.frame, *frame);
+    } catch (const std::exception& e) {
+      pool.discard(std::move(reader));
+      return {FrameStatus::unreadable, e.what(), nullptr};
+    }
+    const double ms = (steady_seconds() - t0) * 1e3;
+    pool.release(s.camera, s.task, std::move(reader));
+    {
+      std::lock_guard lock(stats_mutex);
+      stats.decode_ms.push_back(ms);
+      ++(prefetching ? stats.prefetch_decodes : stats.display_decodes);
+    }
+    return {FrameStatus::ok, {}, std::move(frame)};
+  }
+
+  // The frame of s through the cache. `waited`/`hit` report how it was obtained.
+  Decoded fetch(const Selection& s, bool& hit, bool& waited) {
+    const FrameKey key{stream_of(s.camera, s.task), s.frame};
+    std::shared_ptr<const video::YuvFrame> frame;
+    hit = waited = false;
+    switch (cache.claim(key, frame)) {
+      case FrameCache::Claim::cached:
+        hit = true;
+        return {FrameStatus::ok, {}, std::move(frame)};
+      case FrameCache::Claim::in_flight:
+        waited = true;
+        if (auto f = cache.wait(key)) return {FrameStatus::ok, {}, std::move(f)};
+        // The prefetch decode failed or did not fit the cache: decode here (uncached).
+        return decode(s, false);
+      case FrameCache::Claim::claimed: {
+        Decoded d = decode(s, false);
+        cache.finish(key, d.frame);
+        return d;
+      }
+    }
+    return {};
+  }
+
+  // ---- prefetch ----
+  void worker_loop() {
+    for (;;) {
+      Selection s;
+      {
+        std::unique_lock lock(job_mutex);
+        job_ready.wait(lock, [&] { return stopping || job_next < jobs.size(); });
+        if (stopping) return;
+        s = jobs[job_next++];
+        ++busy;
+      }
+      const FrameKey key{stream_of(s.camera, s.task), s.frame};
+      std::shared_ptr<const video::YuvFrame> cached;
+      if (cache.claim(key, cached) == FrameCache::Claim::claimed) {
+        Decoded d = decode(s, true);
+        cache.finish(key, std::move(d.frame));
+      }
+      {
+        std::lock_guard lock(job_mutex);
+        --busy;
+        if (busy == 0 && job_next >= jobs.size()) job_idle.notify_all();
+      }
+    }
+  }
+
+  void start_workers() {
+    const int n = options.prefetch ? options.prefetch_threads : 0;
+    for (int i = 0; i < n; ++i) workers.emplace_back([this] { worker_loop(); });
+  }
+
+  void stop_workers() {
+    {
+      std::lock_guard lock(job_mutex);
+      stopping = true;
+    }
+    job_ready.notify_all();
+    for (auto& w : workers) w.join();
+    workers.clear();
+  }
+
+  int wrap_frame(int f) const {
+    if (looping) return ((f % frames) + frames) % frames;
+    return std::clamp(f, 0, frames - 1);
+  }
+
+  // The frame shown one display period (1/fps) from now while playing, else the next in direction.
+  int next_frame() const {
+    const double step = is_playing ? speed_factor * dir : dir;
+    int n = int(std::floor(double(sel.frame) + step + 1e-9));
+    if (n == sel.frame) n += dir;
+    return wrap_frame(n);
+  }
+
+  // Replaces the prefetch queue with the neighbourhood of the selection. Order = priority: the current
+  // stream's next frames (playback), then every neighbour at the next frame (what a switch during
+  // playback shows), then neighbours at the current frame (a switch while paused).
+  void schedule_prefetch() {
+    if (workers.empty()) return;
+    if (scheduled_valid && scheduled == sel) return;
+    scheduled = sel;
+    scheduled_valid = true;
+    std::vector<Selection> list;
+    const int next = next_frame();
+    int f = sel.frame;
+    for (int k = 0; k <= options.read_ahead; ++k) {
+      f = (k == 0) ? next : wrap_frame(f + dir * std::max(1, int(std::lround(speed_factor))));
+      list.push_back({sel.camera, sel.task, f});
+    }
+    std::vector<std::pair<int, int>> streams;  // (camera, task) neighbours
+    if (options.prefetch_cameras && !db.manifest().graph.empty()) {
+      const auto& n = db.manifest().graph.neighbours[std::size_t(sel.camera)];
+      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out})
+        if (c >= 0 && c != sel.camera) streams.emplace_back(c, sel.task);
+    }
+    if (options.prefetch_tasks && tasks > 1) {
+      streams.emplace_back(sel.camera, (sel.task + 1) % tasks);
+      streams.emplace_back(sel.camera, (sel.task + tasks - 1) % tasks);
+      const auto& m = db.manifest();
+      for (const auto& a : m.axes)
+        for (int d : {1, -1}) {
+          const int t = m.step_task_on_axis(sel.task, a.name, d);
+          if (t >= 0) streams.emplace_back(sel.camera, t);
+        }
+    }
+    std::sort(streams.begin(), streams.end());
+    streams.erase(std::unique(streams.begin(), streams.end()), streams.end());
+    std::erase_if(streams, [&](const auto& p) { return p.first == sel.camera && p.second == sel.task; });
+    for (const auto& [c, t] : streams) list.push_back({c, t, next});
+    for (const auto& [c, t] : streams) list.push_back({c, t, sel.frame});
+    {
+      std::lock_guard lock(job_mutex);
+      jobs = std::move(list);
+      job_next = 0;
+    }
+    job_ready.notify_all();
+  }
+
+  // ---- clock ----
+  double current_position(double t) const {
+    return is_playing ? position + (t - anchor_time) * fps * speed_factor * dir : position;
+  }
+
+  void set_position(double p) {
+    anchor_time = now();
+    position = p;
+    sel.frame = std::clamp(int(std::floor(p + 1e-9)), 0, frames - 1);
+  }
+
+  void tick() {
+    const double t = now();
+    double p = current_position(t);
+    position = p;
+    anchor_time = t;
+    if (p >= frames || p < 0) {
+      if (looping) {
+        p = std::fmod(p, double(frames));
+        if (p < 0) p += frames;
+      } else {
+        p = p < 0 ? 0 : frames - 1;
+        is_playing = false;
+      }
+      position = p;
+    }
+    sel.frame = std::clamp(int(std::floor(position + 1e-9)), 0, frames - 1);
+  }
+
+  void begin_switch(const Selection& from, const std::string& command) {
+    if (!switch_pending) {
+      switch_pending = true;
+      switch_start = steady_seconds();
+      switch_from = from;
+    }
+    switch_command = command;
+  }
+
+  bool select(int camera, int task, const std::string& command) {
+    if (camera < 0 || camera >= cameras || task < 0 || task >= tasks) return false;
+    if (camera == sel.camera && task == sel.task) return false;
+    begin_switch(sel, command);
+    sel.camera = camera;
+    sel.task = task;
+    return true;
+  }
+
+  std::shared_ptr<const video::YuvFrame> placeholder_for(const Selection& s, FrameStatus status) {
+    const std::int64_t stream = stream_of(s.camera, s.task);
+    if (!placeholder || placeholder_stream != stream || placeholder_status != status) {
+      const int w = db.manifest().image.width, h = db.manifest().image.height;
+      placeholder = std::make_shared<video::YuvFrame>(make_placeholder(
+          w, h, status == FrameStatus::missing ? "STREAM MISSING" : "STREAM UNREADABLE",
+          "CAMERA " + std::to_string(s.camera) + " TASK " + std::to_string(s.task)));
+      placeholder_stream = stream;
+      placeholder_status = status;
+    }
+    return placeholder;
+  }
+
+  ShownFrame make_shown(const Selection& s, Decoded d, bool hit) {
+    ShownFrame out;
+    out.selection = s;
+    out.status = d.status;
+    out.message = std::move(d.message);
+    out.cache_hit = hit;
+    out.time = db.manifest().frame_time(s.frame);
+    if (d.status == FrameStatus::ok && d.frame) {
+      out.frame = std::move(d.frame);
+    } else {
+      if (out.status == FrameStatus::ok) out.status = FrameStatus::unreadable;
+      out.frame = placeholder_for(s, out.status);
+    }
+    return out;
+  }
+};
+
+// ------------------------------------------------------------------------------------------------
+
+Engine::Engine(const std::filesystem::path& dir, EngineOptions options)
+    : Engine(store::Database::open(dir), std::move(options)) {}
+
+Engine::Engine(store::Database database, EngineOptions options) {
+  const std::string where = database.dir().string();
+  if (database.camera_count() == 0) throw Error(where + ": the database has no cameras");
+  if (database.task_count() == 0) throw Error(where + ": the database has no tasks");
+  if (database.frame_count() <= 0)
+    throw Error(where + ": the database has no complete frame yet (status " +
+                std::string(store::to_string(database.status())) + ", frames_written 0)");
+  if (options.prefetch_threads < 0 || options.prefetch_threads > 64)
+    throw Error("prefetch threads must be in 0..64, got " + std::to_string(options.prefetch_threads));
+  const int threads = options.prefetch ? options.prefetch_threads : 0;
+  if (options.reader_pool_capacity < threads + 2)
+    throw Error("reader pool capacity " + std::to_string(options.reader_pool_capacity) +
+                " is too small: it must be at least prefetch threads + 2 = " + std::to_string(threads + 2));
+  if (options.read_ahead < 0) throw Error("read_ahead must be >= 0, got " + std::to_string(options.read_ahead));
+  if (options.camera < 0 || options.camera >= database.camera_count())
+    throw Error(where + ": camera " + std::to_string(options.camera) + " out of range 0.." +
+                std::to_string(database.camera_count() - 1));
+  if (options.task < 0 || options.task >= database.task_count())
+    throw Error(where + ": task " + std::to_string(options.task) + " out of range 0.." +
+                std::to_string(database.task_count() - 1));
+  if (options.frame < 0 || options.frame >= database.frame_count())
+    throw Error(where + ": frame " + std::to_string(options.frame) + " out of range 0.." +
+                std::to_string(database.frame_count() - 1));
+
+  impl_ = std::make_unique<Impl>(std::move(database), std::move(options));
+  Impl& m = *impl_;
+  m.now = m.options.time_source ? m.options.time_source : steady_time_source();
+  m.cameras = m.db.camera_count();
+  m.tasks = m.db.task_count();
+  m.frames = m.db.frame_count();
+  m.fps = m.db.manifest().video.fps > 0 ? m.db.manifest().video.fps : 30;
+  m.directions.reserve(std::size_t(m.cameras));
+  m.shells.reserve(std::size_t(m.cameras));
+  for (const auto& c : m.db.manifest().cameras) {
+    m.directions.push_back(normalize(c.position - c.look_at));
+    m.shells.push_back(c.labels.shell);
+  }
+  m.sel = {m.options.camera, m.options.task, m.options.frame};
+  m.is_playing = m.options.start_playing;
+  m.looping = m.options.loop;
+  m.axis = m.db.manifest().axes.empty() ? -1 : 0;
+  m.set_position(m.options.frame);
+  m.stats.cache_capacity = m.cache.capacity();
+  m.stats.reader_capacity = m.pool.capacity();
+  m.start_workers();
+}
+
+Engine::~Engine() {
+  if (impl_) impl_->stop_workers();
+}
+Engine::Engine(Engine&&) noexcept = default;
+Engine& Engine::operator=(Engine&& other) noexcept {
+  if (this != &other) {
+    if (impl_) impl_->stop_workers();
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
+
+const store::Database& Engine::database() const { return impl_->db; }
+const store::Manifest& Engine::manifest() const { return impl_->db.manifest(); }
+const EngineOptions& Engine::options() const { return impl_->options; }
+int Engine::frame_count() const { return impl_->frames; }
+double Engine::fps() const { return impl_->fps; }
+Selection Engine::selection() const { return impl_->sel; }
+void Engine::tick() { impl_->tick(); }
+bool Engine::playing() const { return impl_->is_playing; }
+
+void Engine::set_playing(bool playing) {
+  Impl& m = *impl_;
+  if (playing == m.is_playing) return;
+  m.tick();  // freeze the position reached so far
+  m.is_playing = playing;
+  m.anchor_time = m.now();
+}
+void Engine::toggle_playing() { set_playing(!impl_->is_playing); }
+double Engine::speed() const { return impl_->speed_factor; }
+void Engine::set_speed(double speed) {
+  Impl& m = *impl_;
+  if (!std::isfinite(speed)) return;
+  m.tick();
+  m.speed_factor = std::clamp(speed, kMinSpeed, kMaxSpeed);
+}
+bool Engine::loop() const { return impl_->looping; }
+void Engine::set_loop(bool loop) { impl_->looping = loop; }
+int Engine::direction() const { return impl_->dir; }
+void Engine::set_direction(int direction) {
+  Impl& m = *impl_;
+  m.tick();
+  m.dir = direction < 0 ? -1 : 1;
+}
+
+bool Engine::apply(Action action) {
+  Impl& m = *impl_;
+  switch (action) {
+    case Action::play_pause: toggle_playing(); return true;
+    case Action::frame_forward: step_frame(1); return true;
+    case Action::frame_back: step_frame(-1); return true;
+    case Action::first_frame: seek(0); return true;
+    case Action::last_frame: seek(m.frames - 1); return true;
+    case Action::toggle_loop: set_loop(!m.looping); return true;
+    case Action::faster: {
+      const double before = m.speed_factor;
+      set_speed(m.speed_factor * 2);
+      return m.speed_factor != before;
+    }
+    case Action::slower: {
+      const double before = m.speed_factor;
+      set_speed(m.speed_factor / 2);
+      return m.speed_factor != before;
+    }
+    case Action::reverse: set_direction(-m.dir); return true;
+    case Action::camera_left: return navigate(Direction::left);
+    case Action::camera_right: return navigate(Direction::right);
+    case Action::camera_up: return navigate(Direction::up);
+    case Action::camera_down: return navigate(Direction::down);
+    case Action::shell_in: return navigate(Direction::in);
+    case Action::shell_out: return navigate(Direction::out);
+    case Action::next_task: return next_task();
+    case Action::previous_task: return previous_task();
+    case Action::task_1: case Action::task_2: case Action::task_3: case Action::task_4: case Action::task_5:
+    case Action::task_6: case Action::task_7: case Action::task_8: case Action::task_9:
+      return m.select(m.sel.camera, int(action) - int(Action::task_1), std::string(to_string(action)));
+    case Action::axis_up: return m.axis >= 0 && step_axis(m.axis, 1);
+    case Action::axis_down: return m.axis >= 0 && step_axis(m.axis, -1);
+    case Action::next_axis:
+      if (m.axis < 0) return false;
+      m.axis = (m.axis + 1) % int(manifest().axes.size());
+      return true;
+    default: return false;
+  }
+}
+
+bool Engine::navigate(Direction direction) {
+  Impl& m = *impl_;
+  if (m.db.manifest().graph.empty()) return false;
+  const auto& n = m.db.manifest().graph.neighbours[std::size_t(m.sel.camera)];
+  int target = -1;
+  switch (direction) {
+    case Direction::left: target = n.left; break;
+    case Direction::right: target = n.right; break;
+    case Direction::up: target = n.up; break;
+    case Direction::down: target = n.down; break;
+    case Direction::in: target = n.in; break;
+    case Direction::out: target = n.out; break;
+  }
+  return m.select(target, m.sel.task, "camera_" + std::string(to_string(direction)));
+}
+
+int Engine::nearest_camera(const Vec3& direction, int shell) const {
+  const Impl& m = *impl_;
+  const Vec3 d = normalize(direction);
+  if (!(norm(d) > 0)) return -1;
+  int best = -1;
+  double best_dot = -2;
+  const std::size_t n = m.directions.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (shell >= 0 && m.shells[i] != shell) continue;
+    const double c = dot(m.directions[i], d);
+    if (c > best_dot) best_dot = c, best = int(i);
+  }
+  return best;
+}
+
+bool Engine::snap_to_direction(const Vec3& direction) {
+  Impl& m = *impl_;
+  const int c = nearest_camera(direction, m.shells[std::size_t(m.sel.camera)]);
+  return c >= 0 && m.select(c, m.sel.task, "snap");
+}
+
+bool Engine::jump_to_camera(int camera) { return impl_->select(camera, impl_->sel.task, "jump_to_camera"); }
+bool Engine::set_task(int task) { return impl_->select(impl_->sel.camera, task, "set_task"); }
+bool Engine::next_task() {
+  Impl& m = *impl_;
+  return m.select(m.sel.camera, (m.sel.task + 1) % m.tasks, "next_task");
+}
+bool Engine::previous_task() {
+  Impl& m = *impl_;
+  return m.select(m.sel.camera, (m.sel.task + m.tasks - 1) % m.tasks, "previous_task");
+}
+bool Engine::step_axis(int axis, int delta) {
+  Impl& m = *impl_;
+  const auto& axes = m.db.manifest().axes;
+  if (axis < 0 || axis >= int(axes.size()) || delta == 0) return false;
+  const int t = m.db.manifest().step_task_on_axis(m.sel.task, axes[std::size_t(axis)].name, delta);
+  return t >= 0 && m.select(m.sel.camera, t, "axis_" + axes[std::size_t(axis)].name);
+}
+int Engine::active_axis() const { return impl_->axis; }
+void Engine::set_active_axis(int axis) {
+  if (axis >= 0 && axis < int(manifest().axes.size())) impl_->axis = axis;
+}
+
+void Engine::step_frame(int delta) {
+  Impl& m = *impl_;
+  m.tick();
+  m.is_playing = false;
+  m.set_position(m.wrap_frame(m.sel.frame + delta));
+}
+
+void Engine::seek(int frame) {
+  Impl& m = *impl_;
+  m.set_position(std::clamp(frame, 0, m.frames - 1));
+}
+
+ShownFrame Engine::current_frame() {
+  Impl& m = *impl_;
+  const Selection s = m.sel;
+  bool hit = false, waited = false;
+  Impl::Decoded d = m.fetch(s, hit, waited);
+  ShownFrame out = m.make_shown(s, std::move(d), hit);
+  const std::int64_t stream = m.stream_of(s.camera, s.task);
+  {
+    std::lock_guard lock(m.stats_mutex);
+    ++m.stats.frames_shown;
+    ++(hit ? m.stats.cache_hits : m.stats.cache_misses);
+    if (waited) ++m.stats.waited_for_prefetch;
+    if (out.status != FrameStatus::ok) ++m.stats.placeholders_shown;
+    if (m.switch_pending) {
+      if (stream != m.last_stream) {
+        SwitchRecord r;
+        r.from = m.switch_from;
+        r.to = s;
+        r.command = m.switch_command;
+        r.latency_ms = (steady_seconds() - m.switch_start) * 1e3;
+        r.cache_hit = hit;
+        m.stats.switches.push_back(std::move(r));
+      }
+      m.switch_pending = false;
+    }
+  }
+  m.last_stream = stream;
+  m.schedule_prefetch();
+  return out;
+}
+
+ShownFrame Engine::frame_at(const Selection& selection) {
+  Impl& m = *impl_;
+  if (selection.camera < 0 || selection.camera >= m.cameras || selection.task < 0 || selection.task >= m.tasks ||
+      selection.frame < 0 || selection.frame >= m.frames)
+    throw Error("selection (camera " + std::to_string(selection.camera) + ", task " + std::to_string(selection.task) +
+                ", frame " + std::to_string(selection.frame) + ") is out of range");
+  bool hit = false, waited = false;
+  return m.make_shown(selection, m.fetch(selection, hit, waited), hit);
+}
+
+void Engine::wait_prefetch_idle() {
+  Impl& m = *impl_;
+  if (m.workers.empty()) return;
+  std::unique_lock lock(m.job_mutex);
+  m.job_idle.wait(lock, [&] { return m.busy == 0 && m.job_next >= m.jobs.size(); });
+}
+
+bool Engine::is_cached(const Selection& s) const {
+  return impl_->cache.contains(FrameKey{impl_->stream_of(s.camera, s.task), s.frame});
+}
+
+Statistics Engine::statistics() const {
+  const Impl& m = *impl_;
+  Statistics st;
+  {
+    std::lock_guard lock(m.stats_mutex);
+    st = m.stats;
+  }
+  st.cache_bytes = m.cache.bytes();
+  st.cache_capacity = m.cache.capacity();
+  st.cache_evictions = m.cache.evictions();
+  st.readers_open = m.pool.open();
+  st.reader_capacity = m.pool.capacity();
+  st.readers_opened = m.pool.opened();
+  st.readers_evicted = m.pool.evicted();
+  return st;
+}
+
+void Engine::reset_statistics() {
+  Impl& m = *impl_;
+  std::lock_guard lock(m.stats_mutex);
+  m.stats = Statistics{};
+}
+
+void Engine::write_statistics(const std::filesystem::path& path) const {
+  std::ofstream out(path);
+  if (!out) throw FileError(path.string(), "cannot create the statistics file");
+  out << to_json(statistics()).dump(2) << '\n';
+  if (!out) throw FileError(path.string(), "cannot write the statistics file");
+}
+
+}  // namespace panoptes::player

@@ -1,0 +1,272 @@
+#include "player/headless.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/png.hpp"
+
+namespace panoptes::player {
+namespace {
+
+std::string trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r");
+  return std::string(s.substr(b, e - b + 1));
+}
+
+double parse_double(const std::string& text, const std::string& where) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument("trailing");
+    return v;
+  } catch (const std::exception&) {
+    throw Error(where + ": expected a number, got \"" + text + "\"");
+  }
+}
+
+int parse_int(const std::string& text, const std::string& where) {
+  try {
+    std::size_t used = 0;
+    const long v = std::stol(text, &used);
+    if (used != text.size() || v < -(1L << 30) || v > (1L << 30)) throw std::invalid_argument("trailing");
+    return int(v);
+  } catch (const std::exception&) {
+    throw Error(where + ": expected an integer, got \"" + text + "\"");
+  }
+}
+
+std::string describe(const ScriptCommand& c) {
+  using K = ScriptCommand::Kind;
+  switch (c.kind) {
+    case K::key: return "key=" + c.key;
+    case K::seek: return "seek=" + std::to_string(c.value);
+    case K::camera: return "camera=" + std::to_string(c.value);
+    case K::task: return "task=" + (c.value >= 0 ? std::to_string(c.value) : c.name);
+    case K::axis: return "axis=" + c.name + ":" + std::to_string(c.value);
+    case K::snap: {
+      char b[96];
+      std::snprintf(b, sizeof b, "snap=%g,%g,%g", c.direction.x, c.direction.y, c.direction.z);
+      return b;
+    }
+    case K::speed: return "speed=" + std::to_string(c.speed);
+    case K::play: return "play";
+    case K::pause: return "pause";
+    case K::end: return "end";
+  }
+  return "?";
+}
+
+// Applies one command; false if it could not apply (no such edge, unknown task name, ...).
+bool apply(Engine& engine, const ScriptCommand& c) {
+  using K = ScriptCommand::Kind;
+  switch (c.kind) {
+    case K::key: return engine.apply(c.action);
+    case K::seek: engine.seek(c.value); return c.value >= 0 && c.value < engine.frame_count();
+    case K::camera: return engine.jump_to_camera(c.value);
+    case K::task: {
+      const int t = c.value >= 0 ? c.value : engine.manifest().find_task(c.name);
+      return t >= 0 && engine.set_task(t);
+    }
+    case K::axis: {
+      const int a = engine.manifest().find_axis(c.name);
+      return a >= 0 && engine.step_axis(a, c.value);
+    }
+    case K::snap: return engine.snap_to_direction(c.direction);
+    case K::speed: engine.set_speed(c.speed); return true;
+    case K::play: engine.set_playing(true); return true;
+    case K::pause: engine.set_playing(false); return true;
+    case K::end: return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<ScriptCommand> parse_script(const std::string& text, const std::string& source) {
+  std::vector<ScriptCommand> out;
+  std::istringstream in(text);
+  std::string raw;
+  int line_no = 0;
+  double last_t = 0;
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::string where = source + ":" + std::to_string(line_no);
+    std::string line = trim(raw.substr(0, raw.find('#')));
+    if (line.empty()) continue;
+    std::istringstream words(line);
+    std::string word;
+    ScriptCommand c;
+    c.line = line_no;
+    bool have_t = false, have_command = false;
+    while (words >> word) {
+      const auto eq = word.find('=');
+      const std::string key = word.substr(0, eq), value = eq == std::string::npos ? "" : word.substr(eq + 1);
+      if (key == "t" && eq != std::string::npos) {
+        c.t = parse_double(value, where);
+        if (c.t < 0) throw Error(where + ": time t=" + value + " is negative");
+        have_t = true;
+        continue;
+      }
+      if (have_command) throw Error(where + ": more than one command on the line (\"" + word + "\")");
+      have_command = true;
+      using K = ScriptCommand::Kind;
+      if (key == "key") {
+        // Key names contain no spaces; "Shift+Tab" etc. are single words.
+        const auto action = action_for_key(value);
+        if (!action) throw Error(where + ": unknown key \"" + value + "\" (see `panoptes play --help` or docs/player.md)");
+        c.kind = K::key, c.action = *action, c.key = value;
+      } else if (key == "seek") {
+        c.kind = K::seek, c.value = parse_int(value, where);
+        if (c.value < 0) throw Error(where + ": seek frame " + value + " is negative");
+      } else if (key == "camera") {
+        c.kind = K::camera, c.value = parse_int(value, where);
+      } else if (key == "task") {
+        c.kind = K::task;
+        if (!value.empty() && value.find_first_not_of("0123456789") == std::string::npos)
+          c.value = parse_int(value, where);
+        else if (!value.empty())
+          c.value = -1, c.name = value;
+        else
+          throw Error(where + ": task= needs a task id or name");
+      } else if (key == "axis") {
+        const auto colon = value.rfind(':');
+        if (colon == std::string::npos || colon == 0)
+          throw Error(where + ": expected axis=NAME:DELTA (e.g. axis=isovalue:+1), got \"" + word + "\"");
+        c.kind = K::axis, c.name = value.substr(0, colon);
+        std::string delta = value.substr(colon + 1);
+        if (!delta.empty() && delta[0] == '+') delta.erase(0, 1);
+        c.value = parse_int(delta, where);
+      } else if (key == "snap") {
+        std::array<double, 3> v{};
+        std::istringstream parts(value);
+        std::string part;
+        int n = 0;
+        while (std::getline(parts, part, ',')) {
+          if (n == 3) throw Error(where + ": expected snap=X,Y,Z, got \"" + word + "\"");
+          v[std::size_t(n++)] = parse_double(part, where);
+        }
+        if (n != 3) throw Error(where + ": expected snap=X,Y,Z, got \"" + word + "\"");
+        c.kind = K::snap, c.direction = {v[0], v[1], v[2]};
+        if (norm(c.direction) == 0) throw Error(where + ": snap direction is the zero vector");
+      } else if (key == "speed") {
+        c.kind = K::speed, c.speed = parse_double(value, where);
+        if (c.speed < 0.25 || c.speed > 8) throw Error(where + ": speed " + value + " is outside 0.25 .. 8");
+      } else if (word == "play") {
+        c.kind = K::play;
+      } else if (word == "pause") {
+        c.kind = K::pause;
+      } else if (word == "end") {
+        c.kind = K::end;
+      } else {
+        throw Error(where + ": unknown command \"" + word +
+                    "\" (expected key=, seek=, camera=, task=, axis=, snap=, speed=, play, pause or end)");
+      }
+    }
+    if (!have_t) throw Error(where + ": missing time (lines look like `t=0.5 key=Right`)");
+    if (!have_command) throw Error(where + ": a time without a command");
+    if (c.t < last_t) throw Error(where + ": time t=" + std::to_string(c.t) + " is before the previous line's");
+    last_t = c.t;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::vector<ScriptCommand> read_script(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw FileError(path.string(), "cannot read the script");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse_script(buffer.str(), path.string());
+}
+
+HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOptions& options) {
+  VirtualClock clock;
+  EngineOptions eo = options.engine;
+  eo.time_source = clock.source();
+  Engine engine(dir, eo);
+  const double fps = engine.fps();
+
+  double duration = 0;
+  if (options.duration) {
+    duration = *options.duration;
+    if (!(duration > 0)) throw Error("duration must be positive, got " + std::to_string(duration));
+  } else if (options.script.empty()) {
+    duration = engine.frame_count() / fps;  // no script: play the database once
+  } else {
+    duration = options.script.back().t + 1 / fps;
+    for (const auto& c : options.script)
+      if (c.kind == ScriptCommand::Kind::end) {
+        duration = c.t;
+        break;
+      }
+  }
+  const long ticks = std::max(1L, long(std::ceil(duration * fps - 1e-6)));
+  if (ticks > 10'000'000) throw Error("run of " + std::to_string(duration) + " s is too long (over 10^7 frames)");
+
+  if (options.frames_out) {
+    std::error_code ec;
+    std::filesystem::create_directories(*options.frames_out, ec);
+    if (ec) throw FileError(options.frames_out->string(), "cannot create the frames directory: " + ec.message());
+  }
+
+  HeadlessResult result;
+  nlohmann::json displayed = nlohmann::json::array(), commands = nlohmann::json::array();
+  std::size_t next_command = 0;
+  for (long k = 0; k < ticks; ++k) {
+    const double t = double(k) / fps;
+    // A real display gives the prefetch threads one frame period between ticks; waiting for them to
+    // go idle models that deterministically (the shown frames never depend on it, only cache hits).
+    if (options.wait_prefetch_each_tick) engine.wait_prefetch_idle();
+    clock.set(t);
+    engine.tick();
+    bool ended = false;
+    while (next_command < options.script.size() && options.script[next_command].t <= t + 1e-9) {
+      const ScriptCommand& c = options.script[next_command++];
+      if (c.kind == ScriptCommand::Kind::end) ended = true;
+      const bool applied = apply(engine, c);
+      commands.push_back({{"t", c.t}, {"line", c.line}, {"command", describe(c)}, {"applied", applied}, {"tick", k}});
+    }
+    if (ended) break;
+    DisplayedFrame df;
+    df.index = int(k);
+    df.t = t;
+    df.shown = engine.current_frame();
+    const auto& s = df.shown.selection;
+    result.shown.push_back(s);
+    ++result.frames_displayed;
+    if (df.shown.status != FrameStatus::ok) ++result.placeholders;
+    displayed.push_back({{"index", k}, {"t", t}, {"camera", s.camera}, {"task", s.task}, {"frame", s.frame},
+                         {"status", std::string(to_string(df.shown.status))}, {"cache_hit", df.shown.cache_hit}});
+    if (options.frames_out) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%06ld.png", k);
+      write_png((*options.frames_out / name).string(), video::MovieReader::to_rgba(*df.shown.frame));
+    }
+    if (options.on_frame) options.on_frame(df);
+  }
+  engine.wait_prefetch_idle();
+  result.statistics = engine.statistics();
+  if (options.stats_out) {
+    nlohmann::json j = to_json(result.statistics);
+    j["database"] = dir.string();
+    j["fps"] = fps;
+    j["frame_count"] = engine.frame_count();
+    j["frames_displayed"] = result.frames_displayed;
+    j["placeholders"] = result.placeholders;
+    j["commands"] = std::move(commands);
+    j["displayed"] = std::move(displayed);
+    std::ofstream out(*options.stats_out);
+    if (!out) throw FileError(options.stats_out->string(), "cannot create the statistics file");
+    out << j.dump(2) << '\n';
+    if (!out) throw FileError(options.stats_out->string(), "cannot write the statistics file");
+  }
+  return result;
+}
+
+}  // namespace panoptes::player

@@ -1,0 +1,129 @@
+#include "player/keys.hpp"
+
+#include <array>
+#include <cctype>
+
+namespace panoptes::player {
+namespace {
+
+constexpr std::array kBindings{
+    KeyBinding{"Space", Action::play_pause, "play / pause"},
+    KeyBinding{"Left", Action::camera_left, "rotate: camera to the left (navigation graph)"},
+    KeyBinding{"Right", Action::camera_right, "rotate: camera to the right"},
+    KeyBinding{"Up", Action::camera_up, "rotate: camera above"},
+    KeyBinding{"Down", Action::camera_down, "rotate: camera below"},
+    KeyBinding{"Z", Action::shell_in, "zoom by moving to the inner (closer) camera shell"},
+    KeyBinding{"X", Action::shell_out, "zoom by moving to the outer (farther) camera shell"},
+    KeyBinding{"Tab", Action::next_task, "next visualization task"},
+    KeyBinding{"Shift+Tab", Action::previous_task, "previous visualization task"},
+    KeyBinding{"1", Action::task_1, "task 1 (digit keys 1..9 select tasks 1..9)"},
+    KeyBinding{"2", Action::task_2, "task 2"},
+    KeyBinding{"3", Action::task_3, "task 3"},
+    KeyBinding{"4", Action::task_4, "task 4"},
+    KeyBinding{"5", Action::task_5, "task 5"},
+    KeyBinding{"6", Action::task_6, "task 6"},
+    KeyBinding{"7", Action::task_7, "task 7"},
+    KeyBinding{"8", Action::task_8, "task 8"},
+    KeyBinding{"9", Action::task_9, "task 9"},
+    KeyBinding{"PageUp", Action::axis_up, "active parameter axis: next value (other axes kept)"},
+    KeyBinding{"]", Action::axis_up, "same as PageUp"},
+    KeyBinding{"PageDown", Action::axis_down, "active parameter axis: previous value"},
+    KeyBinding{"[", Action::axis_down, "same as PageDown"},
+    KeyBinding{"A", Action::next_axis, "make the next parameter axis the active one"},
+    KeyBinding{"Period", Action::frame_forward, "pause and step one frame forward ('.')"},
+    KeyBinding{"Comma", Action::frame_back, "pause and step one frame back (',')"},
+    KeyBinding{"Home", Action::first_frame, "first frame"},
+    KeyBinding{"End", Action::last_frame, "last frame"},
+    KeyBinding{"L", Action::toggle_loop, "loop on / off"},
+    KeyBinding{"Shift+Period", Action::faster, "double the playback speed, up to x8 ('>')"},
+    KeyBinding{"Shift+Comma", Action::slower, "halve the playback speed, down to x1/4 ('<')"},
+    KeyBinding{"J", Action::reverse, "reverse the playback direction"},
+    KeyBinding{"+", Action::zoom_in, "magnify around the cursor (also '=' and the mouse wheel)"},
+    KeyBinding{"=", Action::zoom_in, "same as +"},
+    KeyBinding{"-", Action::zoom_out, "reduce the magnification"},
+    KeyBinding{"0", Action::zoom_reset, "magnification 1, no pan"},
+    KeyBinding{"F", Action::fullscreen, "full screen on / off"},
+    KeyBinding{"S", Action::screenshot, "save the shown frame as a PNG screenshot"},
+    KeyBinding{"R", Action::record, "start / stop recording what is shown to an MP4"},
+    KeyBinding{"H", Action::help, "help overlay"},
+    KeyBinding{"F1", Action::help, "help overlay"},
+    KeyBinding{"Escape", Action::quit, "quit"},
+    KeyBinding{"Q", Action::quit, "quit"},
+};
+
+}  // namespace
+
+std::span<const KeyBinding> key_bindings() { return kBindings; }
+
+std::optional<Action> action_for_key(std::string_view key) {
+  for (const auto& b : kBindings)
+    if (b.key == key) return b.action;
+  if (key.size() == 1 && std::islower(static_cast<unsigned char>(key[0]))) {
+    const char upper[2] = {char(std::toupper(static_cast<unsigned char>(key[0]))), 0};
+    return action_for_key(std::string_view(upper, 1));
+  }
+  return std::nullopt;
+}
+
+std::string_view to_string(Action action) {
+  switch (action) {
+    case Action::none: return "none";
+    case Action::play_pause: return "play_pause";
+    case Action::frame_forward: return "frame_forward";
+    case Action::frame_back: return "frame_back";
+    case Action::first_frame: return "first_frame";
+    case Action::last_frame: return "last_frame";
+    case Action::toggle_loop: return "toggle_loop";
+    case Action::faster: return "faster";
+    case Action::slower: return "slower";
+    case Action::reverse: return "reverse";
+    case Action::camera_left: return "camera_left";
+    case Action::camera_right: return "camera_right";
+    case Action::camera_up: return "camera_up";
+    case Action::camera_down: return "camera_down";
+    case Action::shell_in: return "shell_in";
+    case Action::shell_out: return "shell_out";
+    case Action::next_task: return "next_task";
+    case Action::previous_task: return "previous_task";
+    case Action::task_1: return "task_1";
+    case Action::task_2: return "task_2";
+    case Action::task_3: return "task_3";
+    case Action::task_4: return "task_4";
+    case Action::task_5: return "task_5";
+    case Action::task_6: return "task_6";
+    case Action::task_7: return "task_7";
+    case Action::task_8: return "task_8";
+    case Action::task_9: return "task_9";
+    case Action::axis_up: return "axis_up";
+    case Action::axis_down: return "axis_down";
+    case Action::next_axis: return "next_axis";
+    case Action::zoom_in: return "zoom_in";
+    case Action::zoom_out: return "zoom_out";
+    case Action::zoom_reset: return "zoom_reset";
+    case Action::fullscreen: return "fullscreen";
+    case Action::screenshot: return "screenshot";
+    case Action::record: return "record";
+    case Action::help: return "help";
+    case Action::quit: return "quit";
+  }
+  return "unknown";
+}
+
+bool is_engine_action(Action action) {
+  switch (action) {
+    case Action::none:
+    case Action::zoom_in:
+    case Action::zoom_out:
+    case Action::zoom_reset:
+    case Action::fullscreen:
+    case Action::screenshot:
+    case Action::record:
+    case Action::help:
+    case Action::quit:
+      return false;
+    default:
+      return true;
+  }
+}
+
+}  // namespace panoptes::player

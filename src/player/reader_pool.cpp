@@ -1,0 +1,81 @@
+#include "player/reader_pool.hpp"
+
+#include "core/error.hpp"
+
+namespace panoptes::player {
+
+ReaderPool::ReaderPool(const store::Database& database, int capacity) : database_(database), capacity_(capacity) {
+  require(capacity >= 1, "reader pool capacity must be at least 1, got " + std::to_string(capacity));
+}
+
+std::unique_ptr<video::MovieReader> ReaderPool::acquire(int camera, int task) {
+  const std::int64_t stream = std::int64_t(camera) * database_.task_count() + task;
+  std::unique_ptr<video::MovieReader> victim;  // closed outside the lock (closing frees codec state)
+  {
+    std::unique_lock lock(mutex_);
+    for (auto it = idle_.begin(); it != idle_.end(); ++it)
+      if (it->stream == stream) {
+        auto reader = std::move(it->reader);
+        idle_.erase(it);
+        return reader;
+      }
+    // Make room: the bound counts lent readers too, so when all are lent we wait for one back.
+    returned_.wait(lock, [&] { return open_ < capacity_ || !idle_.empty(); });
+    if (open_ >= capacity_) {
+      victim = std::move(idle_.back().reader);
+      idle_.pop_back();
+      --open_;
+      ++evicted_;
+    }
+    ++open_;  // reserved before the (slow) open so concurrent acquires respect the bound
+  }
+  victim.reset();
+  try {
+    auto reader = database_.stream(camera, task);
+    std::lock_guard lock(mutex_);
+    ++opened_;
+    return reader;
+  } catch (...) {
+    {
+      std::lock_guard lock(mutex_);
+      --open_;
+    }
+    returned_.notify_one();
+    throw;
+  }
+}
+
+void ReaderPool::release(int camera, int task, std::unique_ptr<video::MovieReader> reader) {
+  if (!reader) return;
+  const std::int64_t stream = std::int64_t(camera) * database_.task_count() + task;
+  {
+    std::lock_guard lock(mutex_);
+    idle_.push_front(Idle{stream, std::move(reader)});
+  }
+  returned_.notify_one();
+}
+
+void ReaderPool::discard(std::unique_ptr<video::MovieReader> reader) {
+  if (!reader) return;
+  reader.reset();
+  {
+    std::lock_guard lock(mutex_);
+    --open_;
+  }
+  returned_.notify_one();
+}
+
+int ReaderPool::open() const {
+  std::lock_guard lock(mutex_);
+  return open_;
+}
+std::int64_t ReaderPool::opened() const {
+  std::lock_guard lock(mutex_);
+  return opened_;
+}
+std::int64_t ReaderPool::evicted() const {
+  std::lock_guard lock(mutex_);
+  return evicted_;
+}
+
+}  // namespace panoptes::player
