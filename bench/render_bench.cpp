@@ -1,2 +1,180 @@
+// Renderer benchmark on the standard scene: a 256×512×160 float32 grid of expanding spherical wave
+// fronts (p and s fields, generated here), 920×896 images, sample distance 0.5 voxel.
+//
+// Counters:
+//   Msamples_s_core  effective samples per second per core: samples along rays inside the volume,
+//                    counted whether marched or skipped, / wall time / OpenMP threads (target ≥ 100)
+//   Msamples_cpu_s   the same per CPU-second of the process (robust when the machine is shared)
+//   marched_pct      share of those samples actually interpolated (the rest was skipped)
+//   ms_per_task      wall time per image when K tasks share the camera
+//   cam_frames_s     camera-frames per second with the paper's 3 tasks (p, s, p+s) per camera
+//   rig130_s_extrap  seconds for one snapshot of the 130-camera Yin-Yang rig, EXTRAPOLATED linearly
+//                    from the handful of cameras rendered (6 directions spread over the sphere)
 #include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <time.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "render/renderer.hpp"
+#include "render/synthetic_fields.hpp"
+
+using namespace panoptes;
+using namespace panoptes::render;
+
+namespace {
+
+constexpr int kWidth = 920, kHeight = 896;
+
+struct StandardScene {
+  GridGeometry grid{{256, 512, 160}, {0, 0, 0}, {1, 1, 1}};
+  std::vector<float> p, s;
+  std::vector<PreparedField> fields;
+  StandardScene() {
+    // Two sources; P fronts travel faster than S fronts, so their shells are larger.
+    const WaveFront pf[] = {{{128, 180, 90}, 150, 4, 1.0}, {{90, 380, 60}, 70, 4, 0.8}};
+    const WaveFront sf[] = {{{128, 180, 90}, 87, 3, 1.0}, {{90, 380, 60}, 40, 3, 0.9}};
+    p = wave_field(grid, pf);
+    s = wave_field(grid, sf);
+    fields = {PreparedField(FieldView::whole(grid, p.data())), PreparedField(FieldView::whole(grid, s.data()))};
+  }
+};
+
+const StandardScene& scene() {
+  static const StandardScene sc;
+  return sc;
+}
+
+// n directions spread over the sphere (golden-angle spiral), cameras at 3 bounding radii.
+camera::Camera camera_at(int i, int n) {
+  const GridGeometry& g = scene().grid;
+  const double z = 1 - (2.0 * i + 1) / n, r = std::sqrt(1 - z * z);
+  const double phi = i * std::numbers::pi * (3 - std::sqrt(5.0));
+  const Vec3 dir{r * std::cos(phi), r * std::sin(phi), z};
+  const double R = 0.5 * norm(g.domain_hi() - g.domain_lo());
+  const double fov = 2 * std::asin(1.03 / 3.0) * 180 / std::numbers::pi;
+  return camera::Camera(g.centre() + dir * (3 * R), g.centre(), {0, 0, 1}, fov, kWidth, kHeight);
+}
+
+const camera::Camera kMain = camera::Camera({-600, -700, 450}, {128, 256, 80}, {0, 0, 1}, 40, kWidth, kHeight);
+
+TaskSpec p_task() { return TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1)); }
+TaskSpec s_task() { return TaskSpec::volume(1, TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 1)); }
+TaskSpec ps_task() {
+  return TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
+                           TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 1));
+}
+
+// K transfer functions of one field: p-wave windows from narrow to wide (a parameter sweep).
+std::vector<TaskSpec> sweep(int k) {
+  std::vector<TaskSpec> t;
+  for (int i = 0; i < k; ++i)
+    t.push_back(TaskSpec::volume(0, TransferFunction::preset(i % 2 ? "hot" : "p-wave"),
+                                 ValueWindow::absolute(0, 0.6 + 0.1 * i)));
+  return t;
+}
+
+// CPU time of the whole process (all threads): on a shared machine wall time × threads overstates
+// the cores we actually had, so the per-core rate is also reported per CPU-second.
+double process_cpu_seconds() {
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+void report(benchmark::State& state, const RenderStats& total, double seconds, double cpu_seconds) {
+  const int threads = omp_get_max_threads();
+  state.counters["Msamples_s_core"] = double(total.samples) / seconds / threads / 1e6;
+  state.counters["Msamples_cpu_s"] = double(total.samples) / cpu_seconds / 1e6;
+  state.counters["marched_pct"] = total.samples ? 100.0 * double(total.marched_samples) / double(total.samples) : 0;
+  state.counters["threads"] = threads;
+}
+
+RenderStats add(RenderStats a, const RenderStats& b) {
+  a.rays += b.rays;
+  a.samples += b.samples;
+  a.marched_samples += b.marched_samples;
+  a.seconds += b.seconds;
+  return a;
+}
+
+void BM_Volume(benchmark::State& state) {
+  const auto& sc = scene();
+  RenderOptions opt;
+  opt.skip_empty = state.range(0) != 0;
+  opt.tile = int(state.range(1));
+  const std::vector<TaskSpec> tasks{p_task()};
+  std::vector<PartialImage> out(1);
+  RenderStats total;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) total = add(total, render_brick(kMain, sc.fields, tasks, out, opt));
+  report(state, total, total.seconds, process_cpu_seconds() - cpu0);
+}
+BENCHMARK(BM_Volume)->ArgNames({"skip", "tile"})->Args({1, 16})->Args({0, 16})->Args({0, 8})->Args({0, 32})->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_TasksOneMarch(benchmark::State& state) {
+  const auto& sc = scene();
+  const auto tasks = sweep(int(state.range(0)));
+  std::vector<PartialImage> out(tasks.size());
+  RenderStats total;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) total = add(total, render_brick(kMain, sc.fields, tasks, out));
+  report(state, total, total.seconds, process_cpu_seconds() - cpu0);
+  state.counters["ms_per_task"] = 1e3 * total.seconds / double(state.iterations()) / double(tasks.size());
+}
+BENCHMARK(BM_TasksOneMarch)->ArgName("K")->Arg(1)->Arg(3)->Arg(10)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_TasksSeparateMarches(benchmark::State& state) {
+  const auto& sc = scene();
+  const auto tasks = sweep(int(state.range(0)));
+  std::vector<PartialImage> out(1);
+  RenderStats total;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state)
+    for (const TaskSpec& t : tasks) total = add(total, render_brick(kMain, sc.fields, std::span(&t, 1), out));
+  report(state, total, total.seconds, process_cpu_seconds() - cpu0);
+  state.counters["ms_per_task"] = 1e3 * total.seconds / double(state.iterations()) / double(tasks.size());
+}
+BENCHMARK(BM_TasksSeparateMarches)->ArgName("K")->Arg(3)->Arg(10)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The paper's three tasks (p, s, p+s) in one march per camera, plus compositing into the final
+// RGBA8 frame with the outline, for a handful of cameras around the sphere.
+void BM_PaperTasksRig(benchmark::State& state) {
+  const auto& sc = scene();
+  const int ncam = int(state.range(0));
+  const std::vector<TaskSpec> tasks{p_task(), s_task(), ps_task()};
+  std::vector<PartialImage> out(tasks.size());
+  RenderStats total;
+  double seconds = 0;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) {
+    const double t0 = omp_get_wtime();
+    for (int c = 0; c < ncam; ++c) {
+      const camera::Camera cam = camera_at(c, ncam);
+      total = add(total, render_brick(cam, sc.fields, tasks, out));
+      for (const PartialImage& o : out) benchmark::DoNotOptimize(finish_image(o, cam, sc.grid));
+    }
+    seconds += omp_get_wtime() - t0;
+  }
+  report(state, total, total.seconds, process_cpu_seconds() - cpu0);
+  const double cams_per_s = double(ncam) * double(state.iterations()) / seconds;
+  state.counters["cam_frames_s"] = cams_per_s;
+  state.counters["rig130_s_extrap"] = 130.0 / cams_per_s;
+}
+BENCHMARK(BM_PaperTasksRig)->ArgName("cameras")->Arg(6)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PrepareFields(benchmark::State& state) {
+  const auto& sc = scene();
+  for (auto _ : state) {
+    PreparedField a(FieldView::whole(sc.grid, sc.p.data())), b(FieldView::whole(sc.grid, sc.s.data()));
+    benchmark::DoNotOptimize(a.cells.total() + b.cells.total());
+  }
+}
+BENCHMARK(BM_PrepareFields)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
 BENCHMARK_MAIN();

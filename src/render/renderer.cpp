@@ -211,6 +211,11 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   while (ke >= ks && !inside(ke)) --ke;
   if (ks > ke) return;
   effective += std::uint64_t(ke - ks + 1);
+  // During the march acc[i][3] holds the TRANSMITTANCE T = 1 − α: the loop-carried chain per
+  // sample is then one multiply, T ← T·(1 − α_s), and colour accumulates as C ← C + T·c_s·α_s.
+  for (std::uint64_t m = S.march_mask; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
+  FieldAcc fa[8];  // local copies: no aliasing with the accumulators, so no reloads per sample
+  for (std::size_t s = 0; s < S.acc.size(); ++s) fa[s] = S.acc[s];
   // The last sample of the ray in the whole domain stands for a shorter segment.
   std::int64_t k_partial = -1;
   float partial = 1;
@@ -228,7 +233,10 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   bool have_prev = false;
   const float Sx = float(dt * D[0]), Sy = float(dt * D[1]), Sz = float(dt * D[2]);
   const int M = S.mc;
+  const double inv_m = 1.0 / M, inv_dt = 1.0 / dt;
+  const double invD[3] = {D[0] != 0 ? 1.0 / D[0] : 0.0, D[1] != 0 ? 1.0 / D[1] : 0.0, D[2] != 0 ? 1.0 / D[2] : 0.0};
   const float thr = S.termination;
+  const float tr_stop = 1.0f - thr;
 
   std::int64_t k = ks;
   while (k <= ke && live) {
@@ -237,13 +245,17 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     int mi[3];
     double texit = INFINITY;
     for (int a = 0; a < 3; ++a) {
-      mi[a] = std::clamp(int((p[a] - B.lo[a]) / M), 0, S.mcount[a] - 1);
+      mi[a] = std::clamp(int((p[a] - B.lo[a]) * inv_m), 0, S.mcount[a] - 1);
       if (D[a] != 0) {
         const double c0 = B.lo[a] + mi[a] * M, c1 = std::min(c0 + M, double(B.hi[a]));
-        texit = std::min(texit, ((D[a] > 0 ? c1 : c0) - O[a]) / D[a]);
+        texit = std::min(texit, ((D[a] > 0 ? c1 : c0) - O[a]) * invD[a]);
       }
     }
-    std::int64_t kend = std::int64_t(std::ceil((texit - t0) / dt)) - 1;
+    // Samples before the exit: ceil((texit − t0)/Δ) − 1, without a libm call (runs are short, so
+    // this bookkeeping is a visible share of the time when most macro-cells are skipped).
+    const double q = (texit - t0) * inv_dt;
+    std::int64_t kend = std::int64_t(q);
+    kend -= (double(kend) >= q);
     kend = std::clamp(kend, k, ke);
     const std::uint64_t mask = S.active[std::size_t(mi[0] + S.mcount[0] * (mi[1] + S.mcount[1] * mi[2]))];
     if (!(mask & live)) {  // empty macro-cell for every live task
@@ -255,16 +267,56 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       // The sample before this run (maybe in the previous brick: within the ghost layers).
       const double tp = t - dt;
       for (int s = 0; s < nslots; ++s)
-        prev[s] = interp_clamped(S.acc[std::size_t(s)], O[0] + tp * D[0], O[1] + tp * D[1], O[2] + tp * D[2]);
+        prev[s] = interp_clamped(fa[s], O[0] + tp * D[0], O[1] + tp * D[1], O[2] + tp * D[2]);
       have_prev = true;
     }
     const float px0 = float(p[0]), py0 = float(p[1]), pz0 = float(p[2]);
+    const std::uint64_t run_tasks = mask & live;
+    if (run_tasks && !(run_tasks & (run_tasks - 1)) && S.rt[std::size_t(std::countr_zero(run_tasks))].kind == RtKind::volume1) {
+      // Fast path: one volume task in this macro-cell; field, LUT and accumulator in registers.
+      const int i = std::countr_zero(run_tasks);
+      const TaskRt& T = S.rt[std::size_t(i)];
+      const FieldAcc f = fa[T.s1];
+      const LutEntry* lut = T.lut1;
+      const float lo = T.lo1, sc = T.sc1, last = T.last1;
+      const bool absv = T.abs1;
+      // Transmittance form: the loop-carried chain is one multiply (T ← T·(1 − α)) instead of
+      // α ← α + (1 − α)·α_s, which shortens the per-sample latency.
+      float a0 = acc[i][0], a1 = acc[i][1], a2 = acc[i][2], tr = acc[i][3];
+      float x = px0, y = py0, z = pz0;
+      std::int64_t kk = k;
+      for (; kk <= kend; ++kk) {
+        const float v = interp(f, x, y, z);
+        x += Sx, y += Sy, z += Sz;
+        const LutEntry& e = lut[lut_bin(v, lo, sc, last, absv)];
+        float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
+        if (kk == k_partial) [[unlikely]] {
+          const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
+          const float sf = al > 0 ? an / al : 0.0f;
+          pr *= sf, pg *= sf, pb *= sf, al = an;
+        }
+        a0 += tr * pr;
+        a1 += tr * pg;
+        a2 += tr * pb;
+        tr *= 1.0f - al;
+        if (tr <= tr_stop) [[unlikely]] {
+          live &= ~(std::uint64_t(1) << i);
+          ++kk;
+          break;
+        }
+      }
+      acc[i][0] = a0, acc[i][1] = a1, acc[i][2] = a2, acc[i][3] = tr;
+      marched += std::uint64_t(kk - k);
+      have_prev = false;  // prev values were not tracked (no isosurface task is live here)
+      k = kend + 1;
+      continue;
+    }
     std::int64_t kk = k;
+    float x = px0, y = py0, z = pz0;  // advanced exactly as in the fast path: same samples, same bits
     for (; kk <= kend; ++kk) {
-      const float j = float(kk - k);
-      const float x = px0 + j * Sx, y = py0 + j * Sy, z = pz0 + j * Sz;
       float v[8];
-      for (int s = 0; s < nslots; ++s) v[s] = interp(S.acc[std::size_t(s)], x, y, z);
+      for (int s = 0; s < nslots; ++s) v[s] = interp(fa[s], x, y, z);
+      x += Sx, y += Sy, z += Sz;
       std::uint64_t m = mask & live;
       while (m) {
         const int i = std::countr_zero(m);
@@ -280,12 +332,12 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
               const float s = al > 0 ? a2 / al : 0.0f;
               pr *= s, pg *= s, pb *= s, al = a2;
             }
-            const float w = 1.0f - a[3];
-            a[0] += w * pr;
-            a[1] += w * pg;
-            a[2] += w * pb;
-            a[3] += w * al;
-            if (a[3] >= thr) live &= ~(std::uint64_t(1) << i);
+            const float tr = a[3];
+            a[0] += tr * pr;
+            a[1] += tr * pg;
+            a[2] += tr * pb;
+            a[3] = tr * (1.0f - al);
+            if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
             break;
           }
           case RtKind::volume2: {
@@ -295,13 +347,13 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
             if (tau <= 0) break;
             float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
             if (kk == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
-            const float s = al / tau;
-            const float w = 1.0f - a[3];
-            a[0] += w * s * (e1.tau * e1.r + e2.tau * e2.r);
-            a[1] += w * s * (e1.tau * e1.g + e2.tau * e2.g);
-            a[2] += w * s * (e1.tau * e1.b + e2.tau * e2.b);
-            a[3] += w * al;
-            if (a[3] >= thr) live &= ~(std::uint64_t(1) << i);
+            const float tr = a[3];
+            const float s = tr * al / tau;
+            a[0] += s * (e1.tau * e1.r + e2.tau * e2.r);
+            a[1] += s * (e1.tau * e1.g + e2.tau * e2.g);
+            a[2] += s * (e1.tau * e1.b + e2.tau * e2.b);
+            a[3] = tr * (1.0f - al);
+            if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
             break;
           }
           case RtKind::iso: {
@@ -310,7 +362,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
             float dp = prev[T.s1] - T.iso;
             if ((dp < 0) == (d < 0)) break;
             // First crossing between samples kk−1 and kk: linear estimate, one regula-falsi step.
-            const FieldAcc& f = S.acc[std::size_t(T.s1)];
+            const FieldAcc& f = fa[T.s1];
             double ta = t0 + double(kk - 1) * dt, tb = ta + dt;
             double dpa = dp, dpb = d;
             double th = ta + (tb - ta) * (dpa / (dpa - dpb));
@@ -320,6 +372,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
             if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
             const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
             shade_hit(S, f, ph, dir, T, a);
+            a[3] = 0;  // opaque: transmittance 0
             live &= ~(std::uint64_t(1) << i);
             break;
           }
@@ -336,6 +389,10 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     }
     marched += std::uint64_t(kk - k);
     k = kend + 1;
+  }
+  for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
+    float* a = acc[std::countr_zero(m)];
+    a[3] = 1.0f - a[3];  // transmittance back to opacity
   }
 }
 
