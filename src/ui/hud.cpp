@@ -54,9 +54,21 @@ void Hud::notify(std::string text, bool error) {
   message_until_ = ImGui::GetTime() + (error ? 6.0 : 3.0);
 }
 
+void Hud::remember_window() {
+  const ImVec2 p = ImGui::GetWindowPos(), sz = ImGui::GetWindowSize();
+  boxes_.push_back({p.x, p.y, p.x + sz.x, p.y + sz.y});
+}
+
+bool Hud::covers(float x, float y) const {
+  for (const auto& b : boxes_)
+    if (x >= b.x0 && x < b.x1 && y >= b.y0 && y < b.y1) return true;
+  return false;
+}
+
 HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
   HudRequests req;
   panel_drawn_ = false;
+  boxes_.clear();
   const store::Manifest& m = *info.manifest;
   const float pad = 8;
 
@@ -66,13 +78,14 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::SetNextWindowBgAlpha(0.72f);
     if (ImGui::Begin("##status", nullptr, kOverlayFlags)) {
       panel_drawn_ = true;
+      remember_window();
       const auto& sel = info.selection;
       const auto& cam = m.cameras[std::size_t(sel.camera)];
       const auto& task = m.tasks[std::size_t(sel.task)];
-      ImGui::Text("t = %.4g  frame %d / %d", info.sim_time, sel.frame + 1, info.frame_count);
+      ImGui::Text("t = %.4g   frame %d of %d", info.sim_time, sel.frame, info.frame_count);
       ImGui::Text("camera %d%s%s  lat %+.1f  lon %+.1f  shell %d", sel.camera, cam.labels.patch.empty() ? "" : " ",
                   cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg, cam.labels.shell);
-      ImGui::Text("task %d/%d: %s", sel.task + 1, int(m.tasks.size()), task.name.c_str());
+      ImGui::Text("task %d of %d: %s", sel.task, int(m.tasks.size()), task.name.c_str());
       const std::string params = format_parameters(m, task);
       if (!params.empty()) ImGui::Text("  %s", params.c_str());
       if (info.active_axis >= 0 && info.active_axis < int(m.axes.size()))
@@ -102,6 +115,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::SetNextWindowPos(ImVec2(vw - pad, vh - slider_h - pad), ImGuiCond_Always, ImVec2(1, 1));
     ImGui::SetNextWindowBgAlpha(0.5f);
     if (ImGui::Begin("##minimap", nullptr, kOverlayFlags)) {
+      remember_window();
       req.jump_camera = minimap_.draw(info.selection.camera, info.neighbours, map);
     }
     ImGui::End();
@@ -111,6 +125,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::SetNextWindowSize(ImVec2(vw, 0), ImGuiCond_Always);
     ImGui::SetNextWindowBgAlpha(0.6f);
     if (ImGui::Begin("##timeline", nullptr, kOverlayFlags & ~ImGuiWindowFlags_AlwaysAutoResize)) {
+      remember_window();
       if (ImGui::Button(info.playing ? "Pause" : "Play")) req.toggle_play = true;
       ImGui::SameLine();
       ImGui::SetNextItemWidth(-1);
@@ -127,6 +142,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::SetNextWindowPos(ImVec2(vw / 2, vh * 0.8f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
     ImGui::SetNextWindowBgAlpha(0.8f);
     if (ImGui::Begin("##message", nullptr, kOverlayFlags)) {
+      remember_window();
       if (message_error_)
         ImGui::TextColored(ImVec4(1, 0.45f, 0.35f, 1), "%s", message_.c_str());
       else
@@ -143,6 +159,7 @@ void Hud::draw_help(float vw, float vh) {
   ImGui::SetNextWindowBgAlpha(0.9f);
   if (ImGui::Begin("Panoptes keys (H / F1 closes)", &show_help,
                    ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse)) {
+    remember_window();
     if (ImGui::BeginTable("##keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
       for (const auto& b : player::key_bindings()) {
         ImGui::TableNextRow();

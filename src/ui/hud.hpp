@@ -57,6 +57,10 @@ class Hud {
   void notify(std::string text, bool error = false);
   /// True if the status panel was submitted in the last draw() (the window test checks it).
   bool panel_drawn() const { return panel_drawn_; }
+  /// True if window point (x, y) lies on one of the HUD's windows as drawn last frame. Mouse events
+  /// there belong to the HUD; elsewhere they drive the view (hit-testing the event's own position
+  /// rather than ImGui's idea of the pointer, which may lag or come from the global pointer state).
+  bool covers(float x, float y) const;
 
  private:
   void draw_help(float viewport_w, float viewport_h);
@@ -65,6 +69,11 @@ class Hud {
   bool message_error_ = false;
   double message_until_ = 0;
   bool panel_drawn_ = false;
+  struct Box {
+    float x0, y0, x1, y1;
+  };
+  std::vector<Box> boxes_;
+  void remember_window();  // records the current ImGui window's rectangle into boxes_
 };
 
 }  // namespace panoptes::ui

@@ -226,7 +226,7 @@ void WindowApp::handle_event(const SDL_Event& e) {
       break;
     }
     case SDL_MOUSEBUTTONDOWN:
-      if (io.WantCaptureMouse) break;
+      if (hud_.covers(float(e.button.x), float(e.button.y))) break;
       if (e.button.button == SDL_BUTTON_LEFT) {
         const auto& cam = engine_.manifest().cameras[std::size_t(engine_.selection().camera)];
         drag_.begin(cam.position, cam.up, cam.look_at);
@@ -252,8 +252,9 @@ void WindowApp::handle_event(const SDL_Event& e) {
       }
       break;
     case SDL_MOUSEWHEEL:
-      if (io.WantCaptureMouse) break;
-      if (e.wheel.preciseY != 0) zoom_by(std::pow(1.2, double(e.wheel.preciseY)));
+      if (hud_.covers(float(e.wheel.mouseX), float(e.wheel.mouseY))) break;
+      // The event carries the pointer position (SDL >= 2.26), so zoom happens where the wheel turned.
+      if (e.wheel.preciseY != 0) view_.zoom_at(std::pow(1.2, double(e.wheel.preciseY)), e.wheel.mouseX * px_x_, e.wheel.mouseY * px_y_);
       break;
     default: break;
   }
@@ -358,6 +359,7 @@ WindowResult WindowApp::run() {
   const double frame_period = 1.0 / engine_.fps();
   bool last = false;
   while (!last) {
+    if (options_.before_frame) options_.before_frame(result.frames_presented);
     run_due_script_commands();
     SDL_Event e;
     while (SDL_PollEvent(&e)) handle_event(e);
@@ -410,7 +412,9 @@ WindowResult WindowApp::run() {
     }
 
     const double wall = wall_seconds();
-    if (wall >= next_stats_) {
+    // Refresh a few times a second, and at once after a switch so its latency shows immediately.
+    const bool switched = shown.selection.camera != result.camera || shown.selection.task != result.task;
+    if (wall >= next_stats_ || (switched && result.frames_presented > 0)) {
       refresh_statistics();
       next_stats_ = wall + 0.5;
     }

@@ -4,6 +4,7 @@
 // `panoptes play DB` (src/app/cmd_play.cpp) calls run_window() unless --headless is given.
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace panoptes::ui {
@@ -45,6 +46,9 @@ struct WindowOptions {
   bool show_hud = true;
   /// Show the help overlay at start.
   bool show_help = false;
+  /// Called at the start of every window frame with the number of frames presented so far, before
+  /// the frame's events are polled: tests push synthetic SDL mouse events here. Empty = none.
+  std::function<void(int)> before_frame;
 };
 
 /// What the session ended with (for tests and for the command to print a summary).

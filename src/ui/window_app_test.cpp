@@ -16,6 +16,9 @@
 #include "core/png.hpp"
 #include "store/database.hpp"
 #include "ui/window_app.hpp"
+#include "video/movie_reader.hpp"
+
+#include <SDL.h>
 
 namespace panoptes::ui {
 namespace {
@@ -119,12 +122,15 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
   const auto script = dir_->path / "keys.txt";
   // Paused at frame 0 of camera 0, task 0. Every key goes through SDL's event queue and the shared
-  // key table: → (camera 1), → (camera 2), ← (camera 1), Tab (task 1), '.' '.' (frame 2),
-  // + then 0 (zoom in and back to 1, so the frame is shown 1:1 again), F1 twice (help on and off).
+  // key table: R (start recording), → (camera 1), → (camera 2), ← (camera 1), Tab (task 1),
+  // '.' '.' (frame 2), + then 0 (zoom in and back to 1, so the frame is shown 1:1 again), F1 twice
+  // (help on and off), S (screenshot), R (stop recording).
   std::ofstream(script) << "# ui window test\n"
+                           "t=0.05 key=R\n"
                            "t=0.10 key=Right\nt=0.20 key=Right\nt=0.30 key=Left\n"
                            "t=0.40 key=Tab\nt=0.50 key=Period\nt=0.60 key=Period\n"
-                           "t=0.70 key=+\nt=0.80 key=0\nt=0.90 key=F1\nt=1.00 key=F1\n";
+                           "t=0.70 key=+\nt=0.80 key=0\nt=0.90 key=F1\nt=1.00 key=F1\n"
+                           "t=1.05 key=S\nt=1.10 key=R\n";
   WindowOptions o;
   o.software_renderer = true;  // Xvfb has no GL worth testing; SDL's software path is deterministic
   o.vsync = false;
@@ -178,6 +184,97 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   EXPECT_GT(panel, 2000) << "status panel not drawn";
   EXPECT_GT(slider, 1000) << "time slider not drawn";
   EXPECT_EQ(middle_left, 0) << "frame area disturbed";
+
+  // S saved the shown frame without the HUD.
+  const auto png = dir_->path / "panoptes-c1-t1-f2.png";
+  ASSERT_TRUE(std::filesystem::exists(png));
+  const Image saved = read_png(png.string());
+  EXPECT_EQ(read_frame_stamp(saved), (FrameStamp{1, 1, 2}));
+  int hud_pixels = 0;
+  for (int y = 0; y < kH / 3; ++y)
+    for (int x = kW / 2; x < kW; ++x) hud_pixels += std::abs(saved.at(x, y)[0] - kGrey) > 24;
+  EXPECT_EQ(hud_pixels, 0) << "the screenshot should hold the frame only";
+
+  // R recorded the user's path: one movie frame per database frame period (virtual clock), starting
+  // at camera 0 and ending at the last selection.
+  std::filesystem::path movie;
+  for (const auto& e : std::filesystem::directory_iterator(dir_->path))
+    if (e.path().extension() == ".mp4") movie = e.path();
+  ASSERT_FALSE(movie.empty()) << "no recording in " << dir_->path;
+  video::MovieReader reader(movie.string());
+  EXPECT_EQ(reader.width(), kW);
+  EXPECT_EQ(reader.height(), kH);
+  EXPECT_GE(reader.frame_count(), 28);
+  EXPECT_LE(reader.frame_count(), 32);
+  EXPECT_EQ(read_frame_stamp(reader.read_rgba(0)), (FrameStamp{0, 0, 0}));
+  EXPECT_EQ(read_frame_stamp(reader.read_rgba(reader.frame_count() - 1)), (FrameStamp{1, 1, 2}));
+}
+
+TEST_F(WindowTest, MouseDragSnapsWheelZoomsAroundTheCursorRightDragPans) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  // Synthetic mouse events, pushed before the window polls its events. (100, 200) lies on the frame,
+  // clear of the HUD windows.
+  auto push = [](SDL_Event e) { SDL_PushEvent(&e); };
+  auto motion = [&](int x, int y, int dx, int dy, Uint32 state) {
+    SDL_Event e{};
+    e.type = SDL_MOUSEMOTION;
+    e.motion.x = x;
+    e.motion.y = y;
+    e.motion.xrel = dx;
+    e.motion.yrel = dy;
+    e.motion.state = state;
+    push(e);
+  };
+  auto button = [&](Uint32 type, Uint8 which, int x, int y) {
+    SDL_Event e{};
+    e.type = type;
+    e.button.button = which;
+    e.button.state = type == SDL_MOUSEBUTTONDOWN ? SDL_PRESSED : SDL_RELEASED;
+    e.button.clicks = 1;
+    e.button.x = x;
+    e.button.y = y;
+    push(e);
+  };
+  WindowOptions o;
+  o.software_renderer = true;
+  o.vsync = false;
+  o.paused = true;
+  o.virtual_time = true;
+  o.camera = 1;  // at longitude 90°, looking along -y with z up: screen right is -x
+  o.max_frames = 30;
+  o.before_frame = [&](int n) {
+    switch (n) {
+      case 2: motion(100, 200, 0, 0, 0); break;
+      case 4: button(SDL_MOUSEBUTTONDOWN, SDL_BUTTON_LEFT, 100, 200); break;
+      // 4 x 36 px right = 0.4 of the 360 px window = 72°: the viewpoint orbits from +y towards +x
+      // (grab-the-object: the object turns right), nearest camera 0 (18° away) rather than 1 (72°).
+      case 5: case 6: case 7: case 8: motion(100 + 36 * (n - 4), 200, 36, 0, SDL_BUTTON_LMASK); break;
+      case 9: button(SDL_MOUSEBUTTONUP, SDL_BUTTON_LEFT, 244, 200); break;
+      case 12: {
+        SDL_Event e{};
+        e.type = SDL_MOUSEWHEEL;
+        e.wheel.y = 1;
+        e.wheel.preciseY = 1;
+        e.wheel.mouseX = 100;
+        e.wheel.mouseY = 200;
+        push(e);
+        break;
+      }
+      case 14: button(SDL_MOUSEBUTTONDOWN, SDL_BUTTON_RIGHT, 100, 200); break;
+      case 15: motion(90, 200, -10, 0, SDL_BUTTON_RMASK); break;
+      case 16: button(SDL_MOUSEBUTTONUP, SDL_BUTTON_RIGHT, 90, 200); break;
+      default: break;
+    }
+  };
+  const WindowResult r = run_window(dir_->path / "db", o);
+  EXPECT_EQ(r.camera, 0);
+  // One wheel notch magnifies x1.2 keeping the frame point under (100, 200) in place: the frame's
+  // origin moves to 100 - 1.2 * 100 = -20, 200 - 1.2 * 200 = -40; the right-drag then pans 10 px left.
+  EXPECT_NEAR(r.zoom, 1.2, 1e-9);
+  EXPECT_EQ(r.view_w, 576);
+  EXPECT_EQ(r.view_h, 432);
+  EXPECT_EQ(r.view_x, -30);
+  EXPECT_EQ(r.view_y, -40);
 }
 
 TEST_F(WindowTest, MissingDisplayIsAClearError) {
