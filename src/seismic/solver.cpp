@@ -1,0 +1,1054 @@
+#include "seismic/solver.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "seismic/attenuation.hpp"
+#include "seismic/medium.hpp"
+
+namespace panoptes::seismic {
+
+namespace {
+
+// 4th-order staggered first-derivative coefficients (times h).
+constexpr float C1 = 9.0f / 8.0f;
+constexpr float C2 = -1.0f / 24.0f;
+constexpr int G = 2;  // ghost layers on every side
+
+using Vec = std::vector<float>;
+
+/// CPML coefficients and slots along one axis (local indices).
+struct PmlAxis {
+  std::vector<int> slot;            // per local index: slot in ψ arrays, −1 outside the layers
+  std::vector<int> indices;         // local indices with a slot, ascending
+  std::vector<float> a_full, b_full, a_half, b_half;
+  int count() const { return int(indices.size()); }
+};
+
+struct Injection {
+  float* field;      // base of the target array
+  std::size_t n;     // linear index
+  int k;             // local plane
+  double weight;     // kernel weight × amplitude (see Impl::inject_*)
+  int source;        // source index
+};
+
+struct ReceiverComp {
+  bool owned = false;
+  std::array<std::size_t, 8> n{};
+  std::array<double, 8> w{};
+};
+
+}  // namespace
+
+double stable_time_step(double h, double vp_max) {
+  return h / (std::sqrt(3.0) * (9.0 / 8.0 + 1.0 / 24.0) * vp_max);
+}
+
+struct Solver::Impl {
+  SolverConfig cfg;
+#ifdef PANOPTES_HAVE_MPI
+  MPI_Comm comm = MPI_COMM_NULL;
+#endif
+  int rank = 0, size = 1;
+  int nx = 0, ny = 0, nz = 0, kb = 0, ke = 0, nzl = 0;
+  long sy = 0, sz = 0;
+  std::size_t N = 0;
+  double h = 0, dt = 0, vpmax = 0;
+  int nsteps = 0;
+  bool free_surface = true;
+  int npml = 0;
+
+  Vec vx, vy, vz, sxx, syy, szz, sxy, sxz, syz;
+  Vec bx, by, bz, lam, twomu, muxy, muxz, muyz;
+  // Attenuation (empty when elastic).
+  int L = 0;
+  std::vector<float> relax_a, relax_b;
+  std::vector<Vec> rxx, ryy, rzz, rxy, rxz, ryz, cl, cm, cmxy, cmxz, cmyz;
+  std::vector<Vec> rowbuf;  // per thread: 6 rows of nx strain rates
+  // CPML.
+  PmlAxis pmlx, pmly, pmlz;
+  std::array<Vec, 6> psix, psiy, psiz;
+  // Sources and receivers.
+  std::vector<SourceSpec> sources;
+  std::vector<Injection> stress_inj, force_inj;
+  std::vector<std::array<ReceiverComp, 3>> recv;
+  std::vector<double> rec_time;
+  std::vector<std::array<std::vector<double>, 3>> rec;
+  // Derived fields.
+  Vec phip, phis;
+
+  FieldView view(const Vec& v, std::array<double, 3> stagger) const {
+    FieldView f;
+    f.data = v.data() + idx(0, 0, 0);
+    f.nx = nx;
+    f.ny = ny;
+    f.nz = nzl;
+    f.stride_y = sy;
+    f.stride_z = sz;
+    f.k_offset = kb;
+    f.global_dims = {nx, ny, nz};
+    f.stagger = stagger;
+    f.h = h;
+    return f;
+  }
+
+  std::size_t idx(int i, int j, int k) const {
+    return std::size_t(i + G) + std::size_t(sy) * std::size_t(j + G) + std::size_t(sz) * std::size_t(k + G);
+  }
+
+  // ---------------------------------------------------------------- setup
+  void init(const SolverConfig& c);
+  void setup_materials(const MediumBlock& mb);
+  void setup_pml();
+  void setup_sources();
+  void setup_receivers();
+
+  // ---------------------------------------------------------------- stepping
+  void step();
+  void velocity_planes(int k0, int k1, double t);
+  void stress_planes(int k0, int k1, double t);
+  template <int Z>
+  void stress_plane_elastic(int k);
+  template <int Z>
+  void stress_plane_visco(int k);
+  void pml_velocity(int k0, int k1);
+  void pml_stress(int k0, int k1);
+  void free_surface_images();
+  void record();
+
+#ifdef PANOPTES_HAVE_MPI
+  std::vector<MPI_Request> reqs;
+#endif
+  void start_exchange(std::initializer_list<Vec*> fields);
+  void finish_exchange();
+
+  double allreduce_max(double v) const {
+#ifdef PANOPTES_HAVE_MPI
+    if (comm != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, comm);
+#endif
+    return v;
+  }
+  double allreduce_sum(double v) const {
+#ifdef PANOPTES_HAVE_MPI
+    if (comm != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, comm);
+#endif
+    return v;
+  }
+  /// Throws the same error on every rank when any rank failed (so no rank is left in a collective).
+  void agree(const std::string& local_error) const {
+    int bad = local_error.empty() ? 0 : 1;
+#ifdef PANOPTES_HAVE_MPI
+    if (comm != MPI_COMM_NULL) {
+      int first = bad ? rank : size;
+      MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, comm);
+      if (first == size) return;
+      int len = int(local_error.size());
+      MPI_Bcast(&len, 1, MPI_INT, first, comm);
+      std::string msg = local_error;
+      msg.resize(len);
+      MPI_Bcast(msg.data(), len, MPI_CHAR, first, comm);
+      throw Error(msg);
+    }
+#endif
+    if (bad) throw Error(local_error);
+  }
+};
+
+// ==================================================================== setup
+
+void Solver::Impl::init(const SolverConfig& c) {
+  cfg = c;
+  std::string err;
+  try {
+    cfg.validate();
+  } catch (const Error& e) {
+    err = e.what();
+  }
+  agree(err);
+  nx = cfg.grid.nx;
+  ny = cfg.grid.ny;
+  nz = cfg.grid.nz;
+  h = cfg.grid.h;
+  npml = cfg.boundary.pml_cells;
+  free_surface = cfg.boundary.free_surface;
+  agree(nz / size >= 2 ? "" : "grid nz = " + std::to_string(nz) + " is too small for " + std::to_string(size) +
+                                  " ranks: every rank needs at least 2 z planes");
+  kb = int((long long)nz * rank / size);
+  ke = int((long long)nz * (rank + 1) / size);
+  nzl = ke - kb;
+  sy = nx + 2 * G;
+  sz = sy * (ny + 2 * G);
+  N = std::size_t(sz) * (nzl + 2 * G);
+
+  MediumBlock mb;
+  try {
+    mb = sample_medium(cfg.medium, cfg.grid, kb, std::min(ke + 1, nz));
+  } catch (const Error& e) {
+    err = e.what();
+  }
+  agree(err);
+  const bool visco_local = mb.attenuating();
+  const bool visco = allreduce_max(visco_local ? 1.0 : 0.0) > 0;
+  L = visco ? cfg.attenuation.mechanisms : 0;
+  // Largest P velocity: unrelaxed when attenuating (that is what the CFL condition sees).
+  setup_materials(mb);  // also sets vpmax (global) and dt
+  setup_pml();
+  setup_sources();
+  setup_receivers();
+  const std::size_t reserve = std::size_t(cfg.steps / cfg.record_every + 2);
+  rec_time.reserve(reserve);
+  for (auto& r : rec)
+    for (auto& c3 : r) c3.reserve(reserve);
+  rowbuf.assign(std::size_t(omp_get_max_threads()), Vec(6 * std::size_t(nx)));
+}
+
+void Solver::Impl::setup_materials(const MediumBlock& mb) {
+  const double fdom = cfg.dominant_frequency();
+  double fmin = cfg.attenuation.fmin, fmax = cfg.attenuation.fmax;
+  if (fmin <= 0) fmin = fdom / 10;
+  if (fmax <= 0) fmax = fdom * 10;
+  const double fref = cfg.attenuation.fref > 0 ? cfg.attenuation.fref : fdom;
+  std::string err;
+  if (L > 0 && !(fmin > 0 && fmax > fmin))
+    err = "attenuation band [" + std::to_string(fmin) + ", " + std::to_string(fmax) + "] Hz is invalid";
+  agree(err);
+  std::map<float, ZenerFit> fits;
+  auto fit_for = [&](float q) -> const ZenerFit& {
+    auto it = fits.find(q);
+    if (it == fits.end()) it = fits.emplace(q, fit_constant_q(q, fmin, fmax, std::max(L, 1))).first;
+    return it->second;
+  };
+  // Unrelaxed moduli on the sampled planes [kb, kb + mb.nk).
+  const std::size_t nn = mb.rho.size();
+  std::vector<double> rho(nn), piU(nn), muU(nn);
+  std::vector<double> ya, yb;  // per node per mechanism: πU·Yα, μU·Yβ
+  if (L > 0) {
+    ya.resize(nn * L);
+    yb.resize(nn * L);
+  }
+  const double wref = 2 * std::numbers::pi * fref;
+  double vmax = 0;
+  for (std::size_t n = 0; n < nn; ++n) {
+    rho[n] = mb.rho[n];
+    double fa = 1, fb = 1;
+    if (L > 0) {
+      const ZenerFit& a = fit_for(mb.qp[n]);
+      const ZenerFit& b = fit_for(mb.qs[n]);
+      fa = a.unrelaxed_factor(wref);
+      fb = b.unrelaxed_factor(wref);
+      piU[n] = rho[n] * double(mb.vp[n]) * mb.vp[n] * fa;
+      muU[n] = rho[n] * double(mb.vs[n]) * mb.vs[n] * fb;
+      for (int l = 0; l < L; ++l) {
+        ya[n * L + l] = piU[n] * a.weight[l];
+        yb[n * L + l] = muU[n] * b.weight[l];
+      }
+    } else {
+      piU[n] = rho[n] * double(mb.vp[n]) * mb.vp[n];
+      muU[n] = rho[n] * double(mb.vs[n]) * mb.vs[n];
+    }
+    vmax = std::max(vmax, std::sqrt(piU[n] / rho[n]));
+  }
+  vpmax = allreduce_max(vmax);
+  const double dtmax = stable_time_step(h, vpmax);
+  if (cfg.dt > 0) {
+    if (cfg.dt > dtmax * (1 + 1e-12)) {
+      std::ostringstream s;
+      s << "time step dt = " << cfg.dt << " s violates the CFL stability condition: the largest stable time step is "
+        << dtmax << " s (h = " << h << " m, max unrelaxed Vp = " << vpmax << " m/s, limit Vp*dt/h <= "
+        << 1.0 / (std::sqrt(3.0) * (9.0 / 8.0 + 1.0 / 24.0)) << ")";
+      err = s.str();
+    }
+    dt = cfg.dt;
+  } else {
+    dt = cfg.courant * dtmax;
+  }
+  agree(err);
+
+  const int mx = mb.nx, my = mb.ny, mk = mb.nk;
+  auto m = [&](int i, int j, int k) {  // clamped node index into the sampled block (global k)
+    i = std::clamp(i, 0, mx - 1);
+    j = std::clamp(j, 0, my - 1);
+    k = std::clamp(k, kb, kb + mk - 1);
+    return mb.index(i, j, k);
+  };
+  for (Vec* v : {&vx, &vy, &vz, &sxx, &syy, &szz, &sxy, &sxz, &syz, &bx, &by, &bz, &lam, &twomu, &muxy, &muxz, &muyz})
+    v->assign(N, 0.0f);
+  const double s = dt / h;
+  auto harm4 = [&](std::size_t a, std::size_t b, std::size_t c, std::size_t d) {
+    return 4.0 / (1.0 / muU[a] + 1.0 / muU[b] + 1.0 / muU[c] + 1.0 / muU[d]);
+  };
+  if (L > 0) {
+    relax_a.resize(L);
+    relax_b.resize(L);
+    const ZenerFit& any = fit_for(std::numeric_limits<float>::infinity());
+    for (int l = 0; l < L; ++l) {
+      const double wdt = any.omega[l] * dt;
+      relax_a[l] = float((1 - wdt / 2) / (1 + wdt / 2));
+      relax_b[l] = float(wdt / (1 + wdt / 2));
+    }
+    for (auto* v : {&rxx, &ryy, &rzz, &rxy, &rxz, &ryz, &cl, &cm, &cmxy, &cmxz, &cmyz}) v->assign(L, Vec(N, 0.0f));
+  }
+  for (int k = kb; k < ke; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t n = idx(i, j, k - kb);
+        const auto c = m(i, j, k);
+        bx[n] = float(s / (0.5 * (rho[c] + rho[m(i + 1, j, k)])));
+        by[n] = float(s / (0.5 * (rho[c] + rho[m(i, j + 1, k)])));
+        bz[n] = float(s / (0.5 * (rho[c] + rho[m(i, j, k + 1)])));
+        lam[n] = float(s * (piU[c] - 2 * muU[c]));
+        twomu[n] = float(s * 2 * muU[c]);
+        const auto cxy = {c, m(i + 1, j, k), m(i, j + 1, k), m(i + 1, j + 1, k)};
+        const auto cxz = {c, m(i + 1, j, k), m(i, j, k + 1), m(i + 1, j, k + 1)};
+        const auto cyz = {c, m(i, j + 1, k), m(i, j, k + 1), m(i, j + 1, k + 1)};
+        auto h4 = [&](std::initializer_list<std::size_t> q) {
+          auto it = q.begin();
+          return harm4(it[0], it[1], it[2], it[3]);
+        };
+        muxy[n] = float(s * h4(cxy));
+        muxz[n] = float(s * h4(cxz));
+        muyz[n] = float(s * h4(cyz));
+        for (int l = 0; l < L; ++l) {
+          cl[l][n] = float(s * (ya[c * L + l] - 2 * yb[c * L + l]));
+          cm[l][n] = float(s * 2 * yb[c * L + l]);
+          auto avg = [&](std::initializer_list<std::size_t> q) {
+            double t = 0;
+            for (auto x : q) t += yb[x * L + l];
+            return s * t / 4;
+          };
+          cmxy[l][n] = float(avg(cxy));
+          cmxz[l][n] = float(avg(cxz));
+          cmyz[l][n] = float(avg(cyz));
+        }
+      }
+}
+
+void Solver::Impl::setup_pml() {
+  const double Lw = std::max(npml, 1) * h;
+  const double d0 = -3.0 * vpmax * std::log(cfg.boundary.pml_reflection) / (2.0 * Lw);  // N = 2
+  const double fa = cfg.boundary.pml_frequency > 0 ? cfg.boundary.pml_frequency : cfg.dominant_frequency();
+  const double amax = std::numbers::pi * fa;
+  // depth (0..1+) into the absorbing layer of the position x [in nodes] along an axis of n nodes.
+  auto coef = [&](double x, int n, bool low, bool high, float& a, float& b) {
+    double r = 0;
+    if (low && x < npml) r = (npml - x) / std::max(npml, 1);
+    if (high && x > n - 1 - npml) r = (x - (n - 1 - npml)) / std::max(npml, 1);
+    const double d = d0 * r * r;
+    const double al = amax * std::max(0.0, 1.0 - r);
+    b = float(std::exp(-(d + al) * dt));
+    a = (d + al) > 0 ? float(d * (double(b) - 1.0) / (d + al)) : 0.0f;
+  };
+  auto build = [&](PmlAxis& p, int n, int offset, int count, bool low, bool high) {
+    p.slot.assign(count, -1);
+    p.a_full.assign(count, 0);
+    p.b_full.assign(count, 1);
+    p.a_half.assign(count, 0);
+    p.b_half.assign(count, 1);
+    if (npml == 0) return;
+    for (int l = 0; l < count; ++l) {
+      const int g = l + offset;
+      const bool in = (low && g < npml) || (high && g >= n - npml - 1);
+      if (!in) continue;
+      p.slot[l] = int(p.indices.size());
+      p.indices.push_back(l);
+      coef(g, n, low, high, p.a_full[l], p.b_full[l]);
+      coef(g + 0.5, n, low, high, p.a_half[l], p.b_half[l]);
+    }
+  };
+  build(pmlx, nx, 0, nx, true, true);
+  build(pmly, ny, 0, ny, true, true);
+  build(pmlz, nz, kb, nzl, !free_surface, true);
+  for (auto& v : psix) v.assign(std::size_t(pmlx.count()) * ny * nzl, 0.0f);
+  for (auto& v : psiy) v.assign(std::size_t(pmly.count()) * nx * nzl, 0.0f);
+  for (auto& v : psiz) v.assign(std::size_t(pmlz.count()) * nx * ny, 0.0f);
+}
+
+void Solver::Impl::setup_sources() {
+  sources = cfg.sources;
+  // Trilinear spreading onto each staggered grid; weights at ghost planes above a free surface are
+  // dropped and the rest renormalised (total moment / force kept).
+  auto spread = [&](const std::array<double, 3>& p, std::array<double, 3> st, Vec& field, double amp, int src,
+                    std::vector<Injection>& out) {
+    const double gx = p[0] / h - st[0], gy = p[1] / h - st[1], gz = p[2] / h - st[2];
+    const int i0 = int(std::floor(gx)), j0 = int(std::floor(gy)), k0 = int(std::floor(gz));
+    const double fx = gx - i0, fy = gy - j0, fz = gz - k0;
+    double kept = 0;
+    struct P { int i, j, k; double w; };
+    std::vector<P> pts;
+    for (int c = 0; c < 8; ++c) {
+      const int i = i0 + (c & 1), j = j0 + ((c >> 1) & 1), k = k0 + ((c >> 2) & 1);
+      const double w = ((c & 1) ? fx : 1 - fx) * (((c >> 1) & 1) ? fy : 1 - fy) * (((c >> 2) & 1) ? fz : 1 - fz);
+      if (w == 0) continue;
+      if (k < 0 || k >= nz || i < 0 || i >= nx || j < 0 || j >= ny) continue;
+      kept += w;
+      pts.push_back({i, j, k, w});
+    }
+    for (const auto& q : pts)
+      if (q.k >= kb && q.k < ke)
+        out.push_back({field.data(), idx(q.i, q.j, q.k - kb), q.k - kb, amp * q.w / kept, src});
+  };
+  const double h3 = h * h * h;
+  for (int s = 0; s < int(sources.size()); ++s) {
+    const auto& S = sources[s];
+    if (S.kind == SourceSpec::Kind::moment) {
+      // σ_ij −= dt·Ṁ_ij(t)·δ_h: amplitude dt·M_ij/h³ times the rate of S.
+      const auto& M = S.moment;
+      const double a = dt / h3;
+      spread(S.position, {0, 0, 0}, sxx, -a * M[0], s, stress_inj);
+      spread(S.position, {0, 0, 0}, syy, -a * M[1], s, stress_inj);
+      spread(S.position, {0, 0, 0}, szz, -a * M[2], s, stress_inj);
+      spread(S.position, {0.5, 0.5, 0}, sxy, -a * M[3], s, stress_inj);
+      spread(S.position, {0.5, 0, 0.5}, sxz, -a * M[4], s, stress_inj);
+      spread(S.position, {0, 0.5, 0.5}, syz, -a * M[5], s, stress_inj);
+    } else {
+      // v += dt·F·S(t)/(ρ h³) = F·S(t)·b/h² with b = dt/(ρ h) the stored buoyancy.
+      spread(S.position, {0.5, 0, 0}, vx, S.force[0] / (h * h), s, force_inj);
+      spread(S.position, {0, 0.5, 0}, vy, S.force[1] / (h * h), s, force_inj);
+      spread(S.position, {0, 0, 0.5}, vz, S.force[2] / (h * h), s, force_inj);
+    }
+  }
+  std::erase_if(stress_inj, [](const Injection& q) { return q.weight == 0; });
+  std::erase_if(force_inj, [](const Injection& q) { return q.weight == 0; });
+}
+
+void Solver::Impl::setup_receivers() {
+  recv.resize(cfg.receivers.size());
+  rec.resize(cfg.receivers.size());
+  const std::array<std::array<double, 3>, 3> st = {{{0.5, 0, 0}, {0, 0.5, 0}, {0, 0, 0.5}}};
+  for (std::size_t r = 0; r < cfg.receivers.size(); ++r) {
+    const auto& p = cfg.receivers[r].position;
+    for (int c = 0; c < 3; ++c) {
+      double g[3];
+      int lo[3];
+      const int dims[3] = {nx, ny, nz};
+      for (int a = 0; a < 3; ++a) {
+        g[a] = p[a] / h - st[c][a];
+        lo[a] = int(std::floor(g[a]));
+        // Below the first node of a staggered grid (at a free surface): take the first node.
+        if (lo[a] < 0) {
+          lo[a] = 0;
+          g[a] = 0;
+        }
+        if (lo[a] > dims[a] - 2) {
+          lo[a] = dims[a] - 2;
+          g[a] = lo[a] + 1;
+        }
+      }
+      ReceiverComp& rc = recv[r][c];
+      rc.owned = lo[2] >= kb && lo[2] < ke;
+      if (!rc.owned) continue;
+      for (int q = 0; q < 8; ++q) {
+        const int i = lo[0] + (q & 1), j = lo[1] + ((q >> 1) & 1), k = lo[2] + ((q >> 2) & 1);
+        const double fx = g[0] - lo[0], fy = g[1] - lo[1], fz = g[2] - lo[2];
+        rc.w[q] = ((q & 1) ? fx : 1 - fx) * (((q >> 1) & 1) ? fy : 1 - fy) * (((q >> 2) & 1) ? fz : 1 - fz);
+        rc.n[q] = idx(i, j, k - kb);  // k − kb may be nzl (halo plane)
+      }
+    }
+  }
+}
+
+// ==================================================================== kernels
+
+void Solver::Impl::velocity_planes(int k0, int k1, double t) {
+  if (k0 >= k1) return;
+  const long Y = sy, Z = sz;
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int k = k0; k < k1; ++k)
+    for (int j = 0; j < ny; ++j) {
+      const std::size_t b = idx(0, j, k);
+      float* __restrict ux = vx.data() + b;
+      float* __restrict uy = vy.data() + b;
+      float* __restrict uz = vz.data() + b;
+      const float* __restrict xx = sxx.data() + b;
+      const float* __restrict yy = syy.data() + b;
+      const float* __restrict zz = szz.data() + b;
+      const float* __restrict xy = sxy.data() + b;
+      const float* __restrict xz = sxz.data() + b;
+      const float* __restrict yz = syz.data() + b;
+      const float* __restrict px = bx.data() + b;
+      const float* __restrict py = by.data() + b;
+      const float* __restrict pz = bz.data() + b;
+#pragma omp simd
+      for (int i = 0; i < nx; ++i) {
+        ux[i] += px[i] * (C1 * (xx[i + 1] - xx[i]) + C2 * (xx[i + 2] - xx[i - 1]) + C1 * (xy[i] - xy[i - Y]) +
+                          C2 * (xy[i + Y] - xy[i - 2 * Y]) + C1 * (xz[i] - xz[i - Z]) + C2 * (xz[i + Z] - xz[i - 2 * Z]));
+        uy[i] += py[i] * (C1 * (xy[i] - xy[i - 1]) + C2 * (xy[i + 1] - xy[i - 2]) + C1 * (yy[i + Y] - yy[i]) +
+                          C2 * (yy[i + 2 * Y] - yy[i - Y]) + C1 * (yz[i] - yz[i - Z]) + C2 * (yz[i + Z] - yz[i - 2 * Z]));
+        uz[i] += pz[i] * (C1 * (xz[i] - xz[i - 1]) + C2 * (xz[i + 1] - xz[i - 2]) + C1 * (yz[i] - yz[i - Y]) +
+                          C2 * (yz[i + Y] - yz[i - 2 * Y]) + C1 * (zz[i + Z] - zz[i]) + C2 * (zz[i + 2 * Z] - zz[i - Z]));
+      }
+    }
+  pml_velocity(k0, k1);
+  for (const auto& q : force_inj)
+    if (q.k >= k0 && q.k < k1) {
+      const Vec& b = q.field == vx.data() ? bx : q.field == vy.data() ? by : bz;
+      q.field[q.n] += float(q.weight * sources[q.source].stf.value(t) * b[q.n]);
+    }
+}
+
+// Strain-rate differences (times h) at node / edge positions of plane k. Z selects the z stencil:
+// 0 interior, 1 the free-surface plane (ezz from σzz = 0; 2nd-order ∂z for the edges at z = h/2),
+// 2 the plane below it (2nd-order ∂z vz: vz above the surface is not a model value).
+#define PANOPTES_STRAIN(Zm)                                                                                       \
+  const float exx = C1 * (ux[i] - ux[i - 1]) + C2 * (ux[i + 1] - ux[i - 2]);                                       \
+  const float eyy = C1 * (uy[i] - uy[i - Y]) + C2 * (uy[i + Y] - uy[i - 2 * Y]);                                   \
+  float ezz;                                                                                                       \
+  if constexpr (Zm == 0) ezz = C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]);                         \
+  else if constexpr (Zm == 1) ezz = -pl[i] / (pl[i] + pm[i]) * (exx + eyy);                                        \
+  else ezz = uz[i] - uz[i - Z];                                                                                    \
+  const float exy = C1 * (ux[i + Y] - ux[i]) + C2 * (ux[i + 2 * Y] - ux[i - Y]) + C1 * (uy[i + 1] - uy[i]) +        \
+                    C2 * (uy[i + 2] - uy[i - 1]);                                                                  \
+  float exz, eyz;                                                                                                  \
+  if constexpr (Zm == 1) {                                                                                         \
+    exz = (ux[i + Z] - ux[i]) + C1 * (uz[i + 1] - uz[i]) + C2 * (uz[i + 2] - uz[i - 1]);                           \
+    eyz = (uy[i + Z] - uy[i]) + C1 * (uz[i + Y] - uz[i]) + C2 * (uz[i + 2 * Y] - uz[i - Y]);                       \
+  } else {                                                                                                         \
+    exz = C1 * (ux[i + Z] - ux[i]) + C2 * (ux[i + 2 * Z] - ux[i - Z]) + C1 * (uz[i + 1] - uz[i]) +                  \
+          C2 * (uz[i + 2] - uz[i - 1]);                                                                            \
+    eyz = C1 * (uy[i + Z] - uy[i]) + C2 * (uy[i + 2 * Z] - uy[i - Z]) + C1 * (uz[i + Y] - uz[i]) +                  \
+          C2 * (uz[i + 2 * Y] - uz[i - Y]);                                                                        \
+  }                                                                                                                \
+  const float th = exx + eyy + ezz;
+
+#define PANOPTES_ROW_POINTERS                         \
+  const std::size_t b = idx(0, j, k);                 \
+  const float* __restrict ux = vx.data() + b;         \
+  const float* __restrict uy = vy.data() + b;         \
+  const float* __restrict uz = vz.data() + b;         \
+  float* __restrict xx = sxx.data() + b;              \
+  float* __restrict yy = syy.data() + b;              \
+  float* __restrict zz = szz.data() + b;              \
+  float* __restrict xy = sxy.data() + b;              \
+  float* __restrict xz = sxz.data() + b;              \
+  float* __restrict yz = syz.data() + b;              \
+  const float* __restrict pl = lam.data() + b;        \
+  const float* __restrict pm = twomu.data() + b;      \
+  const float* __restrict mxy = muxy.data() + b;      \
+  const float* __restrict mxz = muxz.data() + b;      \
+  const float* __restrict myz = muyz.data() + b;      \
+  const long Y = sy, Z = sz;
+
+template <int Zm>
+void Solver::Impl::stress_plane_elastic(int k) {
+#pragma omp for schedule(static)
+  for (int j = 0; j < ny; ++j) {
+    PANOPTES_ROW_POINTERS
+#pragma omp simd
+    for (int i = 0; i < nx; ++i) {
+      PANOPTES_STRAIN(Zm)
+      xx[i] += pl[i] * th + pm[i] * exx;
+      yy[i] += pl[i] * th + pm[i] * eyy;
+      zz[i] += pl[i] * th + pm[i] * ezz;
+      xy[i] += mxy[i] * exy;
+      xz[i] += mxz[i] * exz;
+      yz[i] += myz[i] * eyz;
+    }
+  }
+}
+
+template <int Zm>
+void Solver::Impl::stress_plane_visco(int k) {
+  float* rows = rowbuf[std::size_t(omp_get_thread_num())].data();
+  float* __restrict rxx_ = rows;
+  float* __restrict ryy_ = rows + nx;
+  float* __restrict rzz_ = rows + 2 * nx;
+  float* __restrict rxy_ = rows + 3 * nx;
+  float* __restrict rxz_ = rows + 4 * nx;
+  float* __restrict ryz_ = rows + 5 * nx;
+#pragma omp for schedule(static)
+  for (int j = 0; j < ny; ++j) {
+    PANOPTES_ROW_POINTERS
+#pragma omp simd
+    for (int i = 0; i < nx; ++i) {
+      PANOPTES_STRAIN(Zm)
+      xx[i] += pl[i] * th + pm[i] * exx;
+      yy[i] += pl[i] * th + pm[i] * eyy;
+      zz[i] += pl[i] * th + pm[i] * ezz;
+      xy[i] += mxy[i] * exy;
+      xz[i] += mxz[i] * exz;
+      yz[i] += myz[i] * eyz;
+      rxx_[i] = exx;
+      ryy_[i] = eyy;
+      rzz_[i] = ezz;
+      rxy_[i] = exy;
+      rxz_[i] = exz;
+      ryz_[i] = eyz;
+    }
+    for (int l = 0; l < L; ++l) {
+      const float A = relax_a[l], B = relax_b[l];
+      float* __restrict mx = rxx[l].data() + b;
+      float* __restrict my = ryy[l].data() + b;
+      float* __restrict mz = rzz[l].data() + b;
+      float* __restrict mxy_ = rxy[l].data() + b;
+      float* __restrict mxz_ = rxz[l].data() + b;
+      float* __restrict myz_ = ryz[l].data() + b;
+      const float* __restrict cl_ = cl[l].data() + b;
+      const float* __restrict cm_ = cm[l].data() + b;
+      const float* __restrict cxy = cmxy[l].data() + b;
+      const float* __restrict cxz = cmxz[l].data() + b;
+      const float* __restrict cyz = cmyz[l].data() + b;
+#pragma omp simd
+      for (int i = 0; i < nx; ++i) {
+        const float th = rxx_[i] + ryy_[i] + rzz_[i];
+        float o, n;
+        o = mx[i]; n = A * o + B * (cl_[i] * th + cm_[i] * rxx_[i]); mx[i] = n; xx[i] -= 0.5f * (o + n);
+        o = my[i]; n = A * o + B * (cl_[i] * th + cm_[i] * ryy_[i]); my[i] = n; yy[i] -= 0.5f * (o + n);
+        o = mz[i]; n = A * o + B * (cl_[i] * th + cm_[i] * rzz_[i]); mz[i] = n; zz[i] -= 0.5f * (o + n);
+        o = mxy_[i]; n = A * o + B * (cxy[i] * rxy_[i]); mxy_[i] = n; xy[i] -= 0.5f * (o + n);
+        o = mxz_[i]; n = A * o + B * (cxz[i] * rxz_[i]); mxz_[i] = n; xz[i] -= 0.5f * (o + n);
+        o = myz_[i]; n = A * o + B * (cyz[i] * ryz_[i]); myz_[i] = n; yz[i] -= 0.5f * (o + n);
+      }
+    }
+  }
+}
+
+void Solver::Impl::stress_planes(int k0, int k1, double t) {
+  if (k0 >= k1) return;
+#pragma omp parallel
+  for (int k = k0; k < k1; ++k) {
+    const int g = k + kb;
+    const int zm = !free_surface ? 0 : g == 0 ? 1 : g == 1 ? 2 : 0;
+    if (L == 0) {
+      if (zm == 0) stress_plane_elastic<0>(k);
+      else if (zm == 1) stress_plane_elastic<1>(k);
+      else stress_plane_elastic<2>(k);
+    } else {
+      if (zm == 0) stress_plane_visco<0>(k);
+      else if (zm == 1) stress_plane_visco<1>(k);
+      else stress_plane_visco<2>(k);
+    }
+  }
+  pml_stress(k0, k1);
+  for (const auto& q : stress_inj)
+    if (q.k >= k0 && q.k < k1) q.field[q.n] += float(q.weight * sources[q.source].stf.rate(t));
+  if (free_surface && kb == 0 && k0 == 0) {
+    float* zz = szz.data() + idx(0, 0, 0);
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) zz[i + j * sy] = 0.0f;
+  }
+}
+
+// CPML: ψ ← b·ψ + a·∂f and f += coefficient·ψ, applied after the plain update (κ = 1), over the
+// layers of each axis only. The interior loops above stay branch-free.
+void Solver::Impl::pml_velocity(int k0, int k1) {
+  const long Y = sy, Z = sz;
+  const int cx = pmlx.count(), cy = pmly.count();
+  if (cx > 0) {
+#pragma omp parallel for collapse(2) schedule(static)
+    for (int k = k0; k < k1; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int s = 0; s < cx; ++s) {
+          const int i = pmlx.indices[s];
+          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * ny + j) * cx + s;
+          const float* f = sxx.data() + n;
+          float& a = psix[0][p];
+          a = pmlx.b_half[i] * a + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
+          vx[n] += bx[n] * a;
+          f = sxy.data() + n;
+          float& b = psix[1][p];
+          b = pmlx.b_full[i] * b + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
+          vy[n] += by[n] * b;
+          f = sxz.data() + n;
+          float& c = psix[2][p];
+          c = pmlx.b_full[i] * c + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
+          vz[n] += bz[n] * c;
+        }
+  }
+  if (cy > 0) {
+#pragma omp parallel for collapse(2) schedule(static)
+    for (int k = k0; k < k1; ++k)
+      for (int s = 0; s < cy; ++s) {
+        const int j = pmly.indices[s];
+        for (int i = 0; i < nx; ++i) {
+          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * cy + s) * nx + i;
+          const float* f = sxy.data() + n;
+          float& a = psiy[0][p];
+          a = pmly.b_full[j] * a + pmly.a_full[j] * (C1 * (f[0] - f[-Y]) + C2 * (f[Y] - f[-2 * Y]));
+          vx[n] += bx[n] * a;
+          f = syy.data() + n;
+          float& b = psiy[1][p];
+          b = pmly.b_half[j] * b + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
+          vy[n] += by[n] * b;
+          f = syz.data() + n;
+          float& c = psiy[2][p];
+          c = pmly.b_full[j] * c + pmly.a_full[j] * (C1 * (f[0] - f[-Y]) + C2 * (f[Y] - f[-2 * Y]));
+          vz[n] += bz[n] * c;
+        }
+      }
+  }
+  for (int k = k0; k < k1; ++k) {
+    const int s = pmlz.slot[k];
+    if (s < 0) continue;
+#pragma omp parallel for schedule(static)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t n = idx(i, j, k), p = (std::size_t(s) * ny + j) * nx + i;
+        const float* f = sxz.data() + n;
+        float& a = psiz[0][p];
+        a = pmlz.b_full[k] * a + pmlz.a_full[k] * (C1 * (f[0] - f[-Z]) + C2 * (f[Z] - f[-2 * Z]));
+        vx[n] += bx[n] * a;
+        f = syz.data() + n;
+        float& b = psiz[1][p];
+        b = pmlz.b_full[k] * b + pmlz.a_full[k] * (C1 * (f[0] - f[-Z]) + C2 * (f[Z] - f[-2 * Z]));
+        vy[n] += by[n] * b;
+        f = szz.data() + n;
+        float& c = psiz[2][p];
+        c = pmlz.b_half[k] * c + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
+        vz[n] += bz[n] * c;
+      }
+  }
+}
+
+void Solver::Impl::pml_stress(int k0, int k1) {
+  const long Y = sy, Z = sz;
+  const int cx = pmlx.count(), cy = pmly.count();
+  if (cx > 0) {
+#pragma omp parallel for collapse(2) schedule(static)
+    for (int k = k0; k < k1; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int s = 0; s < cx; ++s) {
+          const int i = pmlx.indices[s];
+          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * ny + j) * cx + s;
+          const float* f = vx.data() + n;
+          float& a = psix[3][p];
+          a = pmlx.b_full[i] * a + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
+          sxx[n] += (lam[n] + twomu[n]) * a;
+          syy[n] += lam[n] * a;
+          szz[n] += lam[n] * a;
+          f = vy.data() + n;
+          float& b = psix[4][p];
+          b = pmlx.b_half[i] * b + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
+          sxy[n] += muxy[n] * b;
+          f = vz.data() + n;
+          float& c = psix[5][p];
+          c = pmlx.b_half[i] * c + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
+          sxz[n] += muxz[n] * c;
+        }
+  }
+  if (cy > 0) {
+#pragma omp parallel for collapse(2) schedule(static)
+    for (int k = k0; k < k1; ++k)
+      for (int s = 0; s < cy; ++s) {
+        const int j = pmly.indices[s];
+        for (int i = 0; i < nx; ++i) {
+          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * cy + s) * nx + i;
+          const float* f = vy.data() + n;
+          float& a = psiy[3][p];
+          a = pmly.b_full[j] * a + pmly.a_full[j] * (C1 * (f[0] - f[-Y]) + C2 * (f[Y] - f[-2 * Y]));
+          syy[n] += (lam[n] + twomu[n]) * a;
+          sxx[n] += lam[n] * a;
+          szz[n] += lam[n] * a;
+          f = vx.data() + n;
+          float& b = psiy[4][p];
+          b = pmly.b_half[j] * b + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
+          sxy[n] += muxy[n] * b;
+          f = vz.data() + n;
+          float& c = psiy[5][p];
+          c = pmly.b_half[j] * c + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
+          syz[n] += muyz[n] * c;
+        }
+      }
+  }
+  for (int k = k0; k < k1; ++k) {
+    const int s = pmlz.slot[k];
+    if (s < 0) continue;
+#pragma omp parallel for schedule(static)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t n = idx(i, j, k), p = (std::size_t(s) * ny + j) * nx + i;
+        const float* f = vz.data() + n;
+        float& a = psiz[3][p];
+        a = pmlz.b_full[k] * a + pmlz.a_full[k] * (C1 * (f[0] - f[-Z]) + C2 * (f[Z] - f[-2 * Z]));
+        szz[n] += (lam[n] + twomu[n]) * a;
+        sxx[n] += lam[n] * a;
+        syy[n] += lam[n] * a;
+        f = vx.data() + n;
+        float& b = psiz[4][p];
+        b = pmlz.b_half[k] * b + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
+        sxz[n] += muxz[n] * b;
+        f = vy.data() + n;
+        float& c = psiz[5][p];
+        c = pmlz.b_half[k] * c + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
+        syz[n] += muyz[n] * c;
+      }
+  }
+}
+
+// Stress imaging (Levander 1988): σzz is antisymmetric about the surface plane z = 0, as are σxz
+// and σyz about it (their planes sit at z = ±h/2, ±3h/2).
+void Solver::Impl::free_surface_images() {
+  if (!free_surface || kb != 0) return;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      szz[idx(i, j, -1)] = -szz[idx(i, j, 1)];
+      szz[idx(i, j, -2)] = -szz[idx(i, j, 2)];
+      sxz[idx(i, j, -1)] = -sxz[idx(i, j, 0)];
+      sxz[idx(i, j, -2)] = -sxz[idx(i, j, 1)];
+      syz[idx(i, j, -1)] = -syz[idx(i, j, 0)];
+      syz[idx(i, j, -2)] = -syz[idx(i, j, 1)];
+    }
+}
+
+// ==================================================================== communication
+
+void Solver::Impl::start_exchange(std::initializer_list<Vec*> fields) {
+#ifdef PANOPTES_HAVE_MPI
+  if (comm == MPI_COMM_NULL || size == 1) return;
+  reqs.clear();
+  const int up = rank - 1, down = rank + 1 < size ? rank + 1 : -1;
+  const int count = int(2 * sz);
+  int f = 0;
+  for (Vec* v : fields) {
+    float* d = v->data();
+    if (up >= 0) {
+      reqs.emplace_back();
+      MPI_Irecv(d + idx(-G, -G, -2), count, MPI_FLOAT, up, 2 * f + 1, comm, &reqs.back());
+      reqs.emplace_back();
+      MPI_Isend(d + idx(-G, -G, 0), count, MPI_FLOAT, up, 2 * f, comm, &reqs.back());
+    }
+    if (down >= 0) {
+      reqs.emplace_back();
+      MPI_Irecv(d + idx(-G, -G, nzl), count, MPI_FLOAT, down, 2 * f, comm, &reqs.back());
+      reqs.emplace_back();
+      MPI_Isend(d + idx(-G, -G, nzl - 2), count, MPI_FLOAT, down, 2 * f + 1, comm, &reqs.back());
+    }
+    ++f;
+  }
+#else
+  (void)fields;
+#endif
+}
+
+void Solver::Impl::finish_exchange() {
+#ifdef PANOPTES_HAVE_MPI
+  if (!reqs.empty()) MPI_Waitall(int(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
+  reqs.clear();
+#endif
+}
+
+// ==================================================================== stepping
+
+void Solver::Impl::step() {
+  const double tv = nsteps * dt;          // σ^n: body forces act at t_n
+  const double ts = (nsteps + 0.5) * dt;  // v^{n+½}: moment rates act at t_{n+½}
+  // Rank-boundary planes first, then their halos travel while the interior is updated.
+  const bool overlap = size > 1 && nzl >= 4;
+  if (overlap) {
+    velocity_planes(0, 2, tv);
+    velocity_planes(nzl - 2, nzl, tv);
+    start_exchange({&vx, &vy, &vz});
+    velocity_planes(2, nzl - 2, tv);
+  } else {
+    velocity_planes(0, nzl, tv);
+    start_exchange({&vx, &vy, &vz});
+  }
+  finish_exchange();
+  if (nsteps % cfg.record_every == 0) record();
+  if (overlap) {
+    stress_planes(0, 2, ts);
+    stress_planes(nzl - 2, nzl, ts);
+    start_exchange({&sxx, &syy, &szz, &sxy, &sxz, &syz});
+    stress_planes(2, nzl - 2, ts);
+  } else {
+    stress_planes(0, nzl, ts);
+    start_exchange({&sxx, &syy, &szz, &sxy, &sxz, &syz});
+  }
+  finish_exchange();
+  free_surface_images();
+  ++nsteps;
+}
+
+void Solver::Impl::record() {
+  rec_time.push_back((nsteps + 0.5) * dt);
+  const std::array<const Vec*, 3> f = {&vx, &vy, &vz};
+  for (std::size_t r = 0; r < recv.size(); ++r)
+    for (int c = 0; c < 3; ++c) {
+      const ReceiverComp& rc = recv[r][c];
+      double v = 0;
+      if (rc.owned)
+        for (int q = 0; q < 8; ++q) v += rc.w[q] * (*f[c])[rc.n[q]];
+      rec[r][c].push_back(v);
+    }
+}
+
+// ==================================================================== public API
+
+Solver::Solver(const SolverConfig& config) : impl_(std::make_unique<Impl>()) {
+#ifdef PANOPTES_HAVE_MPI
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) {
+    impl_->comm = MPI_COMM_WORLD;
+    MPI_Comm_rank(MPI_COMM_WORLD, &impl_->rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &impl_->size);
+  }
+#endif
+  impl_->init(config);
+}
+
+#ifdef PANOPTES_HAVE_MPI
+Solver::Solver(const SolverConfig& config, MPI_Comm comm) : impl_(std::make_unique<Impl>()) {
+  impl_->comm = comm;
+  MPI_Comm_rank(comm, &impl_->rank);
+  MPI_Comm_size(comm, &impl_->size);
+  impl_->init(config);
+}
+#endif
+
+Solver::~Solver() = default;
+
+void Solver::step() { impl_->step(); }
+void Solver::run(int n) {
+  for (int i = 0; i < n; ++i) impl_->step();
+}
+int Solver::steps_done() const { return impl_->nsteps; }
+double Solver::dt() const { return impl_->dt; }
+double Solver::velocity_time() const { return (impl_->nsteps - 0.5) * impl_->dt; }
+const SolverConfig& Solver::config() const { return impl_->cfg; }
+int Solver::rank() const { return impl_->rank; }
+int Solver::ranks() const { return impl_->size; }
+int Solver::k_begin() const { return impl_->kb; }
+int Solver::k_end() const { return impl_->ke; }
+bool Solver::viscoelastic() const { return impl_->L > 0; }
+double Solver::vp_max() const { return impl_->vpmax; }
+
+
+FieldView Solver::vx() const { return impl_->view(impl_->vx, {0.5, 0, 0}); }
+FieldView Solver::vy() const { return impl_->view(impl_->vy, {0, 0.5, 0}); }
+FieldView Solver::vz() const { return impl_->view(impl_->vz, {0, 0, 0.5}); }
+FieldView Solver::phi_p() const { return impl_->view(impl_->phip, {0, 0, 0}); }
+FieldView Solver::phi_s() const { return impl_->view(impl_->phis, {0, 0, 0}); }
+
+void Solver::compute_derived() {
+  Impl& s = *impl_;
+  if (s.phip.size() != s.N) {
+    s.phip.assign(s.N, 0.0f);
+    s.phis.assign(s.N, 0.0f);
+  }
+  const long Y = s.sy, Z = s.sz;
+  const float ih = float(1.0 / s.h);
+  const int nx = s.nx, ny = s.ny, nzl = s.nzl;
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int k = 0; k < nzl; ++k)
+    for (int j = 0; j < ny; ++j) {
+      const std::size_t b = s.idx(0, j, k);
+      const float* __restrict ux = s.vx.data() + b;
+      const float* __restrict uy = s.vy.data() + b;
+      const float* __restrict uz = s.vz.data() + b;
+      float* __restrict pp = s.phip.data() + b;
+      float* __restrict ps = s.phis.data() + b;
+      auto d = [](const float* f, long i, long st) {  // forward staggered derivative at i + ½·st
+        return C1 * (f[i + st] - f[i]) + C2 * (f[i + 2 * st] - f[i - st]);
+      };
+      for (int i = 0; i < nx; ++i) {
+        pp[i] = ih * (C1 * (ux[i] - ux[i - 1]) + C2 * (ux[i + 1] - ux[i - 2]) + C1 * (uy[i] - uy[i - Y]) +
+                      C2 * (uy[i + Y] - uy[i - 2 * Y]) + C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]));
+        // ωx = ∂y vz − ∂z vy on (0, ½, ½) edges, ωy = ∂z vx − ∂x vz on (½, 0, ½), ωz = ∂x vy − ∂y vx on (½, ½, 0);
+        // each averaged over the four edges around the node.
+        float wx = 0, wy = 0, wz = 0;
+        for (long a : {0L, -Y})
+          for (long c : {0L, -Z}) wx += d(uz, i + a + c, Y) - d(uy, i + a + c, Z);
+        for (long a : {0L, -1L})
+          for (long c : {0L, -Z}) wy += d(ux, i + a + c, Z) - d(uz, i + a + c, 1);
+        for (long a : {0L, -1L})
+          for (long c : {0L, -Y}) wz += d(uy, i + a + c, 1) - d(ux, i + a + c, Y);
+        ps[i] = 0.25f * ih * std::sqrt(wx * wx + wy * wy + wz * wz);
+      }
+    }
+}
+
+double Solver::energy() const {
+  const Impl& s = *impl_;
+  const int n = s.npml;
+  const int i0 = n, i1 = s.nx - n, j0 = n, j1 = s.ny - n;
+  const int g0 = s.free_surface ? 0 : n, g1 = s.nz - n;
+  const int k0 = std::max(g0, s.kb) - s.kb, k1 = std::min(g1, s.ke) - s.kb;
+  const double q = s.h / s.dt;  // stored coefficients are (dt/h)·modulus or (dt/h)/ρ
+  double e = 0;
+#pragma omp parallel for collapse(2) reduction(+ : e) schedule(static)
+  for (int k = k0; k < std::max(k0, k1); ++k)
+    for (int j = j0; j < j1; ++j)
+      for (int i = i0; i < i1; ++i) {
+        const std::size_t m = s.idx(i, j, k);
+        const double rx = 1.0 / (q * s.bx[m]), ry = 1.0 / (q * s.by[m]), rz = 1.0 / (q * s.bz[m]);
+        const double kin = 0.5 * (rx * s.vx[m] * s.vx[m] + ry * s.vy[m] * s.vy[m] + rz * s.vz[m] * s.vz[m]);
+        const double mu = 0.5 * q * s.twomu[m], la = q * s.lam[m];
+        const double tr = double(s.sxx[m]) + s.syy[m] + s.szz[m];
+        const double sq = double(s.sxx[m]) * s.sxx[m] + double(s.syy[m]) * s.syy[m] + double(s.szz[m]) * s.szz[m];
+        double w = sq / (4 * mu) - la * tr * tr / (4 * mu * (3 * la + 2 * mu));
+        w += double(s.sxy[m]) * s.sxy[m] / (2 * q * s.muxy[m]) + double(s.sxz[m]) * s.sxz[m] / (2 * q * s.muxz[m]) +
+             double(s.syz[m]) * s.syz[m] / (2 * q * s.muyz[m]);
+        e += kin + w;
+      }
+  return s.allreduce_sum(e * s.h * s.h * s.h);
+}
+
+std::vector<Seismogram> Solver::gather_seismograms() const {
+  const Impl& s = *impl_;
+  const std::size_t T = s.rec_time.size(), R = s.rec.size();
+  std::vector<double> buf(R * 3 * T);
+  for (std::size_t r = 0; r < R; ++r)
+    for (int c = 0; c < 3; ++c) std::copy(s.rec[r][c].begin(), s.rec[r][c].end(), buf.begin() + (r * 3 + c) * T);
+#ifdef PANOPTES_HAVE_MPI
+  // Exactly one rank owns each component; the others contribute zeros, so the sum is exact.
+  if (s.comm != MPI_COMM_NULL && s.size > 1) {
+    if (s.rank == 0)
+      MPI_Reduce(MPI_IN_PLACE, buf.data(), int(buf.size()), MPI_DOUBLE, MPI_SUM, 0, s.comm);
+    else
+      MPI_Reduce(buf.data(), nullptr, int(buf.size()), MPI_DOUBLE, MPI_SUM, 0, s.comm);
+  }
+#endif
+  std::vector<Seismogram> out;
+  if (s.rank != 0) return out;
+  for (std::size_t r = 0; r < R; ++r) {
+    Seismogram g;
+    g.name = s.cfg.receivers[r].name;
+    g.position = s.cfg.receivers[r].position;
+    g.time = s.rec_time;
+    g.vx.assign(buf.begin() + (r * 3 + 0) * T, buf.begin() + (r * 3 + 1) * T);
+    g.vy.assign(buf.begin() + (r * 3 + 1) * T, buf.begin() + (r * 3 + 2) * T);
+    g.vz.assign(buf.begin() + (r * 3 + 2) * T, buf.begin() + (r * 3 + 3) * T);
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
+void Solver::write_seismograms(const std::string& dir) const {
+  const auto all = gather_seismograms();
+  if (impl_->rank != 0) return;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw FileError(dir, "cannot create directory: " + ec.message());
+  for (const auto& g : all) {
+    const std::string path = dir + "/" + g.name + ".csv";
+    std::ofstream out(path);
+    if (!out) throw FileError(path, "cannot create file");
+    out << "time,vx,vy,vz\n";
+    out.precision(9);
+    for (std::size_t t = 0; t < g.time.size(); ++t)
+      out << g.time[t] << ',' << g.vx[t] << ',' << g.vy[t] << ',' << g.vz[t] << '\n';
+    if (!out) throw FileError(path, "write error");
+  }
+}
+
+std::size_t Solver::memory_bytes() const {
+  const Impl& s = *impl_;
+  std::size_t b = 17 * s.N * sizeof(float);
+  b += std::size_t(s.L) * 11 * s.N * sizeof(float);
+  for (const auto* p : {&s.psix, &s.psiy, &s.psiz})
+    for (const auto& v : *p) b += v.size() * sizeof(float);
+  b += s.phip.size() * 2 * sizeof(float);
+  return b;
+}
+
+}  // namespace panoptes::seismic
