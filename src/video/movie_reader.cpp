@@ -79,19 +79,97 @@ struct MovieReader::Impl {
     return int(it - frame_pts.begin());
   }
 
+  // Bytes of the file the demuxer may see. For an MP4 this is the file up to its last complete
+  // top-level box, plus a trailing mdat that was cut short (its complete samples are usable); a
+  // fragment header (moof) cut short would make FFmpeg refuse the whole file, so it is hidden.
+  std::int64_t view_size = 0;
+  std::int64_t view_pos = 0;
+
+  std::int64_t readable_prefix() const {
+    std::int64_t pos = 0;
+    std::uint8_t h[16];
+    while (pos < file_size) {
+      if (file_size - pos < 8) return pos;
+      if (::pread(fd, h, 16, pos) < 8) return pos;
+      std::uint64_t size = (std::uint64_t(h[0]) << 24) | (std::uint64_t(h[1]) << 16) | (std::uint64_t(h[2]) << 8) | h[3];
+      for (int i = 4; i < 8; ++i)
+        if (h[i] < 0x20 || h[i] > 0x7e) return pos == 0 ? file_size : pos;  // not an MP4 box: not MP4
+      const bool mdat = std::memcmp(h + 4, "mdat", 4) == 0;
+      if (size == 1) {
+        if (file_size - pos < 16) return pos;
+        size = 0;
+        for (int i = 8; i < 16; ++i) size = (size << 8) | h[i];
+        if (size < 16) return pos == 0 ? file_size : pos;
+      } else if (size == 0) {
+        return file_size;  // box extends to the end of the file
+      } else if (size < 8) {
+        return pos == 0 ? file_size : pos;
+      }
+      if (std::uint64_t(file_size - pos) < size) return mdat ? file_size : pos;
+      pos += std::int64_t(size);
+    }
+    return file_size;
+  }
+
+  static int io_read(void* opaque, std::uint8_t* buf, int n) {
+    auto* m = static_cast<Impl*>(opaque);
+    const std::int64_t left = m->view_size - m->view_pos;
+    if (left <= 0) return AVERROR_EOF;
+    for (;;) {
+      const ssize_t got = ::pread(m->fd, buf, std::size_t(std::min<std::int64_t>(n, left)), m->view_pos);
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0) return AVERROR(errno);
+      if (got == 0) return AVERROR_EOF;
+      m->view_pos += got;
+      return int(got);
+    }
+  }
+
+  static std::int64_t io_seek(void* opaque, std::int64_t offset, int whence) {
+    auto* m = static_cast<Impl*>(opaque);
+    switch (whence & ~AVSEEK_FORCE) {
+      case AVSEEK_SIZE: return m->view_size;
+      case SEEK_SET: m->view_pos = offset; break;
+      case SEEK_CUR: m->view_pos += offset; break;
+      case SEEK_END: m->view_pos = m->view_size + offset; break;
+      default: return AVERROR(EINVAL);
+    }
+    return m->view_pos;
+  }
+
   void build_index() {
+    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
     struct stat sb {};
-    if (::stat(path.c_str(), &sb) != 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
+    if (::fstat(fd, &sb) != 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
     if (S_ISDIR(sb.st_mode)) throw FileError(path, "is a directory, not a movie");
     file_size = sb.st_size;
+    if (file_size == 0) throw FileError(path, "not a readable movie (the file is empty)");
+    view_size = readable_prefix();
 
-    AVFormatContext* fmt = nullptr;
-    int ret = avformat_open_input(&fmt, path.c_str(), nullptr, nullptr);
-    if (ret < 0) throw FileError(path, "not a readable movie (" + av_error_string(ret) + ")");
+    constexpr int kIoBuffer = 1 << 15;
+    auto* io_buf = static_cast<std::uint8_t*>(av_malloc(kIoBuffer));
+    AVIOContext* io = io_buf ? avio_alloc_context(io_buf, kIoBuffer, 0, this, &io_read, nullptr, &io_seek) : nullptr;
+    AVFormatContext* fmt = io ? avformat_alloc_context() : nullptr;
+    if (!fmt) {
+      if (io) av_freep(&io->buffer);
+      else av_free(io_buf);
+      avio_context_free(&io);
+      throw Error("out of memory");
+    }
+    fmt->pb = io;
+    fmt->flags |= AVFMT_FLAG_CUSTOM_IO;
     struct Closer {
       AVFormatContext*& f;
-      ~Closer() { avformat_close_input(&f); }
-    } closer{fmt};
+      AVIOContext* io;
+      ~Closer() {
+        avformat_close_input(&f);  // does not free a custom AVIOContext
+        av_freep(&io->buffer);
+        avio_context_free(&io);
+      }
+    } closer{fmt, io};
+    int ret = avformat_open_input(&fmt, path.c_str(), nullptr, nullptr);
+    if (ret < 0) throw FileError(path, "not a readable movie (" + av_error_string(ret) + ")");
 
     const int si = av_find_best_stream(fmt, AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
     if (si < 0) throw FileError(path, "has no video stream");
@@ -117,7 +195,7 @@ struct MovieReader::Impl {
       if (ret < 0) break;  // end of file, or the truncated tail: keep what was complete
       if (p->stream_index == si) {
         const std::int64_t pts = p->pts != AV_NOPTS_VALUE ? p->pts : p->dts;
-        const bool complete = p->pos >= 0 && p->pos + p->size <= file_size && p->size > 0 &&
+        const bool complete = p->pos >= 0 && p->pos + p->size <= view_size && p->size > 0 &&
                               !(p->flags & AV_PKT_FLAG_CORRUPT) && pts != AV_NOPTS_VALUE;
         if (complete) {
           packets.push_back({p->pos, p->size, pts, p->dts, (p->flags & AV_PKT_FLAG_KEY) != 0});
@@ -135,7 +213,7 @@ struct MovieReader::Impl {
       const int n = avformat_index_get_entries_count(st);
       for (int i = 0; i < n; ++i) {
         const AVIndexEntry* e = avformat_index_get_entry(st, i);
-        if (!e || e->pos + e->size <= file_size) continue;
+        if (!e || e->pos + e->size <= view_size) continue;
         packets.erase(std::remove_if(packets.begin(), packets.end(),
                                      [&](const PacketInfo& pi) { return pi.pos == e->pos; }),
                       packets.end());
@@ -197,8 +275,6 @@ struct MovieReader::Impl {
     pkt = av_packet_alloc();
     if (!storage || !frame || !pkt) throw Error("out of memory");
 
-    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
     crop_width = coded_width;
     crop_height = coded_height;
   }
@@ -370,15 +446,19 @@ Image MovieReader::to_rgba(const YuvFrame& f) {
       f.u.size() < std::size_t(cw) * ch || f.v.size() < std::size_t(cw) * ch)
     throw Error("to_rgba: YUV frame planes do not match its size " + std::to_string(f.width) + "x" +
                 std::to_string(f.height));
-  // One converter per thread, reused while the size stays the same.
+  // The converter works on the even (coded) size: for odd sizes sws would otherwise stretch the
+  // ceil(w/2) chroma samples over w pixels and shift colours by up to half a pixel. Odd frames are
+  // padded by repeating the last luma column/row (chroma already covers the padded size).
+  const int ew = f.width + (f.width & 1), eh = f.height + (f.height & 1);
   struct Cache {
     SwsContext* ctx = nullptr;
+    std::vector<std::uint8_t> y, rgba;
     ~Cache() { sws_freeContext(ctx); }
   };
   thread_local Cache cache;
-  SwsContext* ctx = sws_getCachedContext(cache.ctx, f.width, f.height, AV_PIX_FMT_YUV420P, f.width, f.height,
-                                         AV_PIX_FMT_RGBA, SWS_BILINEAR | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT,
-                                         nullptr, nullptr, nullptr);
+  SwsContext* ctx = sws_getCachedContext(cache.ctx, ew, eh, AV_PIX_FMT_YUV420P, ew, eh, AV_PIX_FMT_RGBA,
+                                         SWS_LANCZOS | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT, nullptr, nullptr,
+                                         nullptr);
   if (!ctx) throw Error("to_rgba: cannot create the YUV to RGB converter");
   if (ctx != cache.ctx) {
     cache.ctx = ctx;
@@ -386,11 +466,27 @@ Image MovieReader::to_rgba(const YuvFrame& f) {
     sws_setColorspaceDetails(ctx, coeffs, 0, coeffs, 1, 0, 1 << 16, 1 << 16);
   }
   Image img(f.width, f.height, 4);
-  const std::uint8_t* src[3] = {f.y.data(), f.u.data(), f.v.data()};
-  const int src_stride[3] = {f.width, cw, cw};
-  std::uint8_t* dst[1] = {img.pixels.data()};
-  const int dst_stride[1] = {int(img.stride())};
-  sws_scale(ctx, src, src_stride, 0, f.height, dst, dst_stride);
+  const std::uint8_t* luma = f.y.data();
+  if (ew != f.width || eh != f.height) {
+    cache.y.resize(std::size_t(ew) * eh);
+    for (int y = 0; y < eh; ++y) {
+      const std::uint8_t* in = f.y.data() + std::size_t(std::min(y, f.height - 1)) * f.width;
+      std::uint8_t* out = cache.y.data() + std::size_t(y) * ew;
+      std::memcpy(out, in, f.width);
+      if (ew != f.width) out[f.width] = in[f.width - 1];
+    }
+    luma = cache.y.data();
+    cache.rgba.resize(std::size_t(ew) * eh * 4);
+  }
+  const std::uint8_t* src[3] = {luma, f.u.data(), f.v.data()};
+  const int src_stride[3] = {ew, cw, cw};
+  const bool padded = ew != f.width || eh != f.height;
+  std::uint8_t* dst[1] = {padded ? cache.rgba.data() : img.pixels.data()};
+  const int dst_stride[1] = {ew * 4};
+  sws_scale(ctx, src, src_stride, 0, eh, dst, dst_stride);
+  if (padded)
+    for (int y = 0; y < f.height; ++y)
+      std::memcpy(img.row(y), cache.rgba.data() + std::size_t(y) * ew * 4, img.stride());
   return img;
 }
 

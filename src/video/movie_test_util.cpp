@@ -24,17 +24,19 @@ Image make_test_frame(int width, int height, int index, int channels) {
       double r = 40 + 60 * u + 30 * std::sin(6.0 * v + t);
       double g = 30 + 80 * v + 25 * std::sin(5.0 * u - 0.7 * t);
       double b = 90 + 70 * (1 - u) * v + 20 * std::cos(4.0 * (u + v) + t);
-      const double dx = x - sx, dy = y - sy, d2 = dx * dx + dy * dy;
-      if (d2 < sr * sr) {  // Lambert-shaded sphere, light from the upper left
-        const double nz = std::sqrt(1 - d2 / (sr * sr));
+      // Silhouettes are anti-aliased over about one pixel, as a ray caster's are.
+      const double dx = x - sx, dy = y - sy, d = std::sqrt(dx * dx + dy * dy);
+      const double cover = std::clamp(sr - d + 0.5, 0.0, 1.0);
+      if (cover > 0) {  // Lambert-shaded sphere, light from the upper left
+        const double nz = std::sqrt(std::max(0.0, 1 - (d * d) / (sr * sr)));
         const double shade = std::max(0.0, (-dx / sr) * -0.4 + (-dy / sr) * -0.4 + nz * 0.8);
-        r = 220 * shade + 20;
-        g = 140 * shade + 15;
-        b = 60 * shade + 10;
+        r = (1 - cover) * r + cover * (220 * shade + 20);
+        g = (1 - cover) * g + cover * (140 * shade + 15);
+        b = (1 - cover) * b + cover * (60 * shade + 10);
       }
       const double ex = x - rx, ey = y - ry, e = std::sqrt(ex * ex + ey * ey);
-      if (e < r0 && e > r1) {  // a semi-transparent ring
-        const double a = 0.7;
+      const double a = 0.7 * std::clamp(r0 - e + 0.5, 0.0, 1.0) * std::clamp(e - r1 + 0.5, 0.0, 1.0);
+      if (a > 0) {  // a semi-transparent ring
         r = (1 - a) * r + a * 40;
         g = (1 - a) * g + a * 200;
         b = (1 - a) * b + a * 230;

@@ -35,23 +35,31 @@ struct MovieWriter::Impl {
   std::int64_t frames_in = 0;    // frames sent to the encoder
   std::int64_t packets_out = 0;  // packets handed to the muxer
   bool open = false;
-  bool encoder_finished = false;  // drained by flush(); a new encoder is opened on the next append
-  bool failed = false;            // a write failed: the file is no longer extended
+  bool failed = false;  // a write failed: the file is no longer extended
+  // Intra-only movies (gop 1) need no encoder state between frames, so the encoder, the YUV frame and
+  // the converter exist only during append(): an open writer then holds little more than the muxer.
+  // (An x264 encoder at 920x896 holds ~15-25 MB of reference, look-ahead and scratch frames.)
+  bool transient = false;
 
   ~Impl() { release(); }
 
+  // Frees the per-frame machinery (encoder, frame, converters); the muxer stays.
+  void release_encoder() {
+    avcodec_free_context(&enc);
+    av_frame_free(&frame);
+    sws_freeContext(sws_rgb);
+    sws_freeContext(sws_rgba);
+    sws_rgb = sws_rgba = nullptr;
+  }
+
   void release() {
+    release_encoder();
     if (fmt) {
       if (fmt->pb) avio_closep(&fmt->pb);
       avformat_free_context(fmt);
       fmt = nullptr;
     }
-    avcodec_free_context(&enc);
-    av_frame_free(&frame);
     av_packet_free(&pkt);
-    sws_freeContext(sws_rgb);
-    sws_freeContext(sws_rgba);
-    sws_rgb = sws_rgba = nullptr;
     open = false;
   }
 
@@ -92,15 +100,35 @@ struct MovieWriter::Impl {
 
     AVDictionary* opts = nullptr;
     av_dict_set(&opts, "preset", settings.preset.c_str(), 0);
-    av_dict_set(&opts, "crf", std::to_string(settings.crf).c_str(), 0);
+    // Intra-only movies get a fresh encoder per frame (see `transient`), and a fresh x264 in CRF mode
+    // has no rate history: it spends about twice the bits on its first frame. A constant quantizer
+    // equal to the CRF value gives every frame the quality a running CRF encoder settles at
+    // (measured: docs/formats.md), deterministically and independent of the frames before.
+    av_dict_set(&opts, settings.gop == 1 ? "qp" : "crf", std::to_string(settings.crf).c_str(), 0);
     // rc-lookahead=0 / sync-lookahead=0: no look-ahead queue (it both delays frames and costs a
     // full-size frame of memory per entry; it also turns off mb-tree). scenecut=0 keeps keyframes at
     // exact multiples of the GOP, so the worst-case random-access cost is known.
     av_dict_set(&opts, "x264-params", "rc-lookahead=0:sync-lookahead=0:scenecut=0:bframes=0", 0);
-    const int ret = avcodec_open2(enc, codec, &opts);
+    int ret = avcodec_open2(enc, codec, &opts);
     av_dict_free(&opts);
     if (ret < 0) throw Error("movie " + path + ": cannot open the libx264 encoder: " + av_error_string(ret));
-    encoder_finished = false;
+    if (stream) {
+      // A re-opened encoder must describe its stream exactly as the header already written does.
+      const AVCodecParameters* par = stream->codecpar;
+      if (par->extradata_size != enc->extradata_size ||
+          std::memcmp(par->extradata, enc->extradata, std::size_t(enc->extradata_size)) != 0)
+        throw Error("movie " + path + ": the re-opened encoder wrote different stream headers");
+    }
+
+    frame = av_frame_alloc();
+    if (!frame) throw Error("movie " + path + ": out of memory");
+    frame->format = AV_PIX_FMT_YUV420P;
+    frame->width = padded_width;
+    frame->height = padded_height;
+    frame->color_range = AVCOL_RANGE_MPEG;
+    frame->colorspace = AVCOL_SPC_SMPTE170M;
+    ret = av_frame_get_buffer(frame, 0);
+    if (ret < 0) throw Error("movie " + path + ": out of memory for a frame");
   }
 
   void start() {
@@ -126,16 +154,10 @@ struct MovieWriter::Impl {
     avio_flush(fmt->pb);
     check_io("cannot write the movie header");
 
-    frame = av_frame_alloc();
     pkt = av_packet_alloc();
-    if (!frame || !pkt) throw Error("movie " + path + ": out of memory");
-    frame->format = AV_PIX_FMT_YUV420P;
-    frame->width = padded_width;
-    frame->height = padded_height;
-    frame->color_range = AVCOL_RANGE_MPEG;
-    frame->colorspace = AVCOL_SPC_SMPTE170M;
-    ret = av_frame_get_buffer(frame, 0);
-    if (ret < 0) throw Error("movie " + path + ": out of memory for a frame");
+    if (!pkt) throw Error("movie " + path + ": out of memory");
+    transient = settings.gop == 1;
+    if (transient) release_encoder();
     open = true;
   }
 
@@ -156,11 +178,13 @@ struct MovieWriter::Impl {
     }
   }
 
+  // Drains the encoder's delayed frames (none with our settings) and frees it.
   void finish_encoder() {
+    if (!enc) return;
     int ret = avcodec_send_frame(enc, nullptr);
     if (ret < 0 && ret != AVERROR_EOF) throw Error("movie " + path + ": " + av_error_string(ret));
     drain_packets();
-    encoder_finished = true;
+    release_encoder();
   }
 
   SwsContext* converter(int channels) {
@@ -170,7 +194,7 @@ struct MovieWriter::Impl {
       // rendered images survive 4:2:0 better; the cost is small next to the encoder.
       ctx = sws_getContext(padded_width, padded_height, channels == 4 ? AV_PIX_FMT_RGBA : AV_PIX_FMT_RGB24,
                            padded_width, padded_height, AV_PIX_FMT_YUV420P,
-                           SWS_BILINEAR | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INP, nullptr, nullptr, nullptr);
+                           SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INP, nullptr, nullptr, nullptr);
       if (!ctx) throw Error("movie " + path + ": cannot create the RGB to YUV converter");
       // BT.601, full-range RGB in, limited-range YUV out: what the stream's colour tags say.
       const int* coeffs = sws_getCoefficients(SWS_CS_ITU601);
@@ -217,7 +241,7 @@ void MovieWriter::append(const Image& image) {
   if (image.pixels.size() < image.stride() * std::size_t(image.height))
     throw Error("movie " + m.path + ": frame pixel buffer is smaller than its size says");
   if (m.failed) throw FileError(m.path, "an earlier write failed; the movie ends at its last flushed frame");
-  if (m.encoder_finished) m.open_encoder();
+  if (!m.enc) m.open_encoder();
 
   const std::uint8_t* src = image.pixels.data();
   int src_stride = int(image.stride());
@@ -246,6 +270,12 @@ void MovieWriter::append(const Image& image) {
                            av_error_string(ret));
   ++m.frames_in;
   m.drain_packets();
+  if (m.transient) {
+    if (m.packets_out == m.frames_in)
+      m.release_encoder();  // nothing pending: the next frame is a keyframe from a fresh encoder
+    else
+      m.finish_encoder();
+  }
 }
 
 void MovieWriter::flush() {
@@ -270,7 +300,7 @@ void MovieWriter::close() {
   if (!m.open) return;
   try {
     if (!m.failed) {
-      if (!m.encoder_finished) m.finish_encoder();
+      m.finish_encoder();
       int ret = av_write_trailer(m.fmt);
       if (ret < 0) m.fail_write("cannot finish the movie", ret);
       avio_flush(m.fmt->pb);
