@@ -1,0 +1,160 @@
+#include "camera/rig_stats.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+namespace panoptes::camera {
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+// Angle from u to its nearest point other than `self` (π if none), by a growing cap.
+double nearest_other(const SphereIndex& index, const Vec3& u, int self) {
+  for (double r = 2 * index.spacing();; r *= 2) {
+    double best = -2;
+    index.for_each_within(u, r, [&](int id, const Vec3&, double c) {
+      if (id != self && c > best) best = c;
+    });
+    if (best > -2) {
+      const double a = std::acos(std::clamp(best, -1.0, 1.0));
+      if (a <= r || r >= kPi) return a;
+    }
+    if (r >= kPi) return kPi;
+  }
+}
+
+// The three points nearest to u (ids; -1 where fewer exist).
+std::array<int, 3> three_nearest(const SphereIndex& index, const Vec3& u) {
+  for (double r = 2 * index.spacing();; r *= 2) {
+    std::array<int, 3> id{-1, -1, -1};
+    std::array<double, 3> cs{-3, -3, -3};
+    index.for_each_within(u, r, [&](int k, const Vec3&, double c) {
+      for (int s = 0; s < 3; ++s)
+        if (c > cs[s]) {
+          for (int t = 2; t > s; --t) {
+            cs[t] = cs[t - 1];
+            id[t] = id[t - 1];
+          }
+          cs[s] = c;
+          id[s] = k;
+          break;
+        }
+    });
+    if (id[2] >= 0 || r >= kPi) return id;
+  }
+}
+
+}  // namespace
+
+std::vector<double> nearest_neighbour_angles(const SphereIndex& index) {
+  std::vector<double> out(index.size());
+  for (int k = 0; k < index.size(); ++k) out[k] = nearest_other(index, index.direction(k), k);
+  return out;
+}
+
+double covering_radius(const SphereIndex& index, int samples) {
+  const int n = index.size();
+  if (n == 0) return kPi;
+  if (samples <= 0) samples = int(std::clamp(100LL * n, 20000LL, 2000000LL));
+  const double golden_angle = kPi * (3.0 - std::sqrt(5.0));
+  std::vector<std::pair<double, int>> dist(samples);
+  auto sample = [&](int k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / samples, r = std::sqrt(std::max(0.0, 1 - z * z));
+    return Vec3{r * std::cos(golden_angle * k), r * std::sin(golden_angle * k), z};
+  };
+  for (int k = 0; k < samples; ++k) {
+    const Vec3 u = sample(k);
+    dist[k] = {angle_between(u, index.direction(index.nearest(u))), k};
+  }
+  const int top = std::min(samples, 64 + n / 4);
+  std::nth_element(dist.begin(), dist.begin() + (top - 1), dist.end(), std::greater<>());
+  double best = 0;
+  for (int k = 0; k < top; ++k) best = std::max(best, dist[k].first);
+  if (n < 3) return best;
+  for (int k = 0; k < top; ++k) {
+    const Vec3 u = sample(dist[k].second);
+    const auto t = three_nearest(index, u);
+    const Vec3 a = index.direction(t[0]), b = index.direction(t[1]), c = index.direction(t[2]);
+    Vec3 v = cross(b - a, c - a);
+    if (!(norm(v) > 1e-15)) continue;
+    v = normalize(v);
+    if (dot(v, u) < 0) v = -v;
+    const double radius = angle_between(v, a);
+    // A Voronoi vertex only if no point is closer than the three that define it.
+    const double nearest = angle_between(v, index.direction(index.nearest(v)));
+    if (nearest >= radius - 1e-12) best = std::max(best, radius);
+  }
+  return best;
+}
+
+int reachable_count(const NavigationGraph& graph, int start) {
+  const int n = graph.size();
+  if (start < 0 || start >= n) return 0;
+  std::vector<char> seen(n, 0);
+  std::vector<int> queue{start};
+  seen[start] = 1;
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const Neighbours& nb = graph.neighbours[queue[q]];
+    for (int j : {nb.right, nb.left, nb.up, nb.down, nb.in, nb.out})
+      if (j >= 0 && !seen[j]) {
+        seen[j] = 1;
+        queue.push_back(j);
+      }
+  }
+  return int(queue.size());
+}
+
+RigStatistics rig_statistics(const Rig& rig, const NavigationGraph& graph) {
+  RigStatistics st;
+  st.cameras = rig.size();
+  st.shells = rig.shell_count;
+  if (rig.size() == 0) return st;
+  const CameraLocator locator(rig);
+  st.min_nearest_deg = 180;
+  for (int s = 0; s < locator.shell_count(); ++s) {
+    const SphereIndex& index = locator.shell_index(s);
+    if (index.size() == 0) continue;
+    for (double a : nearest_neighbour_angles(index)) {
+      st.min_nearest_deg = std::min(st.min_nearest_deg, a / kDeg);
+      st.max_nearest_deg = std::max(st.max_nearest_deg, a / kDeg);
+    }
+    st.covering_deg = std::max(st.covering_deg, covering_radius(index) / kDeg);
+  }
+  int rl = 0, ud = 0, missing = 0;
+  for (int c = 0; c < graph.size(); ++c) {
+    const Neighbours& nb = graph.neighbours[c];
+    if (nb.right >= 0 && graph.neighbours[nb.right].left == c) ++rl;
+    if (nb.up >= 0 && graph.neighbours[nb.up].down == c) ++ud;
+    missing += (nb.right < 0) + (nb.left < 0) + (nb.up < 0) + (nb.down < 0);
+  }
+  st.right_left_return = double(rl) / graph.size();
+  st.up_down_return = double(ud) / graph.size();
+  st.missing_moves = double(missing) / (4.0 * graph.size());
+  st.reachable_from_0 = reachable_count(graph, 0);
+  // Strongly connected iff camera 0 reaches everyone and everyone reaches camera 0 (reverse graph).
+  if (st.reachable_from_0 == graph.size()) {
+    std::vector<std::vector<int>> in_edges(graph.size());
+    for (int c = 0; c < graph.size(); ++c) {
+      const Neighbours& nb = graph.neighbours[c];
+      for (int j : {nb.right, nb.left, nb.up, nb.down, nb.in, nb.out})
+        if (j >= 0) in_edges[j].push_back(c);
+    }
+    std::vector<char> seen(graph.size(), 0);
+    std::vector<int> queue{0};
+    seen[0] = 1;
+    for (std::size_t q = 0; q < queue.size(); ++q)
+      for (int j : in_edges[queue[q]])
+        if (!seen[j]) {
+          seen[j] = 1;
+          queue.push_back(j);
+        }
+    st.strongly_connected = int(queue.size()) == graph.size();
+  }
+  return st;
+}
+
+}  // namespace panoptes::camera
