@@ -97,42 +97,82 @@ struct ConeCandidates {
   }
 };
 
-// Pairs opposite moves (right/left, up/down) so that most moves are reversible: among the candidates
-// of camera i in cone `forward` that are within (1 + tolerance) of i's best score, and that have i
-// among their own near-best candidates in the opposite cone, pairs are taken greedily by the sum of
-// both scores. Cameras left unpaired take their plainly best candidate.
+// Pairs opposite moves (right/left, up/down) so that most moves are reversible. An edge i -> j exists
+// when j is among i's near-best candidates (score within 1 + tolerance of the best) in cone
+// `forward` and i is among j's near-best candidates in the opposite cone. Edges are matched greedily
+// by summed score, then short augmenting paths raise the number of matched (reversible) cameras —
+// in hexagon-like arrangements (Fibonacci) two candidates are equally good and a greedy choice
+// alone leaves many cameras unpaired. Unpaired cameras take their plainly best candidate.
 void match_axis(const std::vector<std::array<ConeCandidates, 4>>& cand, int forward, int backward, double tolerance,
                 std::vector<int>& fwd, std::vector<int>& bwd) {
   const int n = int(cand.size());
-  struct Pair {
+  struct Edge {
     float score;
     int i, j;
   };
-  std::vector<Pair> pairs;
+  std::vector<Edge> edges;
   auto near_best = [&](const ConeCandidates& c, int k) {
     return c.id[k] >= 0 && c.score[k] <= c.score[0] * (1.0 + tolerance);
   };
   for (int i = 0; i < n; ++i)
-    for (int k = 0; k < kCandidates; ++k) {
-      if (!near_best(cand[i][forward], k)) break;
+    for (int k = 0; k < kCandidates && near_best(cand[i][forward], k); ++k) {
       const int j = cand[i][forward].id[k];
       const ConeCandidates& back = cand[j][backward];
       for (int m = 0; m < kCandidates && near_best(back, m); ++m)
         if (back.id[m] == i) {
-          pairs.push_back({cand[i][forward].score[k] + back.score[m], i, j});
+          edges.push_back({cand[i][forward].score[k] + back.score[m], i, j});
           break;
         }
     }
-  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+  std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) {
     return a.score != b.score ? a.score < b.score : (a.i != b.i ? a.i < b.i : a.j < b.j);
   });
   fwd.assign(n, -1);
   bwd.assign(n, -1);
-  for (const Pair& p : pairs)
-    if (fwd[p.i] < 0 && bwd[p.j] < 0) {
-      fwd[p.i] = p.j;
-      bwd[p.j] = p.i;
+  for (const Edge& e : edges)
+    if (fwd[e.i] < 0 && bwd[e.j] < 0) {
+      fwd[e.i] = e.j;
+      bwd[e.j] = e.i;
     }
+  // Adjacency (CSR, by score) for augmenting paths.
+  std::vector<int> first(n + 1, 0), target(edges.size());
+  for (const Edge& e : edges) ++first[e.i + 1];
+  for (int i = 0; i < n; ++i) first[i + 1] += first[i];
+  {
+    std::vector<int> fill(first.begin(), first.end() - 1);
+    for (const Edge& e : edges) target[fill[e.i]++] = e.j;
+  }
+  // Breadth-first search for an augmenting path from each unmatched source, exploring at most
+  // kExplore sources so the whole pass stays O(N).
+  constexpr int kExplore = 64;
+  std::vector<int> seen(n, -1), parent(n, -1), queue;
+  queue.reserve(kExplore + 1);
+  for (int root = 0; root < n; ++root) {
+    if (fwd[root] >= 0 || first[root] == first[root + 1]) continue;
+    queue.assign(1, root);
+    int free_target = -1;
+    for (std::size_t q = 0; q < queue.size() && free_target < 0 && queue.size() <= kExplore; ++q) {
+      const int a = queue[q];
+      for (int e = first[a]; e < first[a + 1]; ++e) {
+        const int b = target[e];
+        if (seen[b] == root) continue;
+        seen[b] = root;
+        parent[b] = a;
+        if (bwd[b] < 0) {
+          free_target = b;
+          break;
+        }
+        queue.push_back(bwd[b]);
+      }
+    }
+    // Flip the path: each source on it takes the target found through it.
+    for (int b = free_target; b >= 0;) {
+      const int a = parent[b], previous = fwd[a];
+      fwd[a] = b;
+      bwd[b] = a;
+      b = a == root ? -1 : previous;
+    }
+  }
   for (int i = 0; i < n; ++i) {
     if (fwd[i] < 0) fwd[i] = cand[i][forward].id[0];
     if (bwd[i] < 0) bwd[i] = cand[i][backward].id[0];

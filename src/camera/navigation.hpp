@@ -43,7 +43,7 @@ struct GraphOptions {
   /// Reversibility: a candidate whose score is within (1 + tolerance) of the best may be chosen
   /// instead when the opposite move then leads straight back (right then left returns). Pairs are
   /// matched greedily by summed score; 0 = always the best candidate.
-  double reversible_tolerance = 0.25;
+  double reversible_tolerance = 0.5;
 };
 
 /// Finds the nearest camera of a shell to a direction from the rig centre (mouse-drag snapping).

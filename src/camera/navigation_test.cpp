@@ -128,7 +128,7 @@ TEST(Navigation, RightCirclesTheEquatorAndReturns) {
   }
   std::printf("fibonacci:500: right travels %.1f deg of longitude, |lat| <= %.1f\n", lon, max_lat);
   EXPECT_GE(lon, 360);
-  EXPECT_LT(max_lat, 45);
+  EXPECT_LT(max_lat, 30);
 }
 
 TEST(Navigation, RightThenLeftReturnsForMostCameras) {
@@ -136,15 +136,15 @@ TEST(Navigation, RightThenLeftReturnsForMostCameras) {
     const char* spec;
     double min_fraction;
   };
-  for (const Case& c : {Case{"yinyang", 0.85}, Case{"fibonacci", 0.6}, Case{"latlon", 0.95}, Case{"yinyang:13x39", 0.9},
-                        Case{"fibonacci:1000", 0.85}, Case{"latlon:22x45+poles", 0.95}}) {
+  for (const Case& c : {Case{"yinyang", 0.88}, Case{"fibonacci", 0.8}, Case{"latlon", 0.95}, Case{"yinyang:13x39", 0.93},
+                        Case{"fibonacci:1000", 0.93}, Case{"latlon:22x45+poles", 0.95}}) {
     const Rig rig = make_rig(c.spec, kDomain);
     const NavigationGraph g = build_navigation_graph(rig);
     const RigStatistics st = rig_statistics(rig, g);
     std::printf("%-20s %5d cameras: right-then-left returns %.3f, up-then-down %.3f\n", c.spec, rig.size(),
                 st.right_left_return, st.up_down_return);
     EXPECT_GE(st.right_left_return, c.min_fraction) << c.spec;
-    EXPECT_GE(st.up_down_return, 0.7) << c.spec;
+    EXPECT_GE(st.up_down_return, 0.8) << c.spec;
   }
 }
 
