@@ -1,0 +1,89 @@
+// `panoptes synth-db OUT ...`: writes a synthetic database whose every frame carries a machine-readable
+// stamp of (camera, task, frame), for tests and benchmarks of the player.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <regex>
+#include <memory>
+#include <string>
+
+#include "app/command.hpp"
+#include "core/error.hpp"
+#include "store/synthetic.hpp"
+
+namespace {
+
+struct Args {
+  std::string out;
+  int cameras = 8, tasks = 2, frames = 10;
+  std::string size = "64x64";
+  bool overwrite = false;
+  int gop = -1, crf = -1, threads = 0;
+  std::string preset, title = "synthetic database";
+};
+
+void run(const Args& a, const std::string& command_line) {
+  using namespace panoptes;
+  std::smatch m;
+  static const std::regex size_re(R"((\d{1,6})x(\d{1,6}))");
+  if (!std::regex_match(a.size, m, size_re))
+    throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 64x64 or 920x896");
+  store::SyntheticOptions o;
+  o.cameras = a.cameras;
+  o.tasks = a.tasks;
+  o.frames = a.frames;
+  o.width = std::stoi(m[1]);
+  o.height = std::stoi(m[2]);
+  o.overwrite = a.overwrite;
+  o.threads = a.threads;
+  o.title = a.title;
+  o.command_line = command_line;
+  if (a.gop >= 0) o.video.gop = a.gop;
+  if (a.crf >= 0) o.video.crf = a.crf;
+  if (!a.preset.empty()) o.video.preset = a.preset;
+  o.video.validate();
+
+  const bool tty = ::isatty(STDERR_FILENO);
+  const auto t0 = std::chrono::steady_clock::now();
+  store::write_synthetic_database(a.out, o, [&](std::int64_t done, std::int64_t total) {
+    if (!tty) return;
+    std::fprintf(stderr, "\rsynth-db: %lld / %lld streams (%d%%)", (long long)done, (long long)total,
+                 int(total ? 100 * done / total : 100));
+    std::fflush(stderr);
+  });
+  if (tty) std::fprintf(stderr, "\n");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const long long streams = (long long)a.cameras * a.tasks;
+  std::printf("wrote %s: %d cameras x %d tasks = %lld streams, %d frames of %dx%d each, in %.2f s (%.0f streams/s)\n",
+              a.out.c_str(), a.cameras, a.tasks, streams, a.frames, o.width, o.height, seconds, streams / seconds);
+}
+
+panoptes::app::CommandRegistration reg([](CLI::App& root) {
+  auto args = std::make_shared<Args>();
+  auto* sub = root.add_subcommand(
+      "synth-db",
+      "Write a synthetic movie database: cameras on a sphere, tasks on an 'isovalue' axis, every frame stamped "
+      "with a machine-readable (camera, task, frame) code in its top-left corner (for tests and benchmarks)");
+  sub->add_option("OUT", args->out, "Output database directory")->required();
+  sub->add_option("--cameras", args->cameras, "Number of cameras (Fibonacci sphere, ring navigation graph)")
+      ->check(CLI::Range(1, 1 << 24))->capture_default_str();
+  sub->add_option("--tasks", args->tasks, "Number of tasks (one 'isovalue' axis)")
+      ->check(CLI::Range(1, 1 << 16))->capture_default_str();
+  sub->add_option("--frames", args->frames, "Frames per movie")->check(CLI::Range(1, 1 << 20))->capture_default_str();
+  sub->add_option("--size", args->size, "Frame size WIDTHxHEIGHT (at least 40x32 for the stamp)")->capture_default_str();
+  sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in OUT");
+  sub->add_option("--gop", args->gop, "Keyframe interval in frames (default: the video default)");
+  sub->add_option("--crf", args->crf, "x264 constant rate factor 0..51 (default: the video default)");
+  sub->add_option("--preset", args->preset, "x264 preset (default: the video default)");
+  sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->capture_default_str();
+  sub->add_option("--title", args->title, "Title stored in the manifest")->capture_default_str();
+  sub->callback([args] {
+    // The effective settings, so the provenance reproduces the database.
+    const std::string command_line = "panoptes synth-db " + args->out + " --cameras " + std::to_string(args->cameras) + " --tasks " +
+                   std::to_string(args->tasks) + " --frames " + std::to_string(args->frames) + " --size " + args->size;
+    run(*args, command_line);
+  });
+});
+
+}  // namespace
