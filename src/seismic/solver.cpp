@@ -118,11 +118,32 @@ struct Solver::Impl {
   void velocity_planes(int k0, int k1, double t);
   void stress_planes(int k0, int k1, double t);
   template <int Z>
-  void stress_plane_elastic(int k);
+  void stress_row_elastic(int k, int j);
   template <int Z>
-  void stress_plane_visco(int k);
+  void stress_row_visco(int k, int j);
   void pml_velocity(int k0, int k1);
   void pml_stress(int k0, int k1);
+  // Memory variables see the stretched derivative inside the CPML too: when ψ is added to a strain
+  // rate, their update (linear in the rate) and the stress they relax get the matching increments.
+  void visco_normal(std::size_t n, float psi, int axis) {
+    Vec* norm[3] = {&sxx, &syy, &szz};
+    std::vector<Vec>* mem[3] = {&rxx, &ryy, &rzz};
+    for (int l = 0; l < L; ++l) {
+      const float base = relax_b[l] * cl[l][n] * psi;
+      for (int c = 0; c < 3; ++c) {
+        const float d = base + (c == axis ? relax_b[l] * cm[l][n] * psi : 0.0f);
+        (*mem[c])[l][n] += d;
+        (*norm[c])[n] -= 0.5f * d;
+      }
+    }
+  }
+  void visco_shear(std::size_t n, float psi, Vec& stress, std::vector<Vec>& mem, std::vector<Vec>& coef) {
+    for (int l = 0; l < L; ++l) {
+      const float d = relax_b[l] * coef[l][n] * psi;
+      mem[l][n] += d;
+      stress[n] -= 0.5f * d;
+    }
+  }
   void free_surface_images();
   void record();
 
@@ -539,9 +560,8 @@ void Solver::Impl::velocity_planes(int k0, int k1, double t) {
   const long Y = sy, Z = sz;
 
 template <int Zm>
-void Solver::Impl::stress_plane_elastic(int k) {
-#pragma omp for schedule(static)
-  for (int j = 0; j < ny; ++j) {
+void Solver::Impl::stress_row_elastic(int k, int j) {
+  {
     PANOPTES_ROW_POINTERS
 #pragma omp simd
     for (int i = 0; i < nx; ++i) {
@@ -557,7 +577,7 @@ void Solver::Impl::stress_plane_elastic(int k) {
 }
 
 template <int Zm>
-void Solver::Impl::stress_plane_visco(int k) {
+void Solver::Impl::stress_row_visco(int k, int j) {
   float* rows = rowbuf[std::size_t(omp_get_thread_num())].data();
   float* __restrict rxx_ = rows;
   float* __restrict ryy_ = rows + nx;
@@ -565,8 +585,7 @@ void Solver::Impl::stress_plane_visco(int k) {
   float* __restrict rxy_ = rows + 3 * nx;
   float* __restrict rxz_ = rows + 4 * nx;
   float* __restrict ryz_ = rows + 5 * nx;
-#pragma omp for schedule(static)
-  for (int j = 0; j < ny; ++j) {
+  {
     PANOPTES_ROW_POINTERS
 #pragma omp simd
     for (int i = 0; i < nx; ++i) {
@@ -614,18 +633,21 @@ void Solver::Impl::stress_plane_visco(int k) {
 
 void Solver::Impl::stress_planes(int k0, int k1, double t) {
   if (k0 >= k1) return;
-#pragma omp parallel
-  for (int k = k0; k < k1; ++k) {
+  // One parallel loop over all rows of the planes (few barriers: the machine may be oversubscribed).
+  const int rows = (k1 - k0) * ny;
+#pragma omp parallel for schedule(static)
+  for (int r = 0; r < rows; ++r) {
+    const int k = k0 + r / ny, j = r % ny;
     const int g = k + kb;
     const int zm = !free_surface ? 0 : g == 0 ? 1 : g == 1 ? 2 : 0;
     if (L == 0) {
-      if (zm == 0) stress_plane_elastic<0>(k);
-      else if (zm == 1) stress_plane_elastic<1>(k);
-      else stress_plane_elastic<2>(k);
+      if (zm == 0) stress_row_elastic<0>(k, j);
+      else if (zm == 1) stress_row_elastic<1>(k, j);
+      else stress_row_elastic<2>(k, j);
     } else {
-      if (zm == 0) stress_plane_visco<0>(k);
-      else if (zm == 1) stress_plane_visco<1>(k);
-      else stress_plane_visco<2>(k);
+      if (zm == 0) stress_row_visco<0>(k, j);
+      else if (zm == 1) stress_row_visco<1>(k, j);
+      else stress_row_visco<2>(k, j);
     }
   }
   pml_stress(k0, k1);
@@ -686,11 +708,12 @@ void Solver::Impl::pml_velocity(int k0, int k1) {
         }
       }
   }
-  for (int k = k0; k < k1; ++k) {
-    const int s = pmlz.slot[k];
-    if (s < 0) continue;
-#pragma omp parallel for schedule(static)
-    for (int j = 0; j < ny; ++j)
+  const auto zlo = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k0) - pmlz.indices.begin();
+  const auto zhi = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k1) - pmlz.indices.begin();
+#pragma omp parallel for collapse(2) schedule(static)
+  for (long s = zlo; s < zhi; ++s)
+    for (int j = 0; j < ny; ++j) {
+      const int k = pmlz.indices[s];
       for (int i = 0; i < nx; ++i) {
         const std::size_t n = idx(i, j, k), p = (std::size_t(s) * ny + j) * nx + i;
         const float* f = sxz.data() + n;
@@ -733,6 +756,11 @@ void Solver::Impl::pml_stress(int k0, int k1) {
           float& c = psix[5][p];
           c = pmlx.b_half[i] * c + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
           sxz[n] += muxz[n] * c;
+          if (L > 0) {
+            visco_normal(n, a, 0);
+            visco_shear(n, b, sxy, rxy, cmxy);
+            visco_shear(n, c, sxz, rxz, cmxz);
+          }
         }
   }
   if (cy > 0) {
@@ -756,14 +784,20 @@ void Solver::Impl::pml_stress(int k0, int k1) {
           float& c = psiy[5][p];
           c = pmly.b_half[j] * c + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
           syz[n] += muyz[n] * c;
+          if (L > 0) {
+            visco_normal(n, a, 1);
+            visco_shear(n, b, sxy, rxy, cmxy);
+            visco_shear(n, c, syz, ryz, cmyz);
+          }
         }
       }
   }
-  for (int k = k0; k < k1; ++k) {
-    const int s = pmlz.slot[k];
-    if (s < 0) continue;
-#pragma omp parallel for schedule(static)
-    for (int j = 0; j < ny; ++j)
+  const auto zlo = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k0) - pmlz.indices.begin();
+  const auto zhi = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k1) - pmlz.indices.begin();
+#pragma omp parallel for collapse(2) schedule(static)
+  for (long s = zlo; s < zhi; ++s)
+    for (int j = 0; j < ny; ++j) {
+      const int k = pmlz.indices[s];
       for (int i = 0; i < nx; ++i) {
         const std::size_t n = idx(i, j, k), p = (std::size_t(s) * ny + j) * nx + i;
         const float* f = vz.data() + n;
@@ -780,6 +814,11 @@ void Solver::Impl::pml_stress(int k0, int k1) {
         float& c = psiz[5][p];
         c = pmlz.b_half[k] * c + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
         syz[n] += muyz[n] * c;
+        if (L > 0) {
+          visco_normal(n, a, 2);
+          visco_shear(n, b, sxz, rxz, cmxz);
+          visco_shear(n, c, syz, ryz, cmyz);
+        }
       }
   }
 }
