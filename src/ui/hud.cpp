@@ -140,13 +140,16 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
 
   if (!message_.empty() && ImGui::GetTime() < message_until_) {
     ImGui::SetNextWindowPos(ImVec2(vw / 2, vh * 0.8f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(vw * 0.95f, vh * 0.5f));
     ImGui::SetNextWindowBgAlpha(0.8f);
     if (ImGui::Begin("##message", nullptr, kOverlayFlags)) {
       remember_window();
-      if (message_error_)
-        ImGui::TextColored(ImVec4(1, 0.45f, 0.35f, 1), "%s", message_.c_str());
-      else
-        ImGui::TextUnformatted(message_.c_str());
+      // Long paths wrap instead of running off the window.
+      ImGui::PushTextWrapPos(vw * 0.95f - 2 * ImGui::GetStyle().WindowPadding.x);
+      if (message_error_) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.45f, 0.35f, 1));
+      ImGui::TextUnformatted(message_.c_str());
+      if (message_error_) ImGui::PopStyleColor();
+      ImGui::PopTextWrapPos();
     }
     ImGui::End();
   }
