@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# `panoptes export-path`: the shown sequence of a script becomes one MP4 with one frame per tick.
+set -euo pipefail
+panoptes=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+
+"$panoptes" synth-db db --cameras 4 --tasks 2 --frames 12 --size 64x64 >/dev/null
+printf 't=0.1 key=Right\nt=0.3 key=Tab\nt=0.5 key=Right\n' > s.txt
+"$panoptes" export-path db --script s.txt --out path.mp4 | grep -q "wrote path.mp4: 16 frames"
+frames=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,width,height \
+         -of csv=p=0 path.mp4)
+[ "$frames" = "64,64,16" ] || { echo "ffprobe says: $frames"; exit 1; }
+if "$panoptes" export-path db --script s.txt --out /nonexistent/dir/x.mp4 2>err.txt; then
+  echo "unwritable output accepted"; exit 1
+fi
+grep -q "output directory does not exist" err.txt
+echo "export_path: ok"
