@@ -1,0 +1,91 @@
+#pragma once
+// Configuration of an in-situ session (plain data) and its TOML form, shared by the C++ API, the C
+// API and `panoptes run`. Every key is documented by config_keys_help().
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/renderer.hpp"
+#include "video/video_settings.hpp"
+
+namespace toml {
+inline namespace v3 {
+class table;
+}
+}  // namespace toml
+
+namespace panoptes::insitu {
+
+/// A value window: absolute [lo, hi], or relative (lo·ref, hi·ref) where ref is the running maximum
+/// over snapshots of the `percentile` quantile of |field| over the whole grid.
+struct WindowConfig {
+  double lo = 0, hi = 1;
+  bool relative = true;
+};
+
+/// One task, or a sweep of tasks along one parameter axis (several isovalues, windows or slice
+/// positions give several tasks, placed on a manifest axis so the player can step through them).
+struct TaskConfig {
+  enum class Kind { volume, volume2, isosurface, slice };
+  Kind kind = Kind::volume;
+  std::string name;                  ///< unique; sweeps append " <value>" per task
+  std::vector<std::string> fields;   ///< 1 field (volume2: 2)
+  std::string preset = "hot";        ///< transfer function (volume, slice colour map)
+  std::string preset2 = "s-wave";    ///< volume2: second field's transfer function
+  float extinction_scale = 1;
+  std::vector<WindowConfig> windows{WindowConfig{}};  ///< volume/slice; several = a "window" sweep
+  WindowConfig window2;                                ///< volume2: second field's window
+  std::vector<double> isovalues;     ///< isosurface: values (or fractions of ref if iso_relative)
+  bool iso_relative = false;
+  std::array<float, 3> colour{0.85f, 0.85f, 0.85f};  ///< isosurface colour
+  int slice_axis = 2;
+  std::vector<double> slice_positions{0.5};  ///< fractions of the domain along slice_axis
+  std::string axis;                  ///< name of the sweep axis (default: "<name> isovalue|window|position")
+};
+
+/// When snapshots are taken: every `every_steps` steps, or every `every_time` of simulation time
+/// (exactly one of them > 0), at most max_snapshots (0 = unlimited).
+struct ScheduleConfig {
+  std::int64_t every_steps = 10;
+  double every_time = 0;
+  int max_snapshots = 0;
+};
+
+/// Everything a session needs besides the grid and the communicator.
+struct SessionConfig {
+  std::string output_dir = "panoptes_out";
+  bool overwrite = false;
+  std::string title = "in-situ visualization";
+  std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
+  std::string command_line;
+  std::string units;                  ///< length unit of the grid, for the manifest
+  std::string rig = "yinyang";        ///< camera::RigSpec string
+  int width = 920, height = 896;
+  std::vector<TaskConfig> tasks;
+  ScheduleConfig schedule;
+  video::VideoSettings video;
+  render::RenderOptions render;
+  std::array<float, 3> background{0, 0, 0};
+  bool outline = true;
+  double percentile = 0.999;          ///< quantile of |v| used as reference of relative windows
+
+  /// Checks ranges and consistency (not the grid); throws panoptes::Error naming the key.
+  void validate() const;
+};
+
+/// Reads the in-situ keys from a TOML table (sections [output], [image], [rig], [schedule], [video],
+/// [render] and the array [[task]]). Keys of other sections listed in `foreign_sections` are left
+/// for the caller (e.g. the seismic solver's); any other unknown key, a wrong type or an impossible
+/// value throws panoptes::Error naming `source`, the key and what was expected.
+SessionConfig parse_session_config(const toml::table& table, const std::string& source,
+                                   const std::vector<std::string>& foreign_sections = {});
+/// Parses TOML text (errors name `source`).
+SessionConfig parse_session_config_text(const std::string& text, const std::string& source,
+                                        const std::vector<std::string>& foreign_sections = {});
+/// Reads a TOML file; throws FileError naming the file.
+SessionConfig load_session_config(const std::string& path, const std::vector<std::string>& foreign_sections = {});
+
+/// Documentation of every key with its default.
+const char* config_keys_help();
+
+}  // namespace panoptes::insitu

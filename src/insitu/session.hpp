@@ -1,0 +1,133 @@
+#pragma once
+// The in-situ session: a simulation hands it views of its local block at every snapshot; it renders
+// every (camera, task) image, composites the partial images of all ranks on the rank that owns the
+// camera, and appends them to the movie database (DESIGN.md decisions 4, 5, 6, 9).
+//
+// Data flow of one snapshot (collective over the communicator):
+//   local block (float or double, any strides, ghost layers) → float32 copy covering the brick's
+//   ghosted point range (missing ghost points fetched from the ranks that own them) → macro-cells →
+//   for each camera: ONE render_brick march for all tasks → partial images (rect + premultiplied
+//   RGBA + depth) sent to the owner rank of the camera (camera c ↦ rank c mod P, MPI_Isend) → the
+//   owner composites by per-pixel depth, finishes (background + outline) and appends to its movies
+//   → every rank flushes → MPI_Allreduce(min) of complete frames → rank 0 checkpoints the manifest.
+// Cameras are processed in rounds of P (one per owner), so at most ~2·P·K partial images are in
+// flight per rank whatever the number of cameras.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/image.hpp"
+#include "insitu/config.hpp"
+#include "render/field_view.hpp"
+
+#ifdef PANOPTES_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace panoptes::insitu {
+
+/// Element type of a simulation field.
+enum class ScalarType { f32, f64 };
+
+/// This rank's part of the global grid: the points it OWNS (a box; the boxes of all ranks partition
+/// the grid's points) and the ghost layers its arrays hold around them. The session needs, for its
+/// brick, 2 ghost layers below and 2 above the owned box on every split axis (render::required_points);
+/// when the arrays hold fewer, the missing points are fetched from their owners (one extra exchange
+/// per snapshot), so any ghost width, including 0, works.
+struct LocalBlock {
+  render::Index3 offset{0, 0, 0};    ///< global index of the first owned point
+  render::Index3 extent{0, 0, 0};    ///< owned points per axis
+  render::Index3 ghost_lo{0, 0, 0};  ///< ghost layers stored below the owned box, per axis
+  render::Index3 ghost_hi{0, 0, 0};  ///< ghost layers stored above it
+  /// The whole grid owned by one process, no ghosts.
+  static LocalBlock whole(const render::GridGeometry& g) { return {{0, 0, 0}, g.dims, {0, 0, 0}, {0, 0, 0}}; }
+  /// Slab `index` of `parts` along `axis` (the usual 1-D decomposition), with `ghosts` layers on
+  /// both sides of the split axis where a neighbour exists.
+  static LocalBlock slab(const render::GridGeometry& g, int axis, int parts, int index, int ghosts = 0);
+};
+
+/// One field of the local block for one snapshot. `data` points at the FIRST OWNED point
+/// (global index LocalBlock::offset); ghost points are at negative offsets. `stride` is in elements
+/// per axis; {0,0,0} means contiguous x-fastest over the ghosted box (C [nz][ny][nx], Fortran (nx,ny,nz)).
+struct FieldInput {
+  std::string name;
+  const void* data = nullptr;
+  ScalarType type = ScalarType::f32;
+  std::array<std::int64_t, 3> stride{0, 0, 0};
+};
+
+/// Seconds spent in each phase (this rank), summed over snapshots.
+struct Timings {
+  double copy = 0;       ///< field conversion, ghost exchange, macro-cells, reference values
+  double render = 0;     ///< render_brick marches
+  double composite = 0;  ///< sending partials, waiting for them, compositing, finishing images
+  double encode = 0;     ///< DatabaseWriter::append (H.264 encoding)
+  double checkpoint = 0; ///< flush + reduction + manifest
+  double total() const { return copy + render + composite + encode + checkpoint; }
+};
+
+/// What a rank holds and did, for reports.
+struct SessionStats {
+  int snapshots = 0;              ///< snapshots processed
+  std::int64_t frames_encoded = 0;  ///< (camera, task) frames appended on this rank
+  int owned_cameras = 0;          ///< cameras (hence encoders ×tasks) on this rank
+  std::int64_t field_buffer_bytes = 0;   ///< float32 copies of the brick's fields
+  std::int64_t partial_buffer_bytes = 0; ///< partial images and message buffers (capacity)
+  std::int64_t peak_rss_bytes = 0;       ///< process peak resident set (getrusage), includes encoders
+  Timings time;
+};
+
+/// A running in-situ visualization. Not copyable; all public calls except the accessors are
+/// collective over the communicator and must be made by every rank in the same order.
+class Session {
+ public:
+  /// Validates the configuration against the grid (throws panoptes::Error naming the bad key), builds
+  /// the rig, the navigation graph and the task list, and creates the database (rank 0 first, then the
+  /// other ranks for the movies of the cameras they own). Single process.
+  Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block);
+#ifdef PANOPTES_HAVE_MPI
+  /// On communicator `comm` (duplicated internally). Every rank passes the same config and grid.
+  Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm);
+#endif
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// True when the schedule asks for a snapshot at this step / simulation time (same answer on every
+  /// rank given the same arguments). Steps count from 0; with schedule.every_steps = N, steps 0, N,
+  /// 2N… are due; with every_time = Δt, the first step whose time reaches 0, Δt, 2Δt… (each once).
+  bool due(std::int64_t step, double time) const;
+  /// Renders and stores one snapshot of `fields` (must include every field a task reads) at
+  /// simulation time `time`. Collective. Throws Error on missing fields or exhausted max_snapshots.
+  void snapshot(double time, const std::vector<FieldInput>& fields);
+  /// due() then snapshot(); returns whether a snapshot was taken.
+  bool process(std::int64_t step, double time, const std::vector<FieldInput>& fields);
+  /// Closes every movie and marks the database complete (collective). Idempotent.
+  void finalize();
+
+  /// Called on the owner rank with every finished frame before it is encoded (tests, previews).
+  using FrameObserver = std::function<void(int camera, int task, int frame, const Image& image)>;
+  void set_frame_observer(FrameObserver observer);
+
+  int rank() const;
+  int ranks() const;
+  int camera_count() const;
+  int task_count() const;
+  int snapshots() const;
+  /// Names of the fields the tasks read, in first-use order.
+  const std::vector<std::string>& field_names() const;
+  const std::string& output_dir() const;
+  /// This rank's statistics (peak_rss_bytes refreshed on each call).
+  SessionStats stats() const;
+  /// The element-wise maximum over ranks of the per-rank times, and sums of the counters (collective).
+  SessionStats reduced_stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace panoptes::insitu
