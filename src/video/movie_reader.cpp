@@ -334,7 +334,10 @@ struct MovieReader::Impl {
         if (ret == 0) {
           const std::int64_t pts = frame->pts != AV_NOPTS_VALUE ? frame->pts : frame->best_effort_timestamp;
           const int f = frame_of_pts(pts);
-          if (f < 0) continue;  // not a frame of the index (e.g. from a dropped, truncated packet)
+          if (f < 0) {  // not a frame of the index (e.g. from a dropped, truncated packet)
+            current_frame = -1;
+            continue;
+          }
           current_frame = f;
           if (f == index) return;
           if (f > index) break;  // frame `index` was skipped by the decoder: damaged

@@ -362,6 +362,29 @@ TEST_F(MovieTest, MissingAndNonMovieFilesAreFileErrors) {
   EXPECT_THROW(MovieReader r(empty), FileError);
 }
 
+TEST_F(MovieTest, MovieKilledBeforeItsFirstFlushOpensEmpty) {
+  const std::string path = file("empty_movie.mp4");
+  MovieWriter writer(path, 64, 48);  // header written, no frame yet
+  MovieReader reader(path);
+  EXPECT_EQ(reader.frame_count(), 0);
+  EXPECT_EQ(reader.duration(), 0.0);
+  EXPECT_THROW(reader.read_rgba(0), Error);
+}
+
+TEST_F(MovieTest, MovieWithoutVideoIsAFileError) {
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg is not installed";
+  const std::string path = file("audio.mp4");
+  const std::string cmd = "ffmpeg -v error -f lavfi -i anullsrc=r=8000 -t 0.2 -c:a aac '" + path + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  try {
+    MovieReader r(path);
+    FAIL() << "an audio-only file opened as a movie";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.path(), path);
+    EXPECT_NE(std::string(e.what()).find("has no video stream"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(MovieTest, OutOfRangeReadIsAnError) {
   const std::string path = file("range.mp4");
   write_movie(path, 64, 48, 3);
