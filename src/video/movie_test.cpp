@@ -2,6 +2,7 @@
 // odd sizes, bad input.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -336,6 +337,43 @@ TEST_F(MovieTest, FullDiskIsAFileErrorNotACrash) {
     EXPECT_EQ(e.path(), "/dev/full");
     EXPECT_NE(std::string(e.what()).find("No space left"), std::string::npos) << e.what();
   }
+}
+
+// A disk that fills up mid-movie (simulated with RLIMIT_FSIZE in a child): append/flush throw a
+// FileError naming the file, the writer is destroyed without crashing, and the frames flushed
+// before the failure still read.
+TEST_F(MovieTest, DiskFullMidMovieKeepsFlushedFrames) {
+  const std::string path = file("full_disk.mp4");
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    signal(SIGXFSZ, SIG_IGN);  // writes past the limit fail with EFBIG instead of killing us
+    struct rlimit limit {};
+    limit.rlim_cur = limit.rlim_max = 60000;
+    if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(3);
+    int flushed = 0;
+    try {
+      MovieWriter writer(path, 160, 120);
+      for (int i = 0; i < 1000; ++i) {
+        writer.append(make_test_frame(160, 120, i));
+        writer.flush();
+        flushed = i + 1;
+      }
+      _exit(1);  // the limit was never hit
+    } catch (const FileError& e) {
+      const bool named = std::string(e.what()).find(path) != std::string::npos && e.path() == path;
+      _exit(named && flushed > 0 ? 0 : 2);
+    } catch (...) {
+      _exit(4);
+    }
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 0) << "1: no error, 2: error without the path or nothing flushed, 3/4: other";
+  MovieReader reader(path);
+  ASSERT_GT(reader.frame_count(), 0);
+  for (int i = 0; i < reader.frame_count(); ++i) EXPECT_EQ(read_test_frame_number(reader.read_rgba(i)), i);
 }
 
 TEST_F(MovieTest, MissingAndNonMovieFilesAreFileErrors) {
