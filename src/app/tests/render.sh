@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# `panoptes render`: VTK ASCII/BINARY and NumPy inputs, a time series from a glob, the database it
+# writes (cameras x tasks streams, frames), quiet when not a terminal, and clear errors.
+set -euo pipefail
+panoptes=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+fail() { echo "render.sh: $*" >&2; exit 1; }
+
+# A 12x10x8 VTK ASCII volume: distance from the centre.
+{
+  echo "# vtk DataFile Version 3.0"
+  echo "sphere"
+  echo "ASCII"
+  echo "DATASET STRUCTURED_POINTS"
+  echo "DIMENSIONS 12 10 8"
+  echo "ORIGIN -5.5 -4.5 -3.5"
+  echo "SPACING 1 1 1"
+  echo "POINT_DATA 960"
+  echo "SCALARS d float 1"
+  echo "LOOKUP_TABLE default"
+  awk 'BEGIN { for (k = 0; k < 8; k++) for (j = 0; j < 10; j++) for (i = 0; i < 12; i++)
+               printf "%.4f\n", sqrt((i-5.5)^2 + (j-4.5)^2 + (k-3.5)^2) }'
+} > "$tmp/sphere.vtk"
+
+"$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --task volume:hot --task iso:3 --task iso:2 \
+  --task slice:z:0.5 --size 48x40 --out "$tmp/db" > "$tmp/out.txt" 2> "$tmp/err.txt"
+grep -q "4 cameras x 4 tasks = 16 streams, 1 frames of 48x40" "$tmp/out.txt" || fail "unexpected summary: $(cat "$tmp/out.txt")"
+[ ! -s "$tmp/err.txt" ] || fail "progress output although stderr is not a terminal: $(cat "$tmp/err.txt")"
+[ -f "$tmp/db/panoptes.json" ] || fail "no manifest"
+[ "$(find "$tmp/db" -name '*.mp4' | wc -l)" = 16 ] || fail "expected 16 movies"
+grep -q '"isovalue"' "$tmp/db/panoptes.json" || fail "no isovalue axis in the manifest"
+grep -q '"complete"' "$tmp/db/panoptes.json" || fail "database not finalized"
+
+# Refuses to overwrite without --overwrite, accepts with it.
+if "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 48x40 --out "$tmp/db" 2> "$tmp/err.txt"; then
+  fail "overwrote an existing database"
+fi
+grep -q "panoptes: error:" "$tmp/err.txt" || fail "no error line"
+"$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 48x40 --out "$tmp/db" --overwrite > /dev/null
+
+if command -v python3 > /dev/null; then
+  # NumPy files without numpy: header + little-endian float32/float64 data; a BINARY VTK (big-endian).
+  python3 - "$tmp" <<'EOF'
+import struct, sys, math
+tmp = sys.argv[1]
+def npy(path, shape, values, descr="<f4", fmt="<f"):
+    header = "{'descr': '%s', 'fortran_order': False, 'shape': %s, }" % (descr, str(tuple(shape)))
+    header += " " * (63 - (10 + len(header)) % 64) + "\n"
+    with open(path, "wb") as f:
+        f.write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header.encode())
+        f.write(b"".join(struct.pack(fmt, v) for v in values))
+nz, ny, nx = 8, 10, 12
+for t in range(3):
+    vals = [math.sin(0.5 * i + 0.3 * j + 0.2 * k + t) for k in range(nz) for j in range(ny) for i in range(nx)]
+    npy(f"{tmp}/series_{t}.npy", (nz, ny, nx), vals, "<f8", "<d")
+npy(f"{tmp}/flat.npy", (ny, nx), [0.0] * (nx * ny))
+npy(f"{tmp}/ints.npy", (nz, ny, nx), [0] * (nx * ny * nz), "<i4", "<i")
+npy(f"{tmp}/other.npy", (nz, ny, nx + 1), [0.0] * ((nx + 1) * ny * nz))
+with open(f"{tmp}/bin.vtk", "wb") as f:
+    f.write(b"# vtk DataFile Version 3.0\nbinary\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 12 10 8\n"
+            b"ORIGIN 0 0 0\nSPACING 0.5 0.5 0.5\nPOINT_DATA 960\nSCALARS v double\nLOOKUP_TABLE default\n")
+    f.write(b"".join(struct.pack(">d", math.cos(0.4 * i) * j / 10) for k in range(8) for j in range(10) for i in range(12)))
+EOF
+  "$panoptes" render "$tmp/series_*.npy" --rig fibonacci:3 --task volume:diverging --size 32x32 --out "$tmp/series" > "$tmp/out.txt"
+  grep -q "3 cameras x 1 tasks = 3 streams, 3 frames of 32x32" "$tmp/out.txt" || fail "series: $(cat "$tmp/out.txt")"
+  grep -q '"frames_written": 3' "$tmp/series/panoptes.json" || fail "series: frames_written is not 3"
+  "$panoptes" render "$tmp/bin.vtk" --rig fibonacci:2 --task volume:p-wave:0:1 --size 32x32 --out "$tmp/bin" > /dev/null
+
+  expect_error() {  # expect_error PATTERN ARGS...: fails with exit 1 and one error line matching PATTERN
+    local pattern=$1; shift
+    if "$panoptes" render "$@" 2> "$tmp/err.txt" > /dev/null; then fail "accepted: $*"; fi
+    grep -q "panoptes: error:.*$pattern" "$tmp/err.txt" || fail "for '$*' expected /$pattern/, got: $(cat "$tmp/err.txt")"
+  }
+  expect_error "3-D volume" "$tmp/flat.npy" --rig fibonacci:2 --out "$tmp/e1"
+  expect_error "float32" "$tmp/ints.npy" --rig fibonacci:2 --out "$tmp/e2"
+  expect_error "expected 12x10x8" "$tmp/series_0.npy" "$tmp/other.npy" --rig fibonacci:2 --out "$tmp/e3"
+fi
+
+echo "not a volume" > "$tmp/vol.txt"
+if "$panoptes" render "$tmp/vol.txt" --out "$tmp/e4" 2> "$tmp/err.txt"; then fail "accepted a .txt file"; fi
+grep -q "unsupported volume format" "$tmp/err.txt" || fail "unclear error for .txt: $(cat "$tmp/err.txt")"
+if "$panoptes" render "$tmp/sphere.vtk" --task volume:nope --out "$tmp/e5" 2> "$tmp/err.txt"; then fail "accepted a bad preset"; fi
+grep -q "p-wave" "$tmp/err.txt" || fail "bad preset error does not list presets: $(cat "$tmp/err.txt")"
+if "$panoptes" render "$tmp/sphere.vtk" --task slice:w:0.5 --out "$tmp/e6" 2> "$tmp/err.txt"; then fail "accepted axis w"; fi
+if "$panoptes" render "$tmp/missing.npy" --out "$tmp/e7" 2> "$tmp/err.txt"; then fail "accepted a missing file"; fi
+grep -q "missing.npy" "$tmp/err.txt" || fail "missing-file error does not name the file"
+echo "render: ok"
