@@ -1,5 +1,7 @@
 #include "player/engine.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -251,6 +253,9 @@ struct Engine::Impl {
 
   // ---- prefetch ----
   void worker_loop() {
+    // Prefetch is speculative: on a loaded machine the display thread must win the CPU. Linux nice
+    // values are per thread, so this lowers only this worker (best effort; failure is harmless).
+    ::setpriority(PRIO_PROCESS, ::id_t(::syscall(SYS_gettid)), std::min(19, ::getpriority(PRIO_PROCESS, 0) + 5));
     for (;;) {
       Selection s;
       {

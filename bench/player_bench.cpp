@@ -1,0 +1,154 @@
+// Player figures (issue 6): database open time and resident memory versus the number of streams
+// (manifest-only databases), switch latency at 920x896 while playing at 30 fps with prefetch on and
+// off, and the sustained decode rate of one 920x896 stream on one core.
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "player/engine.hpp"
+#include "player/test_db.hpp"
+#include "store/manifest.hpp"
+
+namespace {
+
+using namespace panoptes;
+using namespace panoptes::player;
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 920, kHeight = 896;
+constexpr int kCameras = 4, kFrames = 45;
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double rss_mib() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return double(resident) * double(::sysconf(_SC_PAGE_SIZE)) / (1024.0 * 1024.0);
+}
+
+testing::TempDir& scratch() {
+  static testing::TempDir dir("player-bench");
+  return dir;
+}
+
+// A manifest-only database of cameras x tasks streams (open must not touch the movies).
+fs::path manifest_only_db(int cameras, int tasks) {
+  const fs::path dir = scratch().path / ("manifest_" + std::to_string(cameras) + "x" + std::to_string(tasks));
+  if (!fs::exists(dir / store::kManifestFileName)) {
+    fs::create_directories(dir);
+    store::Manifest m = testing::ring_manifest(cameras, tasks);
+    m.status = store::Status::complete;
+    m.frames_written = 60;
+    store::write_manifest_atomic(dir / store::kManifestFileName, m);
+  }
+  return dir;
+}
+
+// A small real database at the paper's frame size: kCameras on a ring, one task, kFrames frames,
+// written with the video module's default settings.
+const fs::path& real_db() {
+  static const fs::path dir = [] {
+    const fs::path d = scratch().path / "real";
+    testing::write_stamped(d, testing::ring_manifest(kCameras, 1, kWidth, kHeight), kFrames);
+    return d;
+  }();
+  return dir;
+}
+
+void BM_Open(benchmark::State& state) {
+  const int cameras = int(state.range(0)), tasks = int(state.range(1));
+  const fs::path dir = manifest_only_db(cameras, tasks);
+  double worst_ms = 0, rss_delta = 0, rss_after = 0;
+  for (auto _ : state) {
+    const double rss0 = rss_mib();
+    const double t0 = now_s();
+    Engine engine(dir);
+    const double ms = (now_s() - t0) * 1e3;
+    worst_ms = std::max(worst_ms, ms);
+    rss_after = rss_mib();
+    rss_delta = std::max(rss_delta, rss_after - rss0);
+    benchmark::DoNotOptimize(engine.frame_count());
+    state.SetIterationTime(ms / 1e3);
+  }
+  state.counters["streams"] = double(cameras) * tasks;
+  state.counters["open_ms_max"] = worst_ms;
+  state.counters["rss_MiB"] = rss_after;
+  state.counters["rss_delta_MiB"] = rss_delta;
+}
+// 10^2, 10^4, 10^5 streams as cameras x tasks; the last row is the largest manifest (10^5 cameras).
+BENCHMARK(BM_Open)->Args({10, 10})->Args({100, 100})->Args({1000, 100})->Args({100000, 1})
+    ->UseManualTime()->Iterations(3)->Unit(benchmark::kMillisecond);
+
+// Plays for `seconds` of wall time at 30 fps (sleeping to each display deadline, like vsync), switching
+// camera every 10th frame, and reports the engine's switch latencies.
+void BM_SwitchLatency(benchmark::State& state) {
+  const bool prefetch = state.range(0) != 0;
+  const fs::path& db = real_db();
+  constexpr int kTicks = 150;  // 5 s
+  std::vector<double> latencies, frame_ms;
+  std::int64_t hits = 0, switches = 0;
+  for (auto _ : state) {
+    EngineOptions o;
+    o.prefetch = prefetch;
+    o.prefetch_threads = 2;
+    Engine engine(db, o);
+    engine.current_frame();
+    const double start = now_s();
+    for (int k = 0; k < kTicks; ++k) {
+      const double deadline = start + k / 30.0;
+      const double wait = deadline - now_s();
+      if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+      engine.tick();
+      if (k % 10 == 5) engine.apply((k / 10) % 3 == 2 ? Action::camera_left : Action::camera_right);
+      const double t0 = now_s();
+      benchmark::DoNotOptimize(engine.current_frame());
+      frame_ms.push_back((now_s() - t0) * 1e3);
+    }
+    const Statistics st = engine.statistics();
+    for (const auto& s : st.switches) {
+      latencies.push_back(s.latency_ms);
+      hits += s.cache_hit;
+      ++switches;
+    }
+  }
+  const Summary s = summarize(latencies), f = summarize(frame_ms);
+  state.counters["switches"] = double(switches);
+  state.counters["switch_hit_pct"] = switches ? 100.0 * double(hits) / double(switches) : 0;
+  state.counters["switch_p50_ms"] = s.p50;
+  state.counters["switch_p99_ms"] = s.p99;
+  state.counters["switch_max_ms"] = s.max;
+  state.counters["frame_p99_ms"] = f.p99;
+}
+BENCHMARK(BM_SwitchLatency)->Arg(1)->Arg(0)->ArgName("prefetch")->Iterations(1)->Unit(benchmark::kSecond);
+
+// Sequential decode of one 920x896 stream on the calling thread (the decoder is single-threaded).
+void BM_DecodeRate(benchmark::State& state) {
+  const auto database = store::Database::open(real_db());
+  auto reader = database.stream(0, 0);
+  video::YuvFrame frame;
+  std::int64_t frames = 0;
+  double seconds = 0;
+  for (auto _ : state) {
+    const double t0 = now_s();
+    for (int i = 0; i < reader->frame_count(); ++i) reader->read(i, frame);
+    seconds += now_s() - t0;
+    frames += reader->frame_count();
+  }
+  state.counters["decode_fps"] = double(frames) / seconds;
+  state.counters["ms_per_frame"] = 1e3 * seconds / double(frames);
+}
+BENCHMARK(BM_DecodeRate)->Iterations(4)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
