@@ -74,9 +74,13 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
 
   if (show_panel) {
     // Status panel, top right: the top-left corner belongs to the frame (and its stamp in tests).
+    // At most ~60 % of the width (and 440 px) so long messages wrap instead of covering the frame.
+    const float panel_w = std::max(std::min(vw * 0.6f, 440.f), std::min(vw, 240.f));
     ImGui::SetNextWindowPos(ImVec2(vw - pad, pad), ImGuiCond_Always, ImVec2(1, 0));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(panel_w, vh));
     ImGui::SetNextWindowBgAlpha(0.72f);
     if (ImGui::Begin("##status", nullptr, kOverlayFlags)) {
+      ImGui::PushTextWrapPos(panel_w - 2 * ImGui::GetStyle().WindowPadding.x);
       panel_drawn_ = true;
       remember_window();
       const auto& sel = info.selection;
@@ -101,11 +105,19 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       const std::int64_t shown = info.cache_hits + info.cache_misses;
       ImGui::Text("cache %s / %s, hits %.0f%%", megabytes(info.cache_bytes).c_str(),
                   megabytes(info.cache_capacity).c_str(), shown ? 100.0 * double(info.cache_hits) / double(shown) : 0.0);
-      if (info.recording) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "REC %s", info.recording_path.c_str());
-      if (info.status != player::FrameStatus::ok)
-        ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "stream %s: %s", std::string(player::to_string(info.status)).c_str(),
+      if (info.recording) {
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
+        ImGui::TextWrapped("REC %s", info.recording_path.c_str());
+        ImGui::PopStyleColor();
+      }
+      if (info.status != player::FrameStatus::ok) {
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.4f, 0.3f, 1));
+        ImGui::TextWrapped("stream %s: %s", std::string(player::to_string(info.status)).c_str(),
                            info.status_message.c_str());
+        ImGui::PopStyleColor();
+      }
       ImGui::TextDisabled("H / F1: help   renderer: %s", info.renderer.c_str());
+      ImGui::PopTextWrapPos();
     }
     ImGui::End();
 

@@ -443,6 +443,7 @@ WindowResult WindowApp::run() {
     result.view_w = int(std::lround(fr.w));
     result.view_h = int(std::lround(fr.h));
     result.hud_drawn = hud_.panel_drawn();
+    result.status = std::string(player::to_string(shown.status));
   }
   if (recorder_.active()) {
     const std::string path = recorder_.path();

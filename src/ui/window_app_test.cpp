@@ -100,6 +100,12 @@ Image crop(const Image& src, int x0, int y0, int w, int h) {
   return out;
 }
 
+// PANOPTES_UI_TEST_KEEP=DIR keeps the window screenshots for a human to look at.
+void keep_for_humans(const std::filesystem::path& png, const std::string& name) {
+  if (const char* keep = std::getenv("PANOPTES_UI_TEST_KEEP"))
+    std::filesystem::copy_file(png, std::filesystem::path(keep) / name, std::filesystem::copy_options::overwrite_existing);
+}
+
 class WindowTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -155,10 +161,7 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   EXPECT_EQ(r.view_h, kH);
   EXPECT_NE(r.summary.find("switches"), std::string::npos);
 
-  // PANOPTES_UI_TEST_KEEP=DIR keeps the screenshot for a human to look at.
-  if (const char* keep = std::getenv("PANOPTES_UI_TEST_KEEP"))
-    std::filesystem::copy_file(o.screenshot_on_exit, std::filesystem::path(keep) / "ui_window_test.png",
-                               std::filesystem::copy_options::overwrite_existing);
+  keep_for_humans(o.screenshot_on_exit, "ui_window_test.png");
   const Image shot = read_png(o.screenshot_on_exit.string());
   ASSERT_EQ(shot.width, kW);
   ASSERT_EQ(shot.height, kH);
@@ -275,6 +278,33 @@ TEST_F(WindowTest, MouseDragSnapsWheelZoomsAroundTheCursorRightDragPans) {
   EXPECT_EQ(r.view_h, 432);
   EXPECT_EQ(r.view_x, -30);
   EXPECT_EQ(r.view_y, -40);
+}
+
+TEST_F(WindowTest, MissingStreamShowsThePlaceholderAndPlaybackGoesOn) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  const auto db = dir_->path / "db-missing";
+  std::filesystem::copy(dir_->path / "db", db, std::filesystem::copy_options::recursive);
+  const auto movie = store::Database::open(db).stream_path(3, 0);
+  ASSERT_TRUE(std::filesystem::remove(movie));
+  WindowOptions o;
+  o.software_renderer = true;
+  o.vsync = false;
+  o.virtual_time = true;  // playing: 20 ticks of 1/30 s at 30 fps advance 19 frames (looping over 6)
+  o.camera = 3;
+  o.max_frames = 20;
+  o.screenshot_on_exit = dir_->path / "missing.png";
+  const WindowResult r = run_window(db, o);
+  EXPECT_EQ(r.status, "missing");
+  EXPECT_EQ(r.camera, 3);
+  EXPECT_EQ(r.frame, 19 % kFrames);
+  keep_for_humans(o.screenshot_on_exit, "ui_window_test_missing.png");
+  const Image shot = read_png(o.screenshot_on_exit.string());
+  EXPECT_FALSE(read_frame_stamp(shot)) << "a placeholder must not look like data";
+  // The placeholder is reddish where the grey data frame would be.
+  int reddish = 0;
+  for (int y = kH / 3; y < kH / 2; ++y)
+    for (int x = 0; x < kW / 4; ++x) reddish += shot.at(x, y)[0] > shot.at(x, y)[2] + 20;
+  EXPECT_GT(reddish, kW / 4 * (kH / 2 - kH / 3) / 2);
 }
 
 TEST_F(WindowTest, MissingDisplayIsAClearError) {
