@@ -183,6 +183,35 @@ double writer_memory_mb(const VideoSettings& s, int writers) {
   return bytes < 0 ? -1 : bytes / 1e6;
 }
 
+// Resident growth per open reader that has decoded one frame (the player keeps many open), measured
+// like the writers in a fresh process (--reader-memory).
+double reader_memory_child(int gop, int readers) {
+  const std::string path = write_movie("readers.mp4", with_gop(gop), 10);
+  std::vector<std::unique_ptr<MovieReader>> open;
+  std::vector<YuvFrame> frames(readers);
+  open.reserve(readers);
+  const double before = rss_bytes();
+  for (int i = 0; i < readers; ++i) {
+    open.push_back(std::make_unique<MovieReader>(path));
+    open.back()->read(5, frames[i]);
+  }
+  return (rss_bytes() - before) / readers;
+}
+
+void BM_ReaderMemory(benchmark::State& state) {
+  for (auto _ : state) {
+    const std::string cmd = "/proc/" + std::to_string(getpid()) + "/exe --reader-memory " +
+                            std::to_string(state.range(0)) + " 20";
+    FILE* p = popen(cmd.c_str(), "r");
+    double bytes = -1;
+    if (!p || std::fscanf(p, "%lf", &bytes) != 1) bytes = -1;
+    if (p) pclose(p);
+    if (bytes < 0) state.SkipWithError("the --reader-memory child failed");
+    state.counters["MB_per_reader"] = bytes / 1e6;  // includes the reader's decoded YUV frame (1.24 MB)
+  }
+}
+BENCHMARK(BM_ReaderMemory)->Arg(1)->Arg(10)->Iterations(1)->Unit(benchmark::kMillisecond);
+
 void measure_writer_memory(benchmark::State& state, const VideoSettings& s, int writers) {
   for (auto _ : state) {
     const double mb = writer_memory_mb(s, writers);
@@ -254,6 +283,10 @@ int main(int argc, char** argv) {
     s.crf = std::atoi(argv[3]);
     s.gop = std::atoi(argv[4]);
     std::printf("%.0f\n", writer_memory_child(s, std::atoi(argv[5])));
+    return 0;
+  }
+  if (argc == 4 && std::string(argv[1]) == "--reader-memory") {
+    std::printf("%.0f\n", reader_memory_child(std::atoi(argv[2]), std::atoi(argv[3])));
     return 0;
   }
   benchmark::Initialize(&argc, argv);
