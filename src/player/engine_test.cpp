@@ -415,3 +415,56 @@ TEST(EngineErrors, ClearErrorsForBadInput) {
 
 }  // namespace
 }  // namespace panoptes::player
+
+namespace panoptes::player {
+namespace {
+
+// A rig with two patches and two shells, like a Yin-Yang seam: the graph's edges, not geometry,
+// decide where a key goes — including asymmetric seam edges, poles without an `up`, and shell links.
+TEST(Navigation, FollowsTheGraphAcrossSeamsPolesAndShells) {
+  TempDir dir("player-seam");
+  store::Manifest m = testing::ring_manifest(6, 1);
+  // cameras 0..2 = patch A (outer shell), 3..5 = patch B; camera 5 is an inner-shell camera.
+  auto& g = m.graph.neighbours;
+  g[0] = {.left = 2, .right = 1, .up = 3, .down = -1, .in = 5, .out = -1};  // pole: no down
+  g[1] = {.left = 0, .right = 2, .up = 4, .down = -1, .in = -1, .out = -1};
+  g[2] = {.left = 1, .right = 0, .up = 3, .down = -1, .in = -1, .out = -1};  // seam: up goes to B's 3 too
+  g[3] = {.left = 4, .right = 4, .up = -1, .down = 2, .in = -1, .out = -1};  // asymmetric: 3.down = 2, 0.up = 3
+  g[4] = {.left = 3, .right = 3, .up = -1, .down = 1, .in = -1, .out = -1};
+  g[5] = {.left = -1, .right = -1, .up = -1, .down = -1, .in = -1, .out = 0};
+  m.cameras[5].labels.shell = 1;
+  testing::write_stamped(dir.path, m, 3);
+  EngineOptions o;
+  o.start_playing = false;
+  o.prefetch = false;
+  Engine e(dir.path, o);
+  const auto go = [&](Action a) {
+    const bool moved = e.apply(a);
+    const auto s = read_frame_stamp(video::MovieReader::to_rgba(*e.current_frame().frame));
+    EXPECT_TRUE(s.has_value());
+    EXPECT_EQ(s ? int(s->camera) : -1, e.selection().camera);
+    return moved;
+  };
+  EXPECT_FALSE(go(Action::camera_down));  // pole
+  EXPECT_EQ(e.selection().camera, 0);
+  EXPECT_TRUE(go(Action::camera_left));   // wrap-around
+  EXPECT_EQ(e.selection().camera, 2);
+  EXPECT_TRUE(go(Action::camera_up));     // across the seam
+  EXPECT_EQ(e.selection().camera, 3);
+  EXPECT_TRUE(go(Action::camera_down));   // back over the seam, but to 2 (the edge says so)
+  EXPECT_EQ(e.selection().camera, 2);
+  EXPECT_TRUE(go(Action::camera_right));
+  EXPECT_EQ(e.selection().camera, 0);
+  EXPECT_TRUE(go(Action::shell_in));
+  EXPECT_EQ(e.selection().camera, 5);
+  EXPECT_FALSE(go(Action::shell_in));
+  EXPECT_FALSE(go(Action::camera_right));
+  EXPECT_TRUE(go(Action::shell_out));
+  EXPECT_EQ(e.selection().camera, 0);
+  // Snapping keeps to the current shell: camera 5 sits on the ring at 300°, but 0 is on shell 0.
+  EXPECT_EQ(e.nearest_camera({std::cos(-1.0), std::sin(-1.0), 0}, 0), 0);
+  EXPECT_EQ(e.nearest_camera({std::cos(-1.0), std::sin(-1.0), 0}), 5);
+}
+
+}  // namespace
+}  // namespace panoptes::player
