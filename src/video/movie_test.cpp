@@ -475,6 +475,12 @@ TEST_F(MovieTest, FfprobeAcceptsTheMovie) {
                           "nb_read_packets -of csv=p=0 '" + path + "'", &status);
     EXPECT_EQ(status, 0) << out;
     EXPECT_EQ(out, "h264,160,90,yuv420p,12\n");
+    // x264's version SEI is kept once, not in every frame of an intra-only movie.
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::size_t copies = 0;
+    for (auto at = bytes.find("x264 - core"); at != std::string::npos; at = bytes.find("x264 - core", at + 1)) ++copies;
+    EXPECT_EQ(copies, 1u);
     if (std::system("command -v ffmpeg > /dev/null 2>&1") == 0) {
       out = run("ffmpeg -v warning -i '" + path + "' -f null -", &status);
       EXPECT_EQ(status, 0) << out;

@@ -18,6 +18,38 @@ extern "C" {
 
 namespace panoptes::video {
 
+namespace {
+
+// Removes SEI NAL units (type 6) from an Annex B packet, in place. Each fresh x264 encoder puts its
+// version-and-options SEI (~550 bytes) into its first packet; intra-only movies get a fresh encoder
+// per frame, and the copy in every frame after the first is pure overhead (15 % of a 320x240 frame).
+void strip_sei(AVPacket* pkt) {
+  std::uint8_t* d = pkt->data;
+  const int n = pkt->size;
+  auto start_code = [&](int from) {
+    for (int k = from; k + 2 < n; ++k)
+      if (d[k] == 0 && d[k + 1] == 0 && d[k + 2] == 1) return k;
+    return n;
+  };
+  int sc = start_code(0);
+  if (sc > 1 || (sc == 1 && d[0] != 0)) return;  // not Annex B: leave it alone
+  int out = 0;
+  while (sc < n) {
+    const int begin = sc > 0 && d[sc - 1] == 0 ? sc - 1 : sc;  // a 4-byte start code's zero_byte
+    const int next = start_code(sc + 3);
+    const int end = next < n && d[next - 1] == 0 ? next - 1 : next;
+    const bool sei = sc + 3 < n && (d[sc + 3] & 0x1f) == 6;
+    if (!sei) {
+      std::memmove(d + out, d + begin, std::size_t(end - begin));
+      out += end - begin;
+    }
+    sc = next;
+  }
+  if (out > 0) pkt->size = out;
+}
+
+}  // namespace
+
 struct MovieWriter::Impl {
   std::string path;
   int width = 0, height = 0, padded_width = 0, padded_height = 0;
@@ -168,6 +200,11 @@ struct MovieWriter::Impl {
       if (ret == AVERROR(EAGAIN) || ret == AVERROR_EOF) return;
       if (ret < 0) throw Error("movie " + path + ": encoding failed: " + av_error_string(ret));
       if (pkt->duration <= 0) pkt->duration = 1;  // one frame; the muxer needs it for the last sample
+      if (transient && packets_out > 0) {
+        ret = av_packet_make_writable(pkt);
+        if (ret < 0) throw Error("movie " + path + ": out of memory");
+        strip_sei(pkt);
+      }
       av_packet_rescale_ts(pkt, enc->time_base, stream->time_base);
       pkt->stream_index = stream->index;
       ret = av_write_frame(fmt, pkt);
