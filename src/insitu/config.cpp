@@ -1,0 +1,377 @@
+#include "insitu/config.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "camera/rig_spec.hpp"
+#include "core/error.hpp"
+
+namespace panoptes::insitu {
+
+namespace {
+
+struct Ctx {
+  std::string source;
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw Error(source + ": " + key + ": " + what);
+  }
+};
+
+std::string join(const std::set<std::string>& s) {
+  std::string out;
+  for (const auto& a : s) out += (out.empty() ? "" : ", ") + a;
+  return out;
+}
+
+void only_keys(const Ctx& c, const toml::table& t, const std::string& where, const std::set<std::string>& allowed) {
+  for (const auto& [k, v] : t) {
+    (void)v;
+    if (!allowed.count(std::string(k.str())))
+      c.fail(where.empty() ? std::string(k.str()) : where + "." + std::string(k.str()),
+             "unknown key (expected one of: " + join(allowed) + ")");
+  }
+}
+
+const toml::table* table(const Ctx& c, const toml::table& t, const std::string& key) {
+  const auto* n = t.get(key);
+  if (!n) return nullptr;
+  if (!n->is_table()) c.fail(key, "expected a table [" + key + "]");
+  return n->as_table();
+}
+
+double number_of(const Ctx& c, const toml::node& n, const std::string& key) {
+  if (auto v = n.value_exact<double>()) {
+    if (!std::isfinite(*v)) c.fail(key, "expected a finite number");
+    return *v;
+  }
+  if (auto v = n.value_exact<int64_t>()) return double(*v);
+  c.fail(key, "expected a number");
+}
+
+double num(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, double def) {
+  const auto* n = t.get(key);
+  return n ? number_of(c, *n, where + key) : def;
+}
+
+long long integer(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def) {
+  const auto* n = t.get(key);
+  if (!n) return def;
+  if (auto v = n->value_exact<int64_t>()) return *v;
+  c.fail(where + key, "expected an integer");
+}
+
+bool boolean(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, bool def) {
+  const auto* n = t.get(key);
+  if (!n) return def;
+  if (auto v = n->value_exact<bool>()) return *v;
+  c.fail(where + key, "expected true or false");
+}
+
+std::string str(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where,
+                const std::string& def) {
+  const auto* n = t.get(key);
+  if (!n) return def;
+  if (auto v = n->value_exact<std::string>()) return *v;
+  c.fail(where + key, "expected a string");
+}
+
+std::vector<double> numbers(const Ctx& c, const toml::node& n, const std::string& key) {
+  const auto* a = n.as_array();
+  if (!a) c.fail(key, "expected an array of numbers");
+  std::vector<double> v;
+  for (std::size_t i = 0; i < a->size(); ++i) v.push_back(number_of(c, *a->get(i), key + "[" + std::to_string(i) + "]"));
+  return v;
+}
+
+std::array<float, 3> colour(const Ctx& c, const toml::node& n, const std::string& key) {
+  const auto v = numbers(c, n, key);
+  if (v.size() != 3) c.fail(key, "expected [r, g, b] with three numbers in [0, 1]");
+  for (double x : v)
+    if (!(x >= 0 && x <= 1)) c.fail(key, "expected [r, g, b] with three numbers in [0, 1]");
+  return {float(v[0]), float(v[1]), float(v[2])};
+}
+
+WindowConfig window_of(const Ctx& c, const toml::node& n, const std::string& key, bool relative) {
+  const auto v = numbers(c, n, key);
+  if (v.size() != 2 || !(v[0] < v[1])) c.fail(key, "expected [lo, hi] with lo < hi");
+  return {v[0], v[1], relative};
+}
+
+TaskConfig parse_task(const Ctx& c, const toml::table& t, std::size_t index) {
+  const std::string where = "task[" + std::to_string(index) + "].";
+  TaskConfig tc;
+  const std::string type = str(c, t, "type", where, "volume");
+  static const std::set<std::string> common{"type", "name", "field", "fields"};
+  std::set<std::string> allowed = common;
+  if (type == "volume") {
+    tc.kind = TaskConfig::Kind::volume;
+    allowed.insert({"preset", "extinction_scale", "window", "windows", "relative", "axis_name"});
+  } else if (type == "volume2") {
+    tc.kind = TaskConfig::Kind::volume2;
+    allowed.insert({"preset", "preset2", "extinction_scale", "window", "window2", "relative"});
+  } else if (type == "isosurface") {
+    tc.kind = TaskConfig::Kind::isosurface;
+    allowed.insert({"isovalues", "isovalue", "relative", "colour", "axis_name"});
+  } else if (type == "slice") {
+    tc.kind = TaskConfig::Kind::slice;
+    allowed.insert({"preset", "window", "relative", "axis", "position", "positions", "axis_name"});
+  } else {
+    c.fail(where + "type", "\"" + type + "\"; expected volume, volume2, isosurface or slice");
+  }
+  only_keys(c, t, where.substr(0, where.size() - 1), allowed);
+  tc.name = str(c, t, "name", where, "");
+  if (tc.name.empty()) c.fail(where + "name", "missing (every task needs a unique name)");
+  if (const auto* f = t.get("field")) {
+    if (t.get("fields")) c.fail(where + "field", "give either field or fields, not both");
+    auto s = f->value_exact<std::string>();
+    if (!s || s->empty()) c.fail(where + "field", "expected a field name");
+    tc.fields = {*s};
+  } else if (const auto* fs = t.get("fields")) {
+    const auto* a = fs->as_array();
+    if (!a) c.fail(where + "fields", "expected an array of field names");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      auto s = a->get(i)->value_exact<std::string>();
+      if (!s || s->empty()) c.fail(where + "fields", "expected an array of field names");
+      tc.fields.push_back(*s);
+    }
+  }
+  const std::size_t want = tc.kind == TaskConfig::Kind::volume2 ? 2 : 1;
+  if (tc.fields.size() != want)
+    c.fail(where + (want == 2 ? "fields" : "field"),
+           want == 2 ? "a volume2 task reads exactly two fields: fields = [\"a\", \"b\"]"
+                     : "this task reads exactly one field: field = \"name\"");
+  const bool relative = boolean(c, t, "relative", where, true);
+  tc.axis = str(c, t, "axis_name", where, "");
+  auto check_preset = [&](const std::string& key, const std::string& p) {
+    const auto names = render::TransferFunction::preset_names();
+    if (std::find(names.begin(), names.end(), p) == names.end()) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      c.fail(where + key, "unknown preset \"" + p + "\" (expected one of: " + list + ")");
+    }
+  };
+  switch (tc.kind) {
+    case TaskConfig::Kind::volume:
+    case TaskConfig::Kind::volume2:
+      tc.preset = str(c, t, "preset", where, tc.kind == TaskConfig::Kind::volume2 ? "p-wave" : "hot");
+      check_preset("preset", tc.preset);
+      tc.extinction_scale = float(num(c, t, "extinction_scale", where, 1));
+      if (!(tc.extinction_scale > 0)) c.fail(where + "extinction_scale", "expected a number > 0");
+      if (const auto* ws = t.get("windows")) {
+        if (t.get("window")) c.fail(where + "windows", "give either window or windows, not both");
+        const auto* a = ws->as_array();
+        if (!a || a->empty()) c.fail(where + "windows", "expected an array of [lo, hi] pairs");
+        tc.windows.clear();
+        for (std::size_t i = 0; i < a->size(); ++i)
+          tc.windows.push_back(window_of(c, *a->get(i), where + "windows[" + std::to_string(i) + "]", relative));
+      } else {
+        tc.windows = {t.get("window") ? window_of(c, *t.get("window"), where + "window", relative)
+                                      : WindowConfig{0, 1, relative}};
+      }
+      if (tc.kind == TaskConfig::Kind::volume2) {
+        tc.preset2 = str(c, t, "preset2", where, "s-wave");
+        check_preset("preset2", tc.preset2);
+        tc.window2 = t.get("window2") ? window_of(c, *t.get("window2"), where + "window2", relative)
+                                      : WindowConfig{0, 1, relative};
+      }
+      break;
+    case TaskConfig::Kind::isosurface:
+      tc.iso_relative = boolean(c, t, "relative", where, false);
+      if (const auto* v = t.get("isovalues")) {
+        if (t.get("isovalue")) c.fail(where + "isovalues", "give either isovalue or isovalues, not both");
+        tc.isovalues = numbers(c, *v, where + "isovalues");
+      } else if (const auto* v1 = t.get("isovalue")) {
+        tc.isovalues = {number_of(c, *v1, where + "isovalue")};
+      }
+      if (tc.isovalues.empty()) c.fail(where + "isovalues", "missing (at least one isovalue is required)");
+      if (const auto* col = t.get("colour")) tc.colour = colour(c, *col, where + "colour");
+      break;
+    case TaskConfig::Kind::slice: {
+      tc.preset = str(c, t, "preset", where, "diverging");
+      check_preset("preset", tc.preset);
+      tc.windows = {t.get("window") ? window_of(c, *t.get("window"), where + "window", relative)
+                                    : WindowConfig{-1, 1, relative}};
+      const std::string axis = str(c, t, "axis", where, "z");
+      if (axis != "x" && axis != "y" && axis != "z") c.fail(where + "axis", "\"" + axis + "\"; expected x, y or z");
+      tc.slice_axis = axis[0] - 'x';
+      if (const auto* p = t.get("positions")) {
+        if (t.get("position")) c.fail(where + "positions", "give either position or positions, not both");
+        tc.slice_positions = numbers(c, *p, where + "positions");
+      } else if (const auto* p1 = t.get("position")) {
+        tc.slice_positions = {number_of(c, *p1, where + "position")};
+      }
+      if (tc.slice_positions.empty()) c.fail(where + "positions", "expected at least one position");
+      for (double f : tc.slice_positions)
+        if (!(f >= 0 && f <= 1)) c.fail(where + "positions", "expected fractions of the domain in [0, 1]");
+      break;
+    }
+  }
+  return tc;
+}
+
+}  // namespace
+
+void SessionConfig::validate() const {
+  if (output_dir.empty()) throw Error("output.dir: must not be empty");
+  if (width < 2 || height < 2 || width > 16384 || height > 16384)
+    throw Error("image.width/height: " + std::to_string(width) + "x" + std::to_string(height) +
+                "; expected 2..16384 pixels each");
+  (void)camera::RigSpec::parse(rig);  // throws naming the text
+  if (tasks.empty()) throw Error("task: no [[task]] given; at least one visualization task is required");
+  std::set<std::string> names;
+  for (const TaskConfig& t : tasks) {
+    if (!names.insert(t.name).second) throw Error("task \"" + t.name + "\": the name is used twice");
+    if (t.kind == TaskConfig::Kind::isosurface && t.isovalues.empty())
+      throw Error("task \"" + t.name + "\": no isovalue");
+  }
+  if ((schedule.every_steps > 0) == (schedule.every_time > 0))
+    throw Error("schedule: give exactly one of every_steps (> 0) or every_time (> 0)");
+  if (schedule.every_time < 0 || !std::isfinite(schedule.every_time))
+    throw Error("schedule.every_time: expected a finite number > 0");
+  if (schedule.max_snapshots < 0) throw Error("schedule.max_snapshots: expected 0 (unlimited) or more");
+  if (!(percentile > 0 && percentile <= 1)) throw Error("render.percentile: expected a value in (0, 1]");
+  if (!(render.sample_distance >= 0.01 && render.sample_distance <= 16))
+    throw Error("render.sample_distance: " + std::to_string(render.sample_distance) + "; expected 0.01..16 voxels");
+  video.validate();
+}
+
+SessionConfig parse_session_config(const toml::table& root, const std::string& source,
+                                   const std::vector<std::string>& foreign_sections) {
+  const Ctx c{source};
+  std::set<std::string> allowed{"output", "image", "rig", "schedule", "video", "render", "task"};
+  for (const auto& f : foreign_sections) allowed.insert(f);
+  only_keys(c, root, "", allowed);
+  SessionConfig s;
+  if (const auto* o = table(c, root, "output")) {
+    only_keys(c, *o, "output", {"dir", "overwrite", "title", "units"});
+    s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
+    s.overwrite = boolean(c, *o, "overwrite", "output.", false);
+    s.title = str(c, *o, "title", "output.", s.title);
+    s.units = str(c, *o, "units", "output.", "");
+  }
+  if (const auto* im = table(c, root, "image")) {
+    only_keys(c, *im, "image", {"width", "height", "background", "outline"});
+    s.width = int(integer(c, *im, "width", "image.", s.width));
+    s.height = int(integer(c, *im, "height", "image.", s.height));
+    if (s.width < 2 || s.height < 2 || s.width > 16384 || s.height > 16384)
+      c.fail("image.width/height", std::to_string(s.width) + "x" + std::to_string(s.height) +
+                                       " pixels; expected 2..16384 each");
+    if (const auto* bg = im->get("background")) s.background = colour(c, *bg, "image.background");
+    s.outline = boolean(c, *im, "outline", "image.", true);
+  }
+  if (const auto* r = table(c, root, "rig")) {
+    only_keys(c, *r, "rig", {"spec"});
+    s.rig = str(c, *r, "spec", "rig.", s.rig);
+    try {
+      (void)camera::RigSpec::parse(s.rig);
+    } catch (const std::exception& e) {
+      c.fail("rig.spec", e.what());
+    }
+  }
+  if (const auto* sc = table(c, root, "schedule")) {
+    only_keys(c, *sc, "schedule", {"every_steps", "every_time", "max_snapshots"});
+    const bool has_time = sc->get("every_time") != nullptr;
+    s.schedule.every_steps = integer(c, *sc, "every_steps", "schedule.", has_time ? 0 : s.schedule.every_steps);
+    s.schedule.every_time = num(c, *sc, "every_time", "schedule.", 0);
+    s.schedule.max_snapshots = int(integer(c, *sc, "max_snapshots", "schedule.", 0));
+    if (s.schedule.every_steps < 0) c.fail("schedule.every_steps", "expected an integer > 0");
+    if (s.schedule.every_time < 0) c.fail("schedule.every_time", "expected a time > 0");
+    if ((s.schedule.every_steps > 0) == (s.schedule.every_time > 0))
+      c.fail("schedule", "give exactly one of every_steps (> 0) or every_time (> 0)");
+    if (s.schedule.max_snapshots < 0) c.fail("schedule.max_snapshots", "expected 0 (unlimited) or more");
+  }
+  if (const auto* v = table(c, root, "video")) {
+    only_keys(c, *v, "video", {"crf", "preset", "gop", "threads", "fps"});
+    s.video.crf = int(integer(c, *v, "crf", "video.", s.video.crf));
+    s.video.preset = str(c, *v, "preset", "video.", s.video.preset);
+    s.video.gop = int(integer(c, *v, "gop", "video.", s.video.gop));
+    s.video.threads = int(integer(c, *v, "threads", "video.", s.video.threads));
+    s.video.fps = num(c, *v, "fps", "video.", s.video.fps);
+    try {
+      s.video.validate();
+    } catch (const std::exception& e) {
+      c.fail("video", e.what());
+    }
+  }
+  if (const auto* r = table(c, root, "render")) {
+    only_keys(c, *r, "render", {"sample_distance", "percentile", "skip_empty", "termination_alpha"});
+    s.render.sample_distance = num(c, *r, "sample_distance", "render.", s.render.sample_distance);
+    if (!(s.render.sample_distance >= 0.01 && s.render.sample_distance <= 16))
+      c.fail("render.sample_distance", "expected 0.01..16 voxels");
+    s.percentile = num(c, *r, "percentile", "render.", s.percentile);
+    if (!(s.percentile > 0 && s.percentile <= 1)) c.fail("render.percentile", "expected a value in (0, 1]");
+    s.render.skip_empty = boolean(c, *r, "skip_empty", "render.", true);
+    s.render.termination_alpha = float(num(c, *r, "termination_alpha", "render.", s.render.termination_alpha));
+    if (!(s.render.termination_alpha > 0.5f && s.render.termination_alpha <= 1.0f))
+      c.fail("render.termination_alpha", "expected a value in (0.5, 1]");
+  }
+  if (const auto* t = root.get("task")) {
+    const auto* a = t->as_array();
+    if (!a) c.fail("task", "expected an array of tables [[task]]");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const auto* tt = a->get(i)->as_table();
+      if (!tt) c.fail("task[" + std::to_string(i) + "]", "expected a table [[task]]");
+      s.tasks.push_back(parse_task(c, *tt, i));
+    }
+  }
+  if (s.tasks.empty()) c.fail("task", "no [[task]] given; at least one visualization task is required");
+  std::set<std::string> names;
+  for (const auto& t : s.tasks)
+    if (!names.insert(t.name).second) c.fail("task", "the name \"" + t.name + "\" is used twice");
+  return s;
+}
+
+SessionConfig parse_session_config_text(const std::string& text, const std::string& source,
+                                        const std::vector<std::string>& foreign_sections) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << source << ": TOML syntax error at line " << e.source().begin.line << ": " << e.description();
+    throw Error(s.str());
+  }
+  return parse_session_config(root, source, foreign_sections);
+}
+
+SessionConfig load_session_config(const std::string& path, const std::vector<std::string>& foreign_sections) {
+  std::ifstream in(path);
+  if (!in) throw FileError(path, "cannot open the configuration file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_session_config_text(ss.str(), path, foreign_sections);
+}
+
+const char* config_keys_help() {
+  return R"(IN-SITU CONFIGURATION (TOML). Unknown keys, wrong types and impossible values are errors.
+[output]    dir = "panoptes_out" (database directory); overwrite = false; title = "in-situ visualization";
+            units = "" (length unit of the grid)
+[image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box)
+[rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,
+            optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R)
+[schedule]  every_steps = 10 | every_time = DT (exactly one); max_snapshots = 0 (unlimited)
+[video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4)
+[render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid
+            whose running maximum is the reference "ref" of relative windows); skip_empty = true;
+            termination_alpha = 0.998
+[[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |
+            "isosurface" | "slice"; field = "name" (volume2: fields = ["a", "b"])
+  volume:     preset = "hot" (p-wave, s-wave, diverging, grayscale, hot, rainbow); extinction_scale = 1;
+              window = [lo, hi] (default [0, 1]) or windows = [[lo, hi], ...] (a sweep: one task per window
+              on axis "<name> window"); relative = true (window in multiples of ref) | false (absolute)
+  volume2:    preset = "p-wave", preset2 = "s-wave", window = [0, 1], window2 = [0, 1], relative = true,
+              extinction_scale = 1 (the paper's p-wave orange + s-wave green in one image)
+  isosurface: isovalue = v or isovalues = [v1, v2, ...] (a sweep on axis "<name> isovalue");
+              relative = false (true: values are fractions of ref); colour = [0.85, 0.85, 0.85]
+  slice:      axis = "z" (x, y, z); position = 0.5 or positions = [...] (fractions of the domain; a sweep
+              on axis "<name> position"); preset = "diverging"; window = [-1, 1]; relative = true
+  Any sweep may set axis_name to name its axis.
+)";
+}
+
+}  // namespace panoptes::insitu

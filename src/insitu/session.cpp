@@ -1,0 +1,832 @@
+#include "insitu/session.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "camera/navigation.hpp"
+#include "camera/rig_spec.hpp"
+#include "core/error.hpp"
+#include "render/renderer.hpp"
+#include "store/database.hpp"
+
+namespace panoptes::insitu {
+
+using render::Index3;
+
+LocalBlock LocalBlock::slab(const render::GridGeometry& g, int axis, int parts, int index, int ghosts) {
+  if (axis < 0 || axis > 2 || parts < 1 || index < 0 || index >= parts || parts > g.dims[axis])
+    throw Error("LocalBlock::slab: axis " + std::to_string(axis) + ", part " + std::to_string(index) + " of " +
+                std::to_string(parts) + " does not fit " + std::to_string(g.dims[axis]) + " points");
+  LocalBlock b = whole(g);
+  const int n = g.dims[axis];
+  const int lo = int(std::int64_t(n) * index / parts), hi = int(std::int64_t(n) * (index + 1) / parts);
+  b.offset[axis] = lo;
+  b.extent[axis] = hi - lo;
+  b.ghost_lo[axis] = std::min(ghosts, lo);
+  b.ghost_hi[axis] = std::min(ghosts, n - hi);
+  return b;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct Box {
+  Index3 lo{0, 0, 0}, hi{0, 0, 0};
+  bool empty() const { return hi[0] <= lo[0] || hi[1] <= lo[1] || hi[2] <= lo[2]; }
+  std::int64_t size() const {
+    return empty() ? 0 : std::int64_t(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+  }
+  bool contains(const Box& o) const {
+    for (int a = 0; a < 3; ++a)
+      if (o.lo[a] < lo[a] || o.hi[a] > hi[a]) return false;
+    return true;
+  }
+};
+Box intersect(const Box& a, const Box& b) {
+  Box r;
+  for (int i = 0; i < 3; ++i) {
+    r.lo[i] = std::max(a.lo[i], b.lo[i]);
+    r.hi[i] = std::min(a.hi[i], b.hi[i]);
+  }
+  return r;
+}
+
+// What every rank knows about every rank's block.
+struct BlockInfo {
+  Box owned;      // owned points
+  Box available;  // owned + stored ghosts, clipped to the grid
+  Box required;   // the ghosted point range its brick needs (empty brick: empty)
+  render::Brick brick;
+  bool has_brick = false;
+};
+
+BlockInfo block_info(const render::GridGeometry& g, const LocalBlock& b) {
+  BlockInfo bi;
+  for (int a = 0; a < 3; ++a) {
+    bi.owned.lo[a] = b.offset[a];
+    bi.owned.hi[a] = b.offset[a] + b.extent[a];
+    bi.available.lo[a] = std::max(0, b.offset[a] - b.ghost_lo[a]);
+    bi.available.hi[a] = std::min(g.dims[a], b.offset[a] + b.extent[a] + b.ghost_hi[a]);
+    // Owned points [o, o+e) own the cells [o, min(o+e, dims−1)): the cell boxes of a point partition
+    // partition the cells.
+    bi.brick.lo[a] = b.offset[a];
+    bi.brick.hi[a] = std::min(b.offset[a] + b.extent[a], g.dims[a] - 1);
+  }
+  bi.has_brick = bi.brick.cells() > 0 && bi.brick.hi[0] > bi.brick.lo[0] && bi.brick.hi[1] > bi.brick.lo[1] &&
+                 bi.brick.hi[2] > bi.brick.lo[2];
+  if (bi.has_brick) {
+    const render::PointRange pr = render::required_points(g, bi.brick);
+    bi.required.lo = pr.lo;
+    bi.required.hi = pr.hi;
+  }
+  return bi;
+}
+
+// One rendered task: the renderer's spec plus how its window / isovalue follow the reference.
+struct Task {
+  render::TaskSpec spec;
+  bool relative = false, relative2 = false, iso_relative = false;
+  double iso_fraction = 0;
+  store::TaskEntry entry;
+};
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+std::string iso_time() {
+  char buf[32];
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::int64_t peak_rss() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return std::int64_t(u.ru_maxrss) * 1024;
+}
+
+}  // namespace
+
+struct Session::Impl {
+  SessionConfig cfg;
+  render::GridGeometry grid;
+  LocalBlock block;
+  int rank = 0, size = 1;
+#ifdef PANOPTES_HAVE_MPI
+  MPI_Comm comm = MPI_COMM_NULL;
+#endif
+  std::vector<BlockInfo> blocks;  // per rank
+  bool exchange_needed = false;   // some rank's stored ghosts do not cover its required range
+  std::vector<std::string> field_names;
+  std::vector<Task> tasks;
+  std::vector<store::ParameterAxis> axes_;
+  std::vector<render::TaskSpec> specs;  // per snapshot, references resolved
+  camera::Rig rig;
+  std::vector<camera::Camera> cameras;
+  std::optional<store::DatabaseWriter> writer;
+  std::vector<int> owned;
+  int snapshots = 0;
+  double next_time = 0;
+  bool finalized = false;
+  FrameObserver observer;
+
+  std::vector<std::vector<float>> buffers;  // per field, over blocks[rank].required
+  std::vector<render::PreparedField> prepared;
+  std::vector<render::RunningMax> references;
+  std::vector<std::vector<render::PartialImage>> partials;  // [slot][task]
+  std::vector<std::vector<char>> send_buf;                  // [slot]
+  std::vector<char> recv_buf;
+  std::vector<std::vector<render::PartialImage>> received;  // [rank][task]
+  std::vector<render::PartialImage> composited;
+  std::vector<Image> images;
+  std::int64_t frames_encoded = 0;
+  Timings time;
+
+  int owner(int camera) const { return camera % size; }
+  const BlockInfo& me() const { return blocks[std::size_t(rank)]; }
+
+  void barrier() {
+#ifdef PANOPTES_HAVE_MPI
+    if (size > 1) MPI_Barrier(comm);
+#endif
+  }
+
+  void init();
+  void build_tasks();
+  store::Manifest make_manifest() const;
+  void load_fields(const std::vector<FieldInput>& fields);
+  double global_percentile(int field);
+  void render_snapshot(int frame);
+  void checkpoint(double time);
+};
+
+void Session::Impl::init() {
+  cfg.validate();
+  grid.validate();
+  // Every rank's block, for ownership, bricks and the ghost exchange.
+  std::array<int, 12> mine{};
+  for (int a = 0; a < 3; ++a) {
+    mine[std::size_t(a)] = block.offset[a];
+    mine[std::size_t(3 + a)] = block.extent[a];
+    mine[std::size_t(6 + a)] = block.ghost_lo[a];
+    mine[std::size_t(9 + a)] = block.ghost_hi[a];
+  }
+  std::vector<int> all(12 * std::size_t(size));
+#ifdef PANOPTES_HAVE_MPI
+  if (size > 1)
+    MPI_Allgather(mine.data(), 12, MPI_INT, all.data(), 12, MPI_INT, comm);
+  else
+#endif
+    std::copy(mine.begin(), mine.end(), all.begin());
+  std::int64_t points = 0;
+  for (int r = 0; r < size; ++r) {
+    LocalBlock b;
+    for (int a = 0; a < 3; ++a) {
+      b.offset[a] = all[12 * std::size_t(r) + std::size_t(a)];
+      b.extent[a] = all[12 * std::size_t(r) + 3 + std::size_t(a)];
+      b.ghost_lo[a] = all[12 * std::size_t(r) + 6 + std::size_t(a)];
+      b.ghost_hi[a] = all[12 * std::size_t(r) + 9 + std::size_t(a)];
+      if (b.offset[a] < 0 || b.extent[a] < 0 || b.offset[a] + b.extent[a] > grid.dims[a] || b.ghost_lo[a] < 0 ||
+          b.ghost_hi[a] < 0)
+        throw Error("local block of rank " + std::to_string(r) + " (offset " + std::to_string(b.offset[a]) + ", extent " +
+                    std::to_string(b.extent[a]) + " on axis " + std::to_string(a) + ") lies outside the grid of " +
+                    std::to_string(grid.dims[a]) + " points or has negative ghosts");
+    }
+    blocks.push_back(block_info(grid, b));
+    points += blocks.back().owned.size();
+  }
+  const std::int64_t total = std::int64_t(grid.dims[0]) * grid.dims[1] * grid.dims[2];
+  bool overlap = false;
+  for (int r = 0; r < size; ++r)
+    for (int s = r + 1; s < size; ++s)
+      if (!intersect(blocks[std::size_t(r)].owned, blocks[std::size_t(s)].owned).empty()) overlap = true;
+  if (points != total || overlap)
+    throw Error("the local blocks of the " + std::to_string(size) + " ranks do not partition the grid's " +
+                std::to_string(total) + " points (they own " + std::to_string(points) + (overlap ? ", overlapping" : "") +
+                "): each point must be owned by exactly one rank");
+  for (const BlockInfo& b : blocks)
+    if (b.has_brick && !b.available.contains(b.required)) exchange_needed = true;
+
+  build_tasks();
+  const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
+  rig = camera::make_rig(cfg.rig, domain);
+  for (int c = 0; c < rig.size(); ++c) cameras.push_back(rig.camera(c, cfg.width, cfg.height));
+  for (int c = rank; c < rig.size(); c += size) owned.push_back(c);
+  references.resize(field_names.size());
+
+  // Rank 0 creates the directory and manifest first; the others then open their movies' writers.
+  const store::Manifest man = make_manifest();
+  if (rank == 0) {
+    store::WriterOptions o;
+    o.overwrite = cfg.overwrite;
+    o.owned_cameras = owned;
+    writer.emplace(store::DatabaseWriter::create(cfg.output_dir, man, o));
+  }
+  barrier();
+  if (rank != 0 && !owned.empty()) {
+    store::WriterOptions o;
+    o.owned_cameras = owned;
+    o.writes_manifest = false;
+    writer.emplace(store::DatabaseWriter::create(cfg.output_dir, man, o));
+  }
+  const int slots = size;
+  partials.assign(std::size_t(slots), std::vector<render::PartialImage>(tasks.size()));
+  send_buf.resize(std::size_t(slots));
+  received.assign(std::size_t(size), std::vector<render::PartialImage>(tasks.size()));
+  composited.resize(tasks.size());
+  images.resize(tasks.size());
+}
+
+void Session::Impl::build_tasks() {
+  auto field_index = [&](const std::string& name) {
+    auto it = std::find(field_names.begin(), field_names.end(), name);
+    if (it != field_names.end()) return int(it - field_names.begin());
+    field_names.push_back(name);
+    return int(field_names.size()) - 1;
+  };
+  std::vector<store::ParameterAxis> axes;
+  for (const TaskConfig& tc : cfg.tasks) {
+    const int f = field_index(tc.fields[0]);
+    const int f2 = tc.fields.size() > 1 ? field_index(tc.fields[1]) : -1;
+    auto window = [](const WindowConfig& w) {
+      return w.relative ? render::ValueWindow::relative_to(w.lo, w.hi) : render::ValueWindow::absolute(w.lo, w.hi);
+    };
+    std::size_t n = 1;
+    std::string axis_suffix;
+    std::vector<double> axis_values;
+    switch (tc.kind) {
+      case TaskConfig::Kind::volume:
+        n = tc.windows.size();
+        axis_suffix = "window";
+        for (const auto& w : tc.windows) axis_values.push_back(w.hi);
+        break;
+      case TaskConfig::Kind::volume2:
+        break;
+      case TaskConfig::Kind::isosurface:
+        n = tc.isovalues.size();
+        axis_suffix = "isovalue";
+        axis_values = tc.isovalues;
+        break;
+      case TaskConfig::Kind::slice:
+        n = tc.slice_positions.size();
+        axis_suffix = "position";
+        axis_values = tc.slice_positions;
+        break;
+    }
+    const std::string axis_name = tc.axis.empty() ? tc.name + " " + axis_suffix : tc.axis;
+    if (n > 1) axes.push_back({axis_name, axis_values, ""});
+    for (std::size_t i = 0; i < n; ++i) {
+      Task t;
+      t.entry.name = n > 1 ? tc.name + " " + fmt(axis_values[i]) : tc.name;
+      t.entry.fields = tc.fields;
+      if (n > 1) t.entry.axes = {{axis_name, int(i)}};
+      switch (tc.kind) {
+        case TaskConfig::Kind::volume: {
+          const WindowConfig& w = tc.windows[i];
+          t.spec = render::TaskSpec::volume(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale), window(w));
+          t.relative = w.relative;
+          t.entry.method = "volume";
+          t.entry.parameters = {{"preset", tc.preset}, {"window", {w.lo, w.hi}}, {"relative", w.relative},
+                                {"extinction_scale", tc.extinction_scale}};
+          break;
+        }
+        case TaskConfig::Kind::volume2: {
+          const WindowConfig& w = tc.windows[0];
+          t.spec = render::TaskSpec::volume2(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale),
+                                             window(w), f2,
+                                             render::TransferFunction::preset(tc.preset2, tc.extinction_scale),
+                                             window(tc.window2));
+          t.relative = w.relative;
+          t.relative2 = tc.window2.relative;
+          t.entry.method = "volume";
+          t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
+                                {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
+                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale}};
+          break;
+        }
+        case TaskConfig::Kind::isosurface:
+          t.spec = render::TaskSpec::isosurface(f, float(tc.isovalues[i]),
+                                                {tc.colour[0], tc.colour[1], tc.colour[2]});
+          t.iso_relative = tc.iso_relative;
+          t.iso_fraction = tc.isovalues[i];
+          t.entry.method = "isosurface";
+          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative}};
+          break;
+        case TaskConfig::Kind::slice: {
+          const WindowConfig& w = tc.windows[0];
+          const int a = tc.slice_axis;
+          const double pos = grid.origin[a] + tc.slice_positions[i] * (grid.dims[a] - 1) * grid.spacing[a];
+          t.spec = render::TaskSpec::slice(f, a, pos, render::TransferFunction::preset(tc.preset), window(w));
+          t.relative = w.relative;
+          t.entry.method = "slice";
+          t.entry.parameters = {{"axis", std::string(1, char('x' + a))}, {"fraction", tc.slice_positions[i]},
+                                {"position", pos}, {"preset", tc.preset}, {"window", {w.lo, w.hi}},
+                                {"relative", w.relative}};
+          break;
+        }
+      }
+      t.entry.id = int(tasks.size());
+      for (const Task& o : tasks)
+        if (o.entry.name == t.entry.name) throw Error("task \"" + t.entry.name + "\": the name is used twice");
+      tasks.push_back(std::move(t));
+    }
+  }
+  specs.resize(tasks.size());
+  axes_.clear();
+  axes_ = std::move(axes);
+}
+
+store::Manifest Session::Impl::make_manifest() const {
+  store::Manifest man;
+  man.title = cfg.title;
+  man.provenance.program = cfg.program;
+  man.provenance.version = "0.1.0";
+  man.provenance.created = iso_time();
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  man.provenance.host = host;
+  man.provenance.command_line = cfg.command_line;
+  man.provenance.extra["mpi_ranks"] = std::to_string(size);
+  man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
+  man.domain.origin = grid.origin;
+  man.domain.spacing = grid.spacing;
+  man.domain.units = cfg.units;
+  man.image.width = cfg.width;
+  man.image.height = cfg.height;
+  man.video = cfg.video;
+  man.rig.kind = rig.spec;
+  man.rig.parameters = {{"spec", rig.spec}, {"shells", rig.shell_count}};
+  const camera::NavigationGraph graph = camera::build_navigation_graph(rig);
+  for (int c = 0; c < rig.size(); ++c) {
+    const camera::RigCamera& rc = rig.cameras[std::size_t(c)];
+    store::CameraEntry e;
+    e.id = c;
+    e.position = rc.position;
+    e.look_at = rc.look_at;
+    e.up = rc.up;
+    e.fov_y_deg = cameras[std::size_t(c)].fov_y_degrees();
+    e.labels.patch = rc.patch;
+    e.labels.lat_deg = rc.latitude_deg;
+    e.labels.lon_deg = rc.longitude_deg;
+    e.labels.shell = rc.shell;
+    man.cameras.push_back(e);
+    const camera::Neighbours& n = graph.neighbours[std::size_t(c)];
+    man.graph.neighbours.push_back({n.left, n.right, n.up, n.down, n.in, n.out});
+  }
+  for (const Task& t : tasks) man.tasks.push_back(t.entry);
+  man.axes = axes_;
+  return man;
+}
+
+// Copies (and converts) every field to float32 over this rank's required point range; points the
+// simulation's own ghost layers do not hold come from their owners.
+void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
+  const BlockInfo& b = me();
+  const Box& req = b.has_brick ? b.required : b.owned;
+  const Index3 rd{req.hi[0] - req.lo[0], req.hi[1] - req.lo[1], req.hi[2] - req.lo[2]};
+  buffers.resize(field_names.size());
+  std::vector<const FieldInput*> inputs(field_names.size());
+  for (std::size_t f = 0; f < field_names.size(); ++f) {
+    for (const FieldInput& in : fields)
+      if (in.name == field_names[f]) inputs[f] = &in;
+    if (!inputs[f] || !inputs[f]->data)
+      throw Error("snapshot: field \"" + field_names[f] + "\" (read by a task) was not given or has no data");
+  }
+  const Box have = intersect(b.available, req);
+  for (std::size_t f = 0; f < field_names.size(); ++f) {
+    const FieldInput& in = *inputs[f];
+    std::array<std::int64_t, 3> st = in.stride;
+    if (st[0] == 0 && st[1] == 0 && st[2] == 0) {
+      const std::int64_t nx = block.extent[0] + block.ghost_lo[0] + block.ghost_hi[0];
+      const std::int64_t ny = block.extent[1] + block.ghost_lo[1] + block.ghost_hi[1];
+      st = {1, nx, nx * ny};
+    }
+    std::vector<float>& buf = buffers[f];
+    buf.resize(std::size_t(req.size()));
+    const bool dbl = in.type == ScalarType::f64;
+    const auto* pf = static_cast<const float*>(in.data);
+    const auto* pd = static_cast<const double*>(in.data);
+#pragma omp parallel for collapse(2) schedule(static)
+    for (int k = have.lo[2]; k < have.hi[2]; ++k)
+      for (int j = have.lo[1]; j < have.hi[1]; ++j) {
+        float* out = buf.data() + (std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] - req.lo[0];
+        const std::int64_t base = std::int64_t(j - block.offset[1]) * st[1] + std::int64_t(k - block.offset[2]) * st[2];
+        for (int i = have.lo[0]; i < have.hi[0]; ++i) {
+          const std::int64_t idx = base + std::int64_t(i - block.offset[0]) * st[0];
+          out[i] = dbl ? float(pd[idx]) : pf[idx];
+        }
+      }
+  }
+#ifdef PANOPTES_HAVE_MPI
+  if (exchange_needed && size > 1) {
+    // Rank s sends to rank r the points it owns in r's required range, for every rank r whose stored
+    // ghosts do not cover that range. Everyone knows every block, so the pattern needs no handshake.
+    const int nf = int(field_names.size());
+    std::vector<MPI_Request> reqs;
+    std::vector<std::vector<float>> out, in_bufs;
+    std::vector<std::pair<int, Box>> incoming;
+    for (int r = 0; r < size; ++r) {
+      const BlockInfo& br = blocks[std::size_t(r)];
+      if (!br.has_brick || br.available.contains(br.required)) continue;
+      if (r == rank) {
+        for (int s = 0; s < size; ++s) {
+          if (s == rank) continue;
+          const Box x = intersect(blocks[std::size_t(s)].owned, br.required);
+          if (!x.empty()) incoming.emplace_back(s, x);
+        }
+      } else {
+        const Box x = intersect(b.owned, br.required);
+        if (x.empty()) continue;
+        std::vector<float> pack;
+        pack.reserve(std::size_t(x.size()) * std::size_t(nf));
+        for (int f = 0; f < nf; ++f) {
+          const FieldInput& in = *inputs[std::size_t(f)];
+          std::array<std::int64_t, 3> st = in.stride;
+          if (st[0] == 0 && st[1] == 0 && st[2] == 0) {
+            const std::int64_t nx = block.extent[0] + block.ghost_lo[0] + block.ghost_hi[0];
+            const std::int64_t ny = block.extent[1] + block.ghost_lo[1] + block.ghost_hi[1];
+            st = {1, nx, nx * ny};
+          }
+          for (int k = x.lo[2]; k < x.hi[2]; ++k)
+            for (int j = x.lo[1]; j < x.hi[1]; ++j)
+              for (int i = x.lo[0]; i < x.hi[0]; ++i) {
+                const std::int64_t idx = std::int64_t(i - block.offset[0]) * st[0] +
+                                         std::int64_t(j - block.offset[1]) * st[1] +
+                                         std::int64_t(k - block.offset[2]) * st[2];
+                pack.push_back(in.type == ScalarType::f64 ? float(static_cast<const double*>(in.data)[idx])
+                                                          : static_cast<const float*>(in.data)[idx]);
+              }
+        }
+        out.push_back(std::move(pack));
+        reqs.emplace_back();
+        MPI_Isend(out.back().data(), int(out.back().size()), MPI_FLOAT, r, 7, comm, &reqs.back());
+      }
+    }
+    in_bufs.resize(incoming.size());
+    for (std::size_t n = 0; n < incoming.size(); ++n) {
+      in_bufs[n].resize(std::size_t(incoming[n].second.size()) * std::size_t(nf));
+      reqs.emplace_back();
+      MPI_Irecv(in_bufs[n].data(), int(in_bufs[n].size()), MPI_FLOAT, incoming[n].first, 7, comm, &reqs.back());
+    }
+    MPI_Waitall(int(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
+    for (std::size_t n = 0; n < incoming.size(); ++n) {
+      const Box& x = incoming[n].second;
+      const float* p = in_bufs[n].data();
+      for (int f = 0; f < nf; ++f)
+        for (int k = x.lo[2]; k < x.hi[2]; ++k)
+          for (int j = x.lo[1]; j < x.hi[1]; ++j)
+            for (int i = x.lo[0]; i < x.hi[0]; ++i)
+              buffers[std::size_t(f)][std::size_t((std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] +
+                                                  (i - req.lo[0]))] = *p++;
+    }
+  }
+#endif
+  prepared.clear();
+  if (b.has_brick) {
+    render::PointRange pr{req.lo, req.hi};
+    for (std::size_t f = 0; f < field_names.size(); ++f)
+      prepared.emplace_back(render::FieldView::of_brick(grid, b.brick, pr, buffers[f].data()));
+  }
+}
+
+// The q-quantile of |v| over a fixed lattice of global points (the same set whatever the
+// decomposition, so the reference — and every image — does not depend on the number of ranks).
+double Session::Impl::global_percentile(int f) {
+  const std::int64_t total = std::int64_t(grid.dims[0]) * grid.dims[1] * grid.dims[2];
+  const int s = std::max(1, int(std::ceil(std::cbrt(double(total) / 65536.0))));
+  const BlockInfo& b = me();
+  const Box& req = b.has_brick ? b.required : b.owned;
+  const Index3 rd{req.hi[0] - req.lo[0], req.hi[1] - req.lo[1], req.hi[2] - req.lo[2]};
+  std::vector<float> mine;
+  const std::vector<float>& buf = buffers[std::size_t(f)];
+  auto first = [&](int lo) { return (lo + s - 1) / s * s; };
+  for (int k = first(b.owned.lo[2]); k < b.owned.hi[2]; k += s)
+    for (int j = first(b.owned.lo[1]); j < b.owned.hi[1]; j += s)
+      for (int i = first(b.owned.lo[0]); i < b.owned.hi[0]; i += s)
+        mine.push_back(std::fabs(
+            buf[std::size_t((std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] + (i - req.lo[0]))]));
+  std::vector<float> all;
+#ifdef PANOPTES_HAVE_MPI
+  if (size > 1) {
+    int n = int(mine.size());
+    std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
+    MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+    int sum = 0;
+    for (int r = 0; r < size; ++r) displs[std::size_t(r)] = sum, sum += counts[std::size_t(r)];
+    all.resize(std::size_t(sum));
+    MPI_Allgatherv(mine.data(), n, MPI_FLOAT, all.data(), counts.data(), displs.data(), MPI_FLOAT, comm);
+  } else
+#endif
+    all = std::move(mine);
+  if (all.empty()) return 0;
+  const std::size_t idx = std::size_t(std::llround(cfg.percentile * double(all.size() - 1)));
+  std::nth_element(all.begin(), all.begin() + std::ptrdiff_t(idx), all.end());
+  return all[idx];
+}
+
+namespace {
+
+void pack(const render::PartialImage& p, std::vector<char>& out) {
+  const std::int32_t rect[4] = {p.rect.x0, p.rect.y0, p.rect.x1, p.rect.y1};
+  const std::size_t n = p.rect.empty() ? 0 : std::size_t(p.rect.width()) * std::size_t(p.rect.height());
+  const std::size_t at = out.size();
+  out.resize(at + sizeof rect + n * 5 * sizeof(float));
+  std::memcpy(out.data() + at, rect, sizeof rect);
+  if (n) {
+    std::memcpy(out.data() + at + sizeof rect, p.rgba.data(), n * 4 * sizeof(float));
+    std::memcpy(out.data() + at + sizeof rect + n * 4 * sizeof(float), p.depth.data(), n * sizeof(float));
+  }
+}
+
+const char* unpack(const char* in, const char* end, int width, int height, render::PartialImage& p) {
+  std::int32_t rect[4];
+  if (end - in < std::ptrdiff_t(sizeof rect)) throw Error("in-situ compositing: truncated partial-image message");
+  std::memcpy(rect, in, sizeof rect);
+  in += sizeof rect;
+  p.reset(width, height, {rect[0], rect[1], rect[2], rect[3]});
+  const std::size_t n = p.rect.empty() ? 0 : std::size_t(p.rect.width()) * std::size_t(p.rect.height());
+  if (end - in < std::ptrdiff_t(n * 5 * sizeof(float))) throw Error("in-situ compositing: truncated partial-image message");
+  if (n) {
+    std::memcpy(p.rgba.data(), in, n * 4 * sizeof(float));
+    std::memcpy(p.depth.data(), in + n * 4 * sizeof(float), n * sizeof(float));
+  }
+  return in + n * 5 * sizeof(float);
+}
+
+}  // namespace
+
+void Session::Impl::render_snapshot(int frame) {
+  const int C = rig.size();
+  const int K = int(tasks.size());
+  const bool brick = me().has_brick;
+  const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
+  render::OutlineStyle outline;
+  outline.enabled = cfg.outline;
+  for (int r0 = 0; r0 < C; r0 += size) {
+    // Render every camera of this round, sending each partial set to its owner at once.
+#ifdef PANOPTES_HAVE_MPI
+    std::vector<MPI_Request> sends;
+#endif
+    for (int c = r0; c < std::min(C, r0 + size); ++c) {
+      if (!brick) continue;
+      const int slot = c - r0;
+      auto t0 = Clock::now();
+      render::render_brick(cameras[std::size_t(c)], prepared, specs, partials[std::size_t(slot)], cfg.render);
+      time.render += since(t0);
+      if (owner(c) != rank) {
+#ifdef PANOPTES_HAVE_MPI
+        t0 = Clock::now();
+        std::vector<char>& buf = send_buf[std::size_t(slot)];
+        buf.clear();
+        for (const auto& p : partials[std::size_t(slot)]) pack(p, buf);
+        sends.emplace_back();
+        MPI_Isend(buf.data(), int(buf.size()), MPI_BYTE, owner(c), 11, comm, &sends.back());
+        time.composite += since(t0);
+#endif
+      }
+    }
+    const int mine = r0 + rank;
+    if (mine < C) {
+      auto t0 = Clock::now();
+      // Partials of my camera in rank order (a deterministic order: composite() sorts per pixel).
+      std::vector<std::vector<const render::PartialImage*>> parts(static_cast<std::size_t>(K));
+      for (int s = 0; s < size; ++s) {
+        if (!blocks[std::size_t(s)].has_brick) continue;
+        if (s == rank) {
+          for (int t = 0; t < K; ++t) parts[std::size_t(t)].push_back(&partials[std::size_t(rank)][std::size_t(t)]);
+          continue;
+        }
+#ifdef PANOPTES_HAVE_MPI
+        MPI_Status st;
+        MPI_Probe(s, 11, comm, &st);
+        int bytes = 0;
+        MPI_Get_count(&st, MPI_BYTE, &bytes);
+        recv_buf.resize(std::size_t(bytes));
+        MPI_Recv(recv_buf.data(), bytes, MPI_BYTE, s, 11, comm, MPI_STATUS_IGNORE);
+        const char* p = recv_buf.data();
+        const char* end = p + bytes;
+        for (int t = 0; t < K; ++t) {
+          p = unpack(p, end, cfg.width, cfg.height, received[std::size_t(s)][std::size_t(t)]);
+          parts[std::size_t(t)].push_back(&received[std::size_t(s)][std::size_t(t)]);
+        }
+#endif
+      }
+      const camera::Camera& cam = cameras[std::size_t(mine)];
+#pragma omp parallel for schedule(dynamic)
+      for (int t = 0; t < K; ++t) {
+        render::PartialImage empty;
+        if (parts[std::size_t(t)].empty()) {
+          empty.reset(cfg.width, cfg.height, {0, 0, 0, 0});
+          images[std::size_t(t)] = render::finish_image(empty, cam, grid, bg, outline);
+        } else if (parts[std::size_t(t)].size() == 1) {
+          images[std::size_t(t)] = render::finish_image(*parts[std::size_t(t)][0], cam, grid, bg, outline);
+        } else {
+          composited[std::size_t(t)] = render::composite(parts[std::size_t(t)]);
+          images[std::size_t(t)] = render::finish_image(composited[std::size_t(t)], cam, grid, bg, outline);
+        }
+      }
+      time.composite += since(t0);
+      if (observer)
+        for (int t = 0; t < K; ++t) observer(mine, t, frame, images[std::size_t(t)]);
+      t0 = Clock::now();
+      store::DatabaseWriter& w = *writer;
+#pragma omp parallel for schedule(dynamic)
+      for (int t = 0; t < K; ++t) w.append(mine, t, images[std::size_t(t)]);
+      frames_encoded += K;
+      time.encode += since(t0);
+    }
+#ifdef PANOPTES_HAVE_MPI
+    if (!sends.empty()) {
+      auto t0 = Clock::now();
+      MPI_Waitall(int(sends.size()), sends.data(), MPI_STATUSES_IGNORE);
+      time.composite += since(t0);
+    }
+#endif
+  }
+}
+
+void Session::Impl::checkpoint(double t) {
+  auto t0 = Clock::now();
+  int frames = INT_MAX;
+  if (writer) {
+    writer->flush();
+    if (!owned.empty()) frames = writer->complete_frames();
+  }
+#ifdef PANOPTES_HAVE_MPI
+  if (size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, comm);
+#endif
+  if (rank == 0) {
+    writer->set_time(snapshots - 1, t);
+    writer->checkpoint(frames == INT_MAX ? snapshots : frames);
+  }
+  time.checkpoint += since(t0);
+}
+
+Session::Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->cfg = config;
+  impl_->grid = grid;
+  impl_->block = block;
+#ifdef PANOPTES_HAVE_MPI
+  int init = 0;
+  MPI_Initialized(&init);
+  if (init) {
+    MPI_Comm_dup(MPI_COMM_SELF, &impl_->comm);
+  }
+#endif
+  impl_->init();
+}
+
+#ifdef PANOPTES_HAVE_MPI
+Session::Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->cfg = config;
+  impl_->grid = grid;
+  impl_->block = block;
+  MPI_Comm_dup(comm, &impl_->comm);
+  MPI_Comm_rank(impl_->comm, &impl_->rank);
+  MPI_Comm_size(impl_->comm, &impl_->size);
+  impl_->init();
+}
+#endif
+
+Session::~Session() {
+#ifdef PANOPTES_HAVE_MPI
+  if (impl_ && impl_->comm != MPI_COMM_NULL) {
+    int fin = 0;
+    MPI_Finalized(&fin);
+    if (!fin) MPI_Comm_free(&impl_->comm);
+  }
+#endif
+}
+
+bool Session::due(std::int64_t step, double time) const {
+  const ScheduleConfig& s = impl_->cfg.schedule;
+  if (impl_->finalized) return false;
+  if (s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots) return false;
+  if (s.every_steps > 0) return step % s.every_steps == 0;
+  return time >= impl_->next_time - 1e-9 * s.every_time;
+}
+
+void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
+  Impl& m = *impl_;
+  if (m.finalized) throw Error("snapshot: the session is finalized");
+  if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
+    throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
+  auto t0 = Clock::now();
+  m.load_fields(fields);
+  std::vector<double> ref(m.field_names.size());
+  for (std::size_t f = 0; f < m.field_names.size(); ++f)
+    ref[f] = std::max(m.references[f].update(m.global_percentile(int(f))), 1e-30);
+  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
+    const Task& t = m.tasks[i];
+    render::TaskSpec& s = m.specs[i];
+    s = t.spec;
+    if (t.relative) s.reference = ref[std::size_t(t.spec.field)];
+    if (t.relative2 && t.spec.field2 >= 0) s.reference2 = ref[std::size_t(t.spec.field2)];
+    if (t.iso_relative) s.isovalue = float(t.iso_fraction * ref[std::size_t(t.spec.field)]);
+  }
+  m.time.copy += since(t0);
+  m.render_snapshot(m.snapshots);
+  ++m.snapshots;
+  if (m.cfg.schedule.every_time > 0)
+    m.next_time = (std::floor(time / m.cfg.schedule.every_time + 1e-9) + 1) * m.cfg.schedule.every_time;
+  m.checkpoint(time);
+}
+
+bool Session::process(std::int64_t step, double time, const std::vector<FieldInput>& fields) {
+  if (!due(step, time)) return false;
+  snapshot(time, fields);
+  return true;
+}
+
+void Session::finalize() {
+  Impl& m = *impl_;
+  if (m.finalized) return;
+  m.finalized = true;
+  int frames = INT_MAX;
+  if (m.writer && !m.owned.empty()) {
+    m.writer->flush();
+    frames = m.writer->complete_frames();
+  }
+#ifdef PANOPTES_HAVE_MPI
+  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, m.comm);
+#endif
+  if (m.rank != 0 && m.writer) m.writer->finalize();
+  m.barrier();
+  if (m.rank == 0) m.writer->finalize(frames == INT_MAX ? m.snapshots : frames);
+  m.barrier();
+}
+
+void Session::set_frame_observer(FrameObserver observer) { impl_->observer = std::move(observer); }
+int Session::rank() const { return impl_->rank; }
+int Session::ranks() const { return impl_->size; }
+int Session::camera_count() const { return impl_->rig.size(); }
+int Session::task_count() const { return int(impl_->tasks.size()); }
+int Session::snapshots() const { return impl_->snapshots; }
+const std::vector<std::string>& Session::field_names() const { return impl_->field_names; }
+const std::string& Session::output_dir() const { return impl_->cfg.output_dir; }
+
+SessionStats Session::stats() const {
+  const Impl& m = *impl_;
+  SessionStats s;
+  s.snapshots = m.snapshots;
+  s.frames_encoded = m.frames_encoded;
+  s.owned_cameras = int(m.owned.size());
+  for (const auto& b : m.buffers) s.field_buffer_bytes += std::int64_t(b.capacity() * sizeof(float));
+  auto add = [&](const render::PartialImage& p) {
+    s.partial_buffer_bytes += std::int64_t((p.rgba.capacity() + p.depth.capacity()) * sizeof(float));
+  };
+  for (const auto& v : m.partials)
+    for (const auto& p : v) add(p);
+  for (const auto& v : m.received)
+    for (const auto& p : v) add(p);
+  for (const auto& p : m.composited) add(p);
+  for (const auto& b : m.send_buf) s.partial_buffer_bytes += std::int64_t(b.capacity());
+  s.partial_buffer_bytes += std::int64_t(m.recv_buf.capacity());
+  s.peak_rss_bytes = peak_rss();
+  s.time = m.time;
+  return s;
+}
+
+SessionStats Session::reduced_stats() const {
+  SessionStats s = stats();
+#ifdef PANOPTES_HAVE_MPI
+  const Impl& m = *impl_;
+  if (m.size > 1) {
+    double t[5] = {s.time.copy, s.time.render, s.time.composite, s.time.encode, s.time.checkpoint};
+    MPI_Allreduce(MPI_IN_PLACE, t, 5, MPI_DOUBLE, MPI_MAX, m.comm);
+    s.time = {t[0], t[1], t[2], t[3], t[4]};
+    std::int64_t c[2] = {s.frames_encoded, s.owned_cameras};
+    MPI_Allreduce(MPI_IN_PLACE, c, 2, MPI_INT64_T, MPI_SUM, m.comm);
+    s.frames_encoded = c[0];
+    s.owned_cameras = int(c[1]);
+    std::int64_t mx[3] = {s.field_buffer_bytes, s.partial_buffer_bytes, s.peak_rss_bytes};
+    MPI_Allreduce(MPI_IN_PLACE, mx, 3, MPI_INT64_T, MPI_MAX, m.comm);
+    s.field_buffer_bytes = mx[0];
+    s.partial_buffer_bytes = mx[1];
+    s.peak_rss_bytes = mx[2];
+  }
+#endif
+  return s;
+}
+
+}  // namespace panoptes::insitu

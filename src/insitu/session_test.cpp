@@ -1,0 +1,195 @@
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "core/error.hpp"
+#include "insitu/session.hpp"
+#include "render/synthetic_fields.hpp"
+#include "store/database.hpp"
+
+using namespace panoptes;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string error_of(const std::string& toml) {
+  try {
+    (void)insitu::parse_session_config_text(toml, "test.toml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kTask = "[[task]]\nname = \"v\"\nfield = \"f\"\n";
+
+TEST(InsituConfig, DefaultsAndSweeps) {
+  const auto c = insitu::parse_session_config_text(
+      std::string(kTask) + "[[task]]\nname = \"iso\"\ntype = \"isosurface\"\nfield = \"f\"\nisovalues = [0.1, 0.2, 0.3]\n",
+      "t");
+  EXPECT_EQ(c.width, 920);
+  EXPECT_EQ(c.height, 896);
+  EXPECT_EQ(c.rig, "yinyang");
+  EXPECT_EQ(c.schedule.every_steps, 10);
+  ASSERT_EQ(c.tasks.size(), 2u);
+  EXPECT_EQ(c.tasks[1].isovalues.size(), 3u);
+  EXPECT_TRUE(c.tasks[0].windows[0].relative);
+}
+
+TEST(InsituConfig, ErrorsNameTheKey) {
+  EXPECT_NE(error_of(std::string(kTask) + "[image]\nwidht = 3\n").find("image.widht: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[image]\nwidth = \"big\"\n").find("image.width: expected an integer"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[image]\nwidth = 1\n").find("expected 2..16384"), std::string::npos);
+  EXPECT_NE(error_of("").find("no [[task]] given"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[schedule]\nevery_steps = 5\nevery_time = 0.1\n").find("exactly one of"),
+            std::string::npos);
+  EXPECT_NE(error_of("[[task]]\nname = \"v\"\nfield = \"f\"\npreset = \"purple\"\n").find("unknown preset \"purple\""),
+            std::string::npos);
+  EXPECT_NE(error_of("[[task]]\nname = \"v\"\ntype = \"volume2\"\nfield = \"f\"\n").find("exactly two fields"),
+            std::string::npos);
+  EXPECT_NE(error_of("[[task]]\nname = \"v\"\ntype = \"cloud\"\nfield = \"f\"\n").find("task[0].type: \"cloud\""),
+            std::string::npos);
+  EXPECT_NE(error_of("[[task]]\nname = \"s\"\ntype = \"slice\"\nfield = \"f\"\naxis = \"w\"\n").find("task[0].axis"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + kTask).find("used twice"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[rig]\nspec = \"cube:3\"\n").find("rig.spec"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[video]\ncrf = 99\n").find("video"), std::string::npos);
+  EXPECT_NE(error_of("[[task]]\nname = \"v\"\nfield = \"f\"\nwindow = [1, 0]\n").find("lo < hi"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[seismic]\nx = 1\n").find("seismic: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("x = [").find("TOML syntax error"), std::string::npos);
+}
+
+insitu::SessionConfig small_config(const std::string& dir) {
+  auto c = insitu::parse_session_config_text(R"(
+[image]
+width = 32
+height = 32
+[rig]
+spec = "fibonacci:4"
+[schedule]
+every_steps = 1
+[[task]]
+name = "v"
+field = "f"
+[[task]]
+name = "iso"
+type = "isosurface"
+field = "f"
+isovalues = [0.2, 0.5]
+relative = true
+)",
+                                              "small");
+  c.output_dir = dir;
+  c.overwrite = true;
+  return c;
+}
+
+render::GridGeometry grid() { return {{20, 18, 16}, {0, 0, 0}, {1, 1, 1}}; }
+
+std::vector<float> field(double t) {
+  const render::GridGeometry g = grid();
+  const std::vector<render::WaveFront> fronts{{g.centre(), 3 + 2 * t, 1.5, 1.0}};
+  return render::wave_field(g, fronts);
+}
+
+TEST(InsituSession, ExpandsSweepsIntoTasks) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_single_" + std::to_string(::getpid()));
+  {
+    insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+    EXPECT_EQ(s.camera_count(), 4);
+    EXPECT_EQ(s.task_count(), 3);
+    EXPECT_EQ(s.field_names(), std::vector<std::string>{"f"});
+    s.finalize();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(InsituSession, MissingFieldIsAnError) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_missing_" + std::to_string(::getpid()));
+  insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+  EXPECT_THROW(s.snapshot(0, {{"g", nullptr, insitu::ScalarType::f32, {0, 0, 0}}}), Error);
+  s.finalize();
+  fs::remove_all(dir);
+}
+
+TEST(InsituSession, SnapshotsScheduleAndFinalize) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_sched_" + std::to_string(::getpid()));
+  auto cfg = small_config(dir);
+  cfg.schedule.every_steps = 0;
+  cfg.schedule.every_time = 0.25;
+  insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
+  int taken = 0;
+  for (int step = 0; step < 10; ++step) {
+    const double t = 0.1 * step;
+    const auto f = field(t);
+    taken += s.process(step, t, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }
+  EXPECT_EQ(taken, 4);  // t = 0, 0.3 (≥ 0.25), 0.5, 0.8 (≥ 0.75)
+  s.finalize();
+  const auto db = store::Database::open(dir);
+  EXPECT_EQ(db.status(), store::Status::complete);
+  EXPECT_EQ(db.frame_count(), 4);
+  ASSERT_EQ(db.manifest().axes.size(), 1u);
+  EXPECT_EQ(db.manifest().axes[0].name, "iso isovalue");
+  EXPECT_EQ(db.manifest().step_task_on_axis(1, "iso isovalue", 1), 2);
+  EXPECT_NEAR(db.manifest().frame_time(1), 0.3, 1e-12);
+  fs::remove_all(dir);
+}
+
+// A run SIGKILLed in the middle of its third snapshot leaves a database that opens as interrupted
+// with the two completed snapshots playable in every stream.
+TEST(InsituSession, KilledRunOpensInterrupted) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_killed_" + std::to_string(::getpid()));
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    try {
+      insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+      s.set_frame_observer([](int camera, int, int frame, const Image&) {
+        if (frame == 2 && camera == 2) ::raise(SIGKILL);
+      });
+      for (int step = 0; step < 5; ++step) {
+        const auto f = field(0.2 * step);
+        s.process(step, 0.2 * step, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+      }
+      s.finalize();
+    } catch (...) {
+    }
+    ::_exit(3);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGKILL);
+  const auto db = store::Database::open(dir);
+  EXPECT_EQ(db.status(), store::Status::interrupted);
+  EXPECT_EQ(db.frame_count(), 2);
+  for (int c = 0; c < db.camera_count(); ++c)
+    for (int t = 0; t < db.task_count(); ++t) {
+      auto r = db.stream(c, t);
+      ASSERT_GE(r->frame_count(), 2) << "camera " << c << " task " << t;
+      const Image img = r->read_rgba(1);
+      EXPECT_EQ(img.width, 32);
+    }
+  fs::remove_all(dir);
+}
+
+TEST(InsituSession, BadBlocksAreRejected) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_badblock_" + std::to_string(::getpid()));
+  insitu::LocalBlock b = insitu::LocalBlock::whole(grid());
+  b.extent[2] -= 1;  // one plane owned by nobody
+  try {
+    insitu::Session s(small_config(dir), grid(), b);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("do not partition"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
