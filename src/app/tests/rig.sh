@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# `panoptes rig`: statistics of the default rigs, JSON dump with a consistent graph, camera files,
+# nearest-camera lookup, and clear errors for bad specs.
+set -euo pipefail
+panoptes=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+"$panoptes" rig --help | grep -q "yinyang"
+
+# The paper's rig: 130 cameras, nearest-neighbour angles 9.87..18 deg, strongly connected graph.
+out=$("$panoptes" rig yinyang --extent 256,512,160)
+echo "$out" | grep -q "^rig yinyang:5x13@3$" || { echo "$out"; echo "bad canonical spec"; exit 1; }
+echo "$out" | grep -q "^cameras  *130 on 1 shell$" || { echo "$out"; echo "bad count"; exit 1; }
+echo "$out" | grep -q "yang 65 yin 65" || { echo "$out"; echo "bad patches"; exit 1; }
+echo "$out" | grep -q "nearest neighbour  *9.871 .. 18.000 deg" || { echo "$out"; echo "bad spacing"; exit 1; }
+echo "$out" | grep -q "strongly connected" || { echo "$out"; echo "graph not connected"; exit 1; }
+
+# Shells and --list: 3 x 130 cameras, in/out columns filled.
+"$panoptes" rig shells:yinyang@1.5,2.5,4 --list --no-stats > "$tmp/list.txt"
+grep -q "^cameras  *390 on 3 shells$" "$tmp/list.txt"
+[ "$(grep -cE '^ +[0-9]+ (yin|yang) ' "$tmp/list.txt")" = 390 ] || { echo "list has wrong row count"; exit 1; }
+
+# JSON: every neighbour id is valid and never the camera itself; shells and labels present.
+"$panoptes" rig fibonacci:300@2,4 --json > "$tmp/rig.json"
+python3 - "$tmp/rig.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+cams = j["cameras"]
+assert len(cams) == 600 and j["shells"] == 2, (len(cams), j["shells"])
+for c in cams:
+    for k, v in c["neighbours"].items():
+        assert -1 <= v < len(cams) and v != c["id"], (c["id"], k, v)
+    assert c["patch"] == "fibonacci" and c["shell"] in (0, 1)
+    assert (c["neighbours"]["in"] >= 0) == (c["shell"] == 0)
+assert j["statistics"]["strongly_connected"] is True
+print("rig json ok")
+PY
+
+# Camera files (text and JSON) and nearest-camera lookup.
+printf '# x y z\n10 0 0\n0 10 0\n-10 0 0\n0 -10 0\n0 0 10\n0 0 -10\n' > "$tmp/cams.txt"
+out=$("$panoptes" rig "$tmp/cams.txt" --nearest 5,85)
+echo "$out" | grep -q "^cameras  *6 on 1 shell$" || { echo "$out"; exit 1; }
+echo "$out" | grep -q "nearest to lat 5 lon 85 on shell 0: camera 1$" || { echo "$out"; exit 1; }
+echo '{"cameras": [{"position": [0, 0, 9]}, {"position": [9, 0, 0], "fov_y_degrees": 30}]}' > "$tmp/cams.json"
+"$panoptes" rig "file:$tmp/cams.json" --json | python3 -c 'import json,sys; j=json.load(sys.stdin); assert j["cameras"][1]["fov_y_degrees"]==30'
+
+# Errors: one line, exit status 1, naming the bad value.
+expect_error() {  # expect_error NEEDLE ARGS...
+  local needle=$1; shift
+  if "$panoptes" "$@" > /dev/null 2> "$tmp/err"; then echo "accepted: $*"; exit 1; fi
+  grep -q "^panoptes: error: .*$needle" "$tmp/err" || { cat "$tmp/err"; echo "missing '$needle' for: $*"; exit 1; }
+}
+expect_error "yinyang:5xq" rig yinyang:5xq
+expect_error "no-such-rig" rig no-such-rig
+expect_error "extent" rig yinyang --extent 1,0,1
+printf '1 2\n' > "$tmp/bad.txt"
+expect_error "line 1" rig "$tmp/bad.txt"
+echo "rig: ok"
