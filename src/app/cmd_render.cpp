@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <exception>
 #include <algorithm>
 #include <memory>
 #include <regex>
@@ -256,6 +257,7 @@ void run(const Args& a, const std::string& command_line) {
   render::RunningMax reference;
   std::vector<render::PartialImage> partials(tasks.size());
   std::vector<render::TaskSpec> specs(tasks.size());
+  std::vector<Image> frames(std::size_t(8) * tasks.size());
 
   for (std::size_t f = 0; f < files.size(); ++f) {
     app::Volume vol = f == 0 ? std::move(first) : app::read_volume(files[f]);
@@ -272,12 +274,30 @@ void run(const Args& a, const std::string& command_line) {
       specs[i] = tasks[i].spec;
       if (tasks[i].relative) specs[i].reference = std::max(ref, 1e-30);
     }
-    for (int c = 0; c < rig.size(); ++c) {
-      render::render_brick(cams[std::size_t(c)], fields, specs, partials, opt);
-      for (std::size_t i = 0; i < tasks.size(); ++i) {
-        writer.append(c, int(i), render::finish_image(partials[i], cams[std::size_t(c)], grid, background, outline));
-        ++done;
+    // Cameras in batches: render each camera (multi-threaded inside), then encode the batch's
+    // frames in parallel — each goes to its own stream, and one x264 encoder uses one thread.
+    const int batch = 8;
+    for (int c0 = 0; c0 < rig.size(); c0 += batch) {
+      const int c1 = std::min(rig.size(), c0 + batch);
+      for (int c = c0; c < c1; ++c) {
+        render::render_brick(cams[std::size_t(c)], fields, specs, partials, opt);
+        for (std::size_t i = 0; i < tasks.size(); ++i)
+          frames[std::size_t(c - c0) * tasks.size() + i] =
+              render::finish_image(partials[i], cams[std::size_t(c)], grid, background, outline);
       }
+      const int n = (c1 - c0) * int(tasks.size());
+      std::exception_ptr error;
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int j = 0; j < n; ++j) {
+        try {
+          writer.append(c0 + j / int(tasks.size()), j % int(tasks.size()), frames[std::size_t(j)]);
+        } catch (...) {
+#pragma omp critical(render_append_error)
+          if (!error) error = std::current_exception();
+        }
+      }
+      if (error) std::rethrow_exception(error);
+      done += n;
       progress(tty, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     writer.set_time(int(f), double(f));
