@@ -506,6 +506,9 @@ void Engine::set_playing(bool playing) {
   if (playing == m.is_playing) return;
   m.tick();  // freeze the position reached so far
   m.is_playing = playing;
+  // Like a video player: play at the end (without loop) starts again from the other end.
+  if (playing && !m.looping && m.sel.frame == (m.dir > 0 ? m.frames - 1 : 0) && m.frames > 1)
+    m.set_position(m.dir > 0 ? 0 : m.frames - 1);
   m.anchor_time = m.now();
 }
 void Engine::toggle_playing() { set_playing(!impl_->is_playing); }

@@ -174,6 +174,7 @@ class Engine {
   /// direction; at an end it wraps (loop) or stops and pauses.
   void tick();
   bool playing() const;
+  /// Starts/stops the clock. Starting at the end of a non-looping run restarts from the other end.
   void set_playing(bool playing);
   void toggle_playing();
   /// Playback speed factor, clamped to [0.25, 8].

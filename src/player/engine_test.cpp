@@ -163,6 +163,20 @@ TEST_F(EngineTest, SpeedDirectionLoopAndPause) {
   EXPECT_EQ(e.selection().frame, 1);
 }
 
+TEST_F(EngineTest, PlayAtTheEndWithoutLoopRestarts) {
+  Engine e(db(), opts(true));
+  e.set_loop(false);
+  clock.set(100.0);
+  e.tick();
+  EXPECT_EQ(e.selection().frame, kFrames - 1);
+  EXPECT_FALSE(e.playing());
+  ASSERT_TRUE(e.apply(Action::play_pause));
+  EXPECT_EQ(e.selection().frame, 0);
+  clock.advance(2 / 30.0);
+  e.tick();
+  EXPECT_EQ(e.selection().frame, 2);
+}
+
 TEST_F(EngineTest, NearestCameraAndSnap) {
   Engine e(db(), opts());
   // Ring cameras at longitudes 0, 60, ..., 300 degrees.

@@ -20,13 +20,15 @@ FrameCache::Claim FrameCache::claim(const FrameKey& key, std::shared_ptr<const v
   return Claim::claimed;
 }
 
-void FrameCache::insert_locked(const FrameKey& key, std::shared_ptr<const video::YuvFrame> frame) {
+void FrameCache::insert_locked(const FrameKey& key, std::shared_ptr<const video::YuvFrame> frame,
+                               std::vector<std::shared_ptr<const video::YuvFrame>>& dropped) {
   const std::size_t size = frame_bytes(*frame);
   if (size > capacity_ || entries_.count(key)) return;
   while (bytes_ + size > capacity_ && !lru_.empty()) {
     const FrameKey victim = lru_.back();
     auto it = entries_.find(victim);
     bytes_ -= it->second.bytes;
+    dropped.push_back(std::move(it->second.frame));
     entries_.erase(it);
     lru_.pop_back();
     ++evictions_;
@@ -37,12 +39,15 @@ void FrameCache::insert_locked(const FrameKey& key, std::shared_ptr<const video:
 }
 
 void FrameCache::finish(const FrameKey& key, std::shared_ptr<const video::YuvFrame> frame) {
+  std::vector<std::shared_ptr<const video::YuvFrame>> dropped;
   {
     std::lock_guard lock(mutex_);
     in_flight_.erase(key);
-    if (frame) insert_locked(key, std::move(frame));
+    if (frame) insert_locked(key, std::move(frame), dropped);
   }
   done_.notify_all();
+  // `dropped` (and a frame too big to cache) are freed here, outside the lock: freeing megabytes of
+  // planes means munmap system calls, which must not hold up the display thread's lookups.
 }
 
 std::shared_ptr<const video::YuvFrame> FrameCache::wait(const FrameKey& key) {

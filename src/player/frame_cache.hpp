@@ -9,6 +9,7 @@
 #include <mutex>
 #include <unordered_map>
 #include <unordered_set>
+#include <vector>
 
 #include "video/movie_reader.hpp"
 
@@ -60,7 +61,9 @@ class FrameCache {
     std::size_t bytes = 0;
     std::list<FrameKey>::iterator lru;
   };
-  void insert_locked(const FrameKey& key, std::shared_ptr<const video::YuvFrame> frame);
+  // Evicted frames are moved to `dropped` so their memory is freed after the lock is released.
+  void insert_locked(const FrameKey& key, std::shared_ptr<const video::YuvFrame> frame,
+                     std::vector<std::shared_ptr<const video::YuvFrame>>& dropped);
 
   const std::size_t capacity_;
   mutable std::mutex mutex_;
