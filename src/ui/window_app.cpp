@@ -5,6 +5,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -45,9 +49,16 @@ std::string time_tag() {
 }
 
 /// Recording "what is shown": the window's picture (without the HUD) sampled at the database's frame
-/// rate into an MP4 of the window's size at the start of the recording.
+/// rate into an MP4 of the window's size at the start of the recording. Encoding runs on its own
+/// thread so the display keeps its frame rate; the display thread only reads the pixels back.
 class Recorder {
  public:
+  ~Recorder() {
+    try {
+      stop();
+    } catch (...) {
+    }
+  }
   bool active() const { return writer_ != nullptr; }
   const std::string& path() const { return path_; }
 
@@ -62,29 +73,84 @@ class Recorder {
     height_ = height;
     period_ = 1.0 / fps;
     next_ = now;
+    stopping_ = false;
+    error_.clear();
+    encoder_ = std::thread([this] { encode_loop(); });
   }
   /// True if a frame is due at `now` (the caller then reads the pixels and calls add()).
   bool due(double now) const { return writer_ && now >= next_; }
   bool size_matches(int width, int height) const { return width == width_ && height == height_; }
-  void add(const Image& picture, double now) {
-    writer_->append(picture);
+  /// Queues a picture for encoding. Blocks only while kMaxQueued pictures wait (a display much faster
+  /// than the encoder then slows to the encoder's pace rather than dropping recorded frames). Throws
+  /// panoptes::Error if the encoder thread failed (e.g. disk full).
+  void add(Image picture, double now) {
+    std::unique_lock lock(mutex_);
+    space_.wait(lock, [&] { return queue_.size() < kMaxQueued || !error_.empty(); });
+    if (!error_.empty()) throw Error(error_);
+    queue_.push_back(std::move(picture));
+    work_.notify_one();
     // Catch up without bursts if the display fell behind the movie's frame rate.
     next_ = std::max(next_ + period_, now - period_);
   }
-  /// Closes the movie; returns the number of frames written.
+  /// Encodes what is queued, closes the movie; returns the number of frames written. Throws
+  /// panoptes::Error / FileError if encoding or closing failed.
   int stop() {
     if (!writer_) return 0;
-    const int n = writer_->frames_written();
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    work_.notify_one();
+    encoder_.join();
     auto w = std::move(writer_);
+    const int n = w->frames_written();
+    std::string err;
+    {
+      std::lock_guard lock(mutex_);
+      err = error_;
+      queue_.clear();
+    }
+    if (!err.empty()) throw Error(err);
     w->close();
     return n;
   }
 
  private:
+  static constexpr std::size_t kMaxQueued = 4;
+
+  void encode_loop() {
+    for (;;) {
+      Image picture;
+      {
+        std::unique_lock lock(mutex_);
+        work_.wait(lock, [&] { return !queue_.empty() || stopping_; });
+        if (queue_.empty()) return;  // stopping and drained
+        picture = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      space_.notify_one();
+      try {
+        writer_->append(picture);
+      } catch (const std::exception& ex) {
+        std::lock_guard lock(mutex_);
+        error_ = std::string("recording ") + path_ + ": " + ex.what();
+        queue_.clear();
+        space_.notify_all();
+        return;
+      }
+    }
+  }
+
   std::unique_ptr<video::MovieWriter> writer_;
   std::string path_;
   int width_ = 0, height_ = 0;
   double period_ = 1.0 / 30, next_ = 0;
+  std::thread encoder_;
+  std::mutex mutex_;
+  std::condition_variable work_, space_;
+  std::deque<Image> queue_;
+  bool stopping_ = false;
+  std::string error_;
 };
 
 class WindowApp {
@@ -392,11 +458,11 @@ WindowResult WindowApp::run() {
     // Screenshots and recordings hold what is shown of the data, without the HUD on top.
     if (screenshot_pending_ || recorder_.due(now())) {
       try {
-        const Image picture = window_.read_pixels();
+        Image picture = window_.read_pixels();
         if (screenshot_pending_) save_screenshot(picture);
         if (recorder_.due(now())) {
           if (recorder_.size_matches(picture.width, picture.height)) {
-            recorder_.add(picture, now());
+            recorder_.add(std::move(picture), now());
           } else {
             const std::string path = recorder_.path();
             const int n = recorder_.stop();
@@ -405,8 +471,15 @@ WindowResult WindowApp::run() {
           }
         }
       } catch (const std::exception& ex) {
-        if (recorder_.active()) recorder_.stop();
-        hud_.notify(std::string("capture failed: ") + ex.what(), true);
+        std::string what = ex.what();
+        if (recorder_.active()) {
+          try {
+            recorder_.stop();
+          } catch (const std::exception& ex2) {
+            what += std::string("; ") + ex2.what();
+          }
+        }
+        hud_.notify("capture failed: " + what, true);
       }
       screenshot_pending_ = false;
     }
