@@ -148,6 +148,7 @@ struct Engine::Impl {
 
   mutable std::mutex stats_mutex;
   Statistics stats;
+  std::size_t decode_ring = 0;  // next slot to overwrite once decode_ms is full
 
   // Placeholder memo: regenerating a full-size placeholder every displayed frame would cost
   // milliseconds on the display path while a broken stream is shown.
@@ -222,7 +223,12 @@ struct Engine::Impl {
     pool.release(s.camera, s.task, std::move(reader));
     {
       std::lock_guard lock(stats_mutex);
-      stats.decode_ms.push_back(ms);
+      auto& v = stats.decode_ms;
+      if (v.size() < Statistics::kMaxSamples) {
+        v.push_back(ms);
+      } else {
+        v[decode_ring++ % Statistics::kMaxSamples] = ms;
+      }
       ++(prefetching ? stats.prefetch_decodes : stats.display_decodes);
     }
     return {FrameStatus::ok, {}, std::move(frame)};
@@ -661,6 +667,8 @@ ShownFrame Engine::current_frame() {
         r.command = m.switch_command;
         r.latency_ms = (steady_seconds() - m.switch_start) * 1e3;
         r.cache_hit = hit;
+        if (m.stats.switches.size() >= Statistics::kMaxSamples)
+          m.stats.switches.erase(m.stats.switches.begin(), m.stats.switches.begin() + Statistics::kMaxSamples / 2);
         m.stats.switches.push_back(std::move(r));
       }
       m.switch_pending = false;
@@ -713,6 +721,7 @@ void Engine::reset_statistics() {
   Impl& m = *impl_;
   std::lock_guard lock(m.stats_mutex);
   m.stats = Statistics{};
+  m.decode_ring = 0;
 }
 
 void Engine::write_statistics(const std::filesystem::path& path) const {

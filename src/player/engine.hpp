@@ -134,8 +134,12 @@ struct Statistics {
   std::size_t cache_capacity = 0;       ///< the cap
   int readers_open = 0;                 ///< readers in the pool now
   int reader_capacity = 0;
-  std::vector<double> decode_ms;        ///< decode time of every frame decoded (any thread), ms
+  /// Decode times in ms (any thread): every decode, or the most recent kMaxSamples in a long session
+  /// (unordered then), so copying statistics stays cheap.
+  std::vector<double> decode_ms;
+  /// Switches in order: every one, or (in a long session) the most recent ones — at most kMaxSamples.
   std::vector<SwitchRecord> switches;
+  static constexpr std::size_t kMaxSamples = 65536;
 };
 
 /// Percentile summary of a sample (empty sample → all zero).
@@ -230,6 +234,8 @@ class Engine {
 
   // ---- statistics -----------------------------------------------------------------------------
   Statistics statistics() const;
+  /// Clears the counters and samples; readers_opened/evicted and cache_evictions count since
+  /// construction (they belong to the pool and the cache).
   void reset_statistics();
   /// Writes to_json(statistics()) to path (pretty-printed). Throws FileError on failure.
   void write_statistics(const std::filesystem::path& path) const;
