@@ -95,3 +95,4 @@ BENCHMARK(BM_NavigationGraph)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Nearest)->Arg(130)->Arg(10000)->Arg(100000)->Arg(1000000);
 BENCHMARK(BM_NearestBruteForce)->Arg(130)->Arg(10000)->Arg(100000);
+BENCHMARK_MAIN();

@@ -208,7 +208,7 @@ NavigationGraph build_navigation_graph(const Rig& rig, const GraphOptions& optio
   std::vector<std::array<ConeCandidates, 4>> cand(n);
   constexpr double kSame = 1e-9;  // radians: cameras closer than this are the same viewpoint
 
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 4096)  // threads cost more than small rigs
   for (int i = 0; i < n; ++i) {
     const Vec3 u = rig.direction(i);
     const Vec3 axes[4] = {basis[i][0], -basis[i][0], basis[i][1], -basis[i][1]};

@@ -69,7 +69,8 @@ RigSpec RigSpec::parse(std::string_view text) {
     spec.path = std::string(s.starts_with("file:") ? s.substr(5) : s);
     if (spec.path.empty()) bad_spec(text, "no file name after 'file:'");
     if (!s.starts_with("file:") && !std::filesystem::is_regular_file(spec.path))
-      bad_spec(text, "unknown rig kind and no such file");
+      bad_spec(text, spec.path.find_first_of("/.") != std::string::npos ? "no such camera file"
+                                                                        : "unknown rig kind and no such file");
     spec.radii.clear();
     return spec;
   }
