@@ -1,12 +1,21 @@
 #pragma once
 // Shared helpers of the seismic tests: whole-space runs compared with the exact solution.
+#include <omp.h>
+
 #include <cmath>
+#include <cstdlib>
 #include <vector>
 
 #include "seismic/analytic.hpp"
 #include "seismic/solver.hpp"
 
 namespace panoptes::seismic::test_util {
+
+/// Uses one OpenMP thread unless OMP_NUM_THREADS is set.
+inline bool default_single_thread() {
+  if (!std::getenv("OMP_NUM_THREADS")) omp_set_num_threads(1);
+  return true;
+}
 
 /// Relative L2 misfit sqrt(Σ|num − exact|² / Σ|exact|²) over the three components of one trace.
 inline double misfit(const Seismogram& g, const SourceSpec& src, double rho, double vp, double vs) {

@@ -12,6 +12,10 @@
 #include "seismic/solver.hpp"
 #include "seismic/test_util.hpp"
 
+// One OpenMP thread per test process unless OMP_NUM_THREADS says otherwise: ctest runs the cases in
+// parallel on a shared 2-core machine, where spinning thread teams only slow each other down.
+static const bool kThreads = panoptes::seismic::test_util::default_single_thread();
+
 using namespace panoptes::seismic;
 
 namespace {
@@ -29,7 +33,7 @@ struct WholeSpaceResult {
 WholeSpaceResult whole_space(const SourceSpec& proto, double ppw) {
   const double h = kLambdaMin / ppw;
   const int pml = 10;
-  const double rmax = 250;
+  const double rmax = 200;
   const int half = int(std::ceil(rmax / h)) + 3;
   const int n = 2 * (half + pml) + 1;
   const double c = (half + pml) * h;
@@ -43,14 +47,14 @@ WholeSpaceResult whole_space(const SourceSpec& proto, double ppw) {
   cfg.sources = {src};
   const std::vector<std::array<double, 3>> dirs = {
       {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}, {-1, 2, 0.5}, {0.3, -1, -0.7}, {-1, -0.2, 0.4}};
-  const std::vector<double> dist = {150, 200, 250, 180, 230, 210, 165};
+  const std::vector<double> dist = {120, 160, 200, 150, 185, 170, 135};
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     const auto& d = dirs[i];
     const double l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     cfg.receivers.push_back(ReceiverSpec{"r" + std::to_string(i),
                                          {c + dist[i] * d[0] / l, c + dist[i] * d[1] / l, c + dist[i] * d[2] / l}});
   }
-  const double t_end = src.stf.end_time() + rmax / kVs + 0.05;
+  const double t_end = src.stf.delay + 1.2 / kF0 + rmax / kVs + 0.03;
   Solver s(cfg);
   s.run(int(std::ceil(t_end / s.dt())));
   const auto seis = s.gather_seismograms();
@@ -96,11 +100,11 @@ void convergence(const SourceSpec& src, const char* name, std::vector<double> pp
 }  // namespace
 
 TEST(SeismicVerification, ExplosionWholeSpaceMatchesAkiRichards) {
-  convergence(SourceSpec::explosion({0, 0, 0}, 1e15, SourceTimeFunction::ricker(kF0)), "explosion", {5, 6, 8});
+  convergence(SourceSpec::explosion({0, 0, 0}, 1e15, SourceTimeFunction::ricker(kF0, 1.2 / kF0)), "explosion", {6, 8});
 }
 
 TEST(SeismicVerification, DoubleCoupleWholeSpaceMatchesAkiRichards) {
-  convergence(SourceSpec::double_couple({0, 0, 0}, 30, 60, 45, 1e15, SourceTimeFunction::ricker(kF0)),
+  convergence(SourceSpec::double_couple({0, 0, 0}, 30, 60, 45, 1e15, SourceTimeFunction::ricker(kF0, 1.2 / kF0)),
               "double couple", {6, 8});
 }
 
