@@ -115,6 +115,8 @@ struct Engine::Impl {
   EngineOptions options;
   TimeSource now;
   int cameras = 0, tasks = 0, frames = 0;
+  std::vector<double> times;  // frame times, refreshed with frames
+  store::Status db_status = store::Status::complete;
   double fps = 30;
   std::vector<Vec3> directions;  // unit vectors look_at → position, for nearest_camera
   std::vector<int> shells;
@@ -423,7 +425,7 @@ struct Engine::Impl {
     out.status = d.status;
     out.message = std::move(d.message);
     out.cache_hit = hit;
-    out.time = db.manifest().frame_time(s.frame);
+    out.time = s.frame < int(times.size()) ? times[std::size_t(s.frame)] : double(s.frame);
     if (d.status == FrameStatus::ok && d.frame) {
       out.frame = std::move(d.frame);
     } else {
@@ -469,6 +471,8 @@ Engine::Engine(store::Database database, EngineOptions options) {
   m.cameras = m.db.camera_count();
   m.tasks = m.db.task_count();
   m.frames = m.db.frame_count();
+  m.times = m.db.manifest().times;
+  m.db_status = m.db.status();
   m.fps = m.db.manifest().video.fps > 0 ? m.db.manifest().video.fps : 30;
   m.directions.reserve(std::size_t(m.cameras));
   m.shells.reserve(std::size_t(m.cameras));
@@ -504,6 +508,32 @@ const EngineOptions& Engine::options() const { return impl_->options; }
 int Engine::frame_count() const { return impl_->frames; }
 double Engine::fps() const { return impl_->fps; }
 Selection Engine::selection() const { return impl_->sel; }
+store::Status Engine::status() const { return impl_->db_status; }
+
+int Engine::refresh() {
+  Impl& m = *impl_;
+  // A fresh Database object: the one the workers use is never modified (no locking needed).
+  const store::Database fresh = store::Database::open(m.db.dir());
+  const auto& a = m.db.manifest();
+  const auto& b = fresh.manifest();
+  if (b.camera_count() != a.camera_count() || b.task_count() != a.task_count() || !(b.graph == a.graph) ||
+      b.movie_pattern != a.movie_pattern || !(b.image == a.image))
+    throw Error(m.db.dir().string() + ": the database changed shape (cameras, tasks, graph, image size or "
+                "movie pattern) since it was opened; open it again");
+  m.db_status = fresh.status();
+  m.times = b.times;
+  if (fresh.frame_count() > 0 && fresh.frame_count() != m.frames) {
+    m.frames = fresh.frame_count();
+    m.scheduled_valid = false;
+    m.pool.invalidate();  // open readers index only the frames that existed when they were opened
+    if (m.sel.frame >= m.frames) m.set_position(m.frames - 1);
+  }
+  {
+    std::lock_guard lock(m.bad_mutex);
+    m.bad_streams.clear();
+  }
+  return m.frames;
+}
 void Engine::tick() { impl_->tick(); }
 bool Engine::playing() const { return impl_->is_playing; }
 

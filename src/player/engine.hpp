@@ -167,8 +167,17 @@ class Engine {
   const store::Database& database() const;
   const store::Manifest& manifest() const;
   const EngineOptions& options() const;
-  /// Frames playable: the database's frames_written (an interrupted database plays what it has).
+  /// Frames playable: the database's frames_written (an interrupted database plays what it has),
+  /// updated by refresh().
   int frame_count() const;
+  /// For a database that is still being written: re-reads the manifest and takes over its frame count
+  /// and times (cameras, tasks and graph must be unchanged), and forgets streams that were missing so
+  /// they are tried again. Returns the new frame_count(). Throws FileError/Error if the manifest cannot
+  /// be read or the database's shape changed; the engine is unchanged then. manifest() keeps the
+  /// manifest read at construction (its frames_written/times are not updated).
+  int refresh();
+  /// Effective status of the database at construction or the last refresh().
+  store::Status status() const;
   double fps() const;  ///< the database's frame rate
 
   // ---- selection and playback -------------------------------------------------------------------

@@ -414,6 +414,38 @@ TEST(InterruptedDb, PlaysTheFramesItHas) {
   }
 }
 
+TEST(LiveDb, RefreshTakesOverNewCheckpoints) {
+  TempDir dir("player-live");
+  const auto m = testing::ring_manifest(2, 1);
+  auto w = store::DatabaseWriter::create(dir.path, m, true);
+  const auto write = [&](int from, int to) {
+    for (int f = from; f < to; ++f)
+      for (int c = 0; c < 2; ++c) w.append(c, 0, testing::stamped_frame(c, 0, f, 64, 64));
+    w.checkpoint();
+  };
+  write(0, 3);
+  VirtualClock clock;
+  EngineOptions o;
+  o.time_source = clock.source();
+  o.start_playing = false;
+  Engine e(dir.path, o);
+  EXPECT_EQ(e.status(), store::Status::running);
+  EXPECT_EQ(e.frame_count(), 3);
+  e.seek(2);
+  EXPECT_EQ(e.current_frame().status, FrameStatus::ok);  // readers are open now, indexing 3 frames
+  e.wait_prefetch_idle();
+  write(3, 7);
+  EXPECT_EQ(e.frame_count(), 3) << "nothing changes until refresh()";
+  EXPECT_EQ(e.refresh(), 7);
+  e.seek(6);
+  const ShownFrame s = e.current_frame();
+  ASSERT_EQ(s.status, FrameStatus::ok) << s.message;
+  EXPECT_EQ(read_frame_stamp(video::MovieReader::to_rgba(*s.frame)), (FrameStamp{0, 0, 6}));
+  w.finalize();
+  e.refresh();
+  EXPECT_EQ(e.status(), store::Status::complete);
+}
+
 TEST(EngineErrors, ClearErrorsForBadInput) {
   EXPECT_THROW(Engine("/nonexistent/db"), FileError);
   TempDir dir("player-empty");

@@ -17,6 +17,7 @@ std::unique_ptr<video::MovieReader> ReaderPool::acquire(int camera, int task) {
       if (it->stream == stream) {
         auto reader = std::move(it->reader);
         idle_.erase(it);
+        lent_epoch_[reader.get()] = epoch_;
         return reader;
       }
     // Make room: the bound counts lent readers too, so when all are lent we wait for one back.
@@ -34,6 +35,7 @@ std::unique_ptr<video::MovieReader> ReaderPool::acquire(int camera, int task) {
     auto reader = database_.stream(camera, task);
     std::lock_guard lock(mutex_);
     ++opened_;
+    lent_epoch_[reader.get()] = epoch_;
     return reader;
   } catch (...) {
     {
@@ -50,13 +52,36 @@ void ReaderPool::release(int camera, int task, std::unique_ptr<video::MovieReade
   const std::int64_t stream = std::int64_t(camera) * database_.task_count() + task;
   {
     std::lock_guard lock(mutex_);
-    idle_.push_front(Idle{stream, std::move(reader)});
+    const auto it = lent_epoch_.find(reader.get());
+    const bool stale = it != lent_epoch_.end() && it->second != epoch_;
+    if (it != lent_epoch_.end()) lent_epoch_.erase(it);
+    if (stale) {
+      --open_;
+    } else {
+      idle_.push_front(Idle{stream, std::move(reader)});
+    }
   }
+  reader.reset();  // a stale reader is closed outside the lock
   returned_.notify_one();
+}
+
+void ReaderPool::invalidate() {
+  std::list<Idle> closing;
+  {
+    std::lock_guard lock(mutex_);
+    ++epoch_;
+    open_ -= int(idle_.size());
+    closing.swap(idle_);
+  }
+  returned_.notify_all();
 }
 
 void ReaderPool::discard(std::unique_ptr<video::MovieReader> reader) {
   if (!reader) return;
+  {
+    std::lock_guard lock(mutex_);
+    lent_epoch_.erase(reader.get());
+  }
   reader.reset();
   {
     std::lock_guard lock(mutex_);

@@ -6,6 +6,7 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <unordered_map>
 
 #include "store/database.hpp"
 #include "video/movie_reader.hpp"
@@ -27,6 +28,10 @@ class ReaderPool {
   /// Closes a lent reader instead of returning it (after a decode error left it in a doubtful state).
   void discard(std::unique_ptr<video::MovieReader> reader);
 
+  /// Closes every idle reader and marks the lent ones stale (they are closed when returned). For a
+  /// database that grew: a reader indexes the movie's packets when it is opened.
+  void invalidate();
+
   int capacity() const { return capacity_; }
   int open() const;               ///< readers open now (idle + lent)
   std::int64_t opened() const;    ///< readers opened since construction
@@ -42,6 +47,8 @@ class ReaderPool {
   mutable std::mutex mutex_;
   std::condition_variable returned_;
   std::list<Idle> idle_;  // front = most recently used
+  std::unordered_map<const video::MovieReader*, std::uint64_t> lent_epoch_;
+  std::uint64_t epoch_ = 0;
   int open_ = 0;
   std::int64_t opened_ = 0, evicted_ = 0;
 };
