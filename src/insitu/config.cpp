@@ -265,8 +265,13 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.outline = boolean(c, *im, "outline", "image.", true);
   }
   if (const auto* r = table(c, root, "rig")) {
-    only_keys(c, *r, "rig", {"spec"});
+    only_keys(c, *r, "rig", {"spec", "up"});
     s.rig = str(c, *r, "spec", "rig.", s.rig);
+    if (const auto* up = r->get("up")) {
+      const auto v = numbers(c, *up, "rig.up");
+      if (v.size() != 3 || v[0] * v[0] + v[1] * v[1] + v[2] * v[2] == 0) c.fail("rig.up", "expected a non-zero [x, y, z]");
+      s.up = {v[0], v[1], v[2]};
+    }
     try {
       (void)camera::RigSpec::parse(s.rig);
     } catch (const std::exception& e) {
@@ -339,6 +344,26 @@ SessionConfig parse_session_config_text(const std::string& text, const std::stri
   return parse_session_config(root, source, foreign_sections);
 }
 
+SessionConfig parse_combined_config(const std::string& text, const std::string& source,
+                                    const std::vector<std::string>& foreign_sections, std::string& foreign_text) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << source << ": TOML syntax error at line " << e.source().begin.line << ": " << e.description();
+    throw Error(s.str());
+  }
+  toml::table foreign;
+  for (const auto& [k, v] : root)
+    if (std::find(foreign_sections.begin(), foreign_sections.end(), std::string(k.str())) != foreign_sections.end())
+      foreign.insert(k, v);
+  std::ostringstream out;
+  out << foreign;
+  foreign_text = out.str();
+  return parse_session_config(root, source, foreign_sections);
+}
+
 SessionConfig load_session_config(const std::string& path, const std::vector<std::string>& foreign_sections) {
   std::ifstream in(path);
   if (!in) throw FileError(path, "cannot open the configuration file");
@@ -353,7 +378,8 @@ const char* config_keys_help() {
             units = "" (length unit of the grid)
 [image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box)
 [rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,
-            optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R)
+            optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R);
+            up = [0, 0, 1] (world direction shown upwards in the images)
 [schedule]  every_steps = 10 | every_time = DT (exactly one); max_snapshots = 0 (unlimited)
 [video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4)
 [render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid

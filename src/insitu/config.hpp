@@ -60,6 +60,7 @@ struct SessionConfig {
   std::string command_line;
   std::string units;                  ///< length unit of the grid, for the manifest
   std::string rig = "yinyang";        ///< camera::RigSpec string
+  std::array<double, 3> up{0, 0, 1};  ///< requested up vector of the rig's cameras (world)
   int width = 920, height = 896;
   std::vector<TaskConfig> tasks;
   ScheduleConfig schedule;
@@ -84,6 +85,12 @@ SessionConfig parse_session_config_text(const std::string& text, const std::stri
                                         const std::vector<std::string>& foreign_sections = {});
 /// Reads a TOML file; throws FileError naming the file.
 SessionConfig load_session_config(const std::string& path, const std::vector<std::string>& foreign_sections = {});
+
+/// Parses a file that holds the session's sections and another component's (`foreign_sections`, e.g.
+/// the seismic solver's): returns the session configuration and, in `foreign_text`, the TOML text of
+/// the foreign sections only, for that component's own parser.
+SessionConfig parse_combined_config(const std::string& text, const std::string& source,
+                                    const std::vector<std::string>& foreign_sections, std::string& foreign_text);
 
 /// Documentation of every key with its default.
 const char* config_keys_help();

@@ -227,7 +227,9 @@ void Session::Impl::init() {
 
   build_tasks();
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
-  rig = camera::make_rig(cfg.rig, domain);
+  camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
+  spec.up = {cfg.up[0], cfg.up[1], cfg.up[2]};
+  rig = camera::make_rig(spec, domain);
   for (int c = 0; c < rig.size(); ++c) cameras.push_back(rig.camera(c, cfg.width, cfg.height));
   for (int c = rank; c < rig.size(); c += size) owned.push_back(c);
   references.resize(field_names.size());
