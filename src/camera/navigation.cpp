@@ -222,7 +222,12 @@ NavigationGraph build_navigation_graph(const Rig& rig, const GraphOptions& optio
       const Vec3 t = p - u * c;
       const double tn = norm(t);
       const double angle = std::atan2(tn, c);
-      if (angle < kSame || tn < 1e-12) return;
+      if (angle < kSame) return;
+      if (tn < 1e-12) {
+        // Exactly opposite: every heading leads there, so it is a (last-resort) candidate in all cones.
+        for (int a = 0; a < 4; ++a) best[a].offer(j, float(2 * angle));
+        return;
+      }
       for (int a = 0; a < 4; ++a) {
         const double cos_dev = dot(t, axes[a]) / tn;
         if (cos_dev < cos_cone) continue;

@@ -194,3 +194,21 @@ TEST(Navigation, RejectsBadOptions) {
   o.alignment_weight = -1;
   EXPECT_THROW(build_navigation_graph(rig, o), Error);
 }
+
+TEST(Navigation, TinyRigs) {
+  // Two antipodal cameras (Yin-Yang 1x1): every heading leads to the other one.
+  const Rig two = make_rig("yinyang:1x1", kDomain);
+  ASSERT_EQ(two.size(), 2);
+  const NavigationGraph g2 = build_navigation_graph(two);
+  for (Move m : {Move::right, Move::left, Move::up, Move::down}) {
+    EXPECT_EQ(g2.next(0, m), 1);
+    EXPECT_EQ(g2.next(1, m), 0);
+  }
+  // A lone camera has no neighbours and the whole sphere but one point is uncovered.
+  const Rig one = make_rig("fibonacci:1", kDomain);
+  const NavigationGraph g1 = build_navigation_graph(one);
+  EXPECT_EQ(g1.neighbours[0], Neighbours{});
+  const RigStatistics st = rig_statistics(one, g1);
+  EXPECT_NEAR(st.covering_deg, 180, 1e-9);
+  EXPECT_EQ(st.reachable_from_0, 1);
+}

@@ -58,7 +58,7 @@ std::vector<double> nearest_neighbour_angles(const SphereIndex& index) {
 
 double covering_radius(const SphereIndex& index, int samples) {
   const int n = index.size();
-  if (n == 0) return kPi;
+  if (n <= 1) return kPi;  // the antipode of a lone point
   if (samples <= 0) samples = int(std::clamp(100LL * n, 20000LL, 2000000LL));
   const double golden_angle = kPi * (3.0 - std::sqrt(5.0));
   std::vector<std::pair<double, int>> dist(samples);
