@@ -19,7 +19,7 @@ struct Args {
   int cameras = 8, tasks = 2, frames = 10;
   std::string size = "64x64";
   bool overwrite = false;
-  int gop = -1, crf = -1, threads = 0;
+  int gop = 10, crf = -1, threads = 0;
   std::string preset, title = "synthetic database";
 };
 
@@ -39,7 +39,7 @@ void run(const Args& a, const std::string& command_line) {
   o.threads = a.threads;
   o.title = a.title;
   o.command_line = command_line;
-  if (a.gop >= 0) o.video.gop = a.gop;
+  o.video.gop = a.gop;
   if (a.crf >= 0) o.video.crf = a.crf;
   if (!a.preset.empty()) o.video.preset = a.preset;
   o.video.validate();
@@ -73,7 +73,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--frames", args->frames, "Frames per movie")->check(CLI::Range(1, 1 << 20))->capture_default_str();
   sub->add_option("--size", args->size, "Frame size WIDTHxHEIGHT (at least 40x32 for the stamp)")->capture_default_str();
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in OUT");
-  sub->add_option("--gop", args->gop, "Keyframe interval in frames (default: the video default)");
+  // Not the video default (1): an intra-only writer opens an x264 encoder per frame, which for tiny
+  // frames costs 2.6x the CPU of one encoder per movie (measured: 10 vs 3.8 ms per 64x64 10-frame stream).
+  sub->add_option("--gop", args->gop, "Keyframe interval in frames")->check(CLI::Range(1, 100000))->capture_default_str();
   sub->add_option("--crf", args->crf, "x264 constant rate factor 0..51 (default: the video default)");
   sub->add_option("--preset", args->preset, "x264 preset (default: the video default)");
   sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->capture_default_str();
