@@ -116,6 +116,14 @@ RigSpec RigSpec::parse(std::string_view text) {
     spec.count = 130;
     if (has_params) spec.count = parse_int(text, params, "camera count");
   } else {
+    // A file whose name starts like a kind (e.g. "yinyang.txt") is still a camera file.
+    if (!shells_prefix && std::filesystem::is_regular_file(std::string(text))) {
+      spec = RigSpec{};
+      spec.kind = Kind::file;
+      spec.path = std::string(text);
+      spec.radii.clear();
+      return spec;
+    }
     bad_spec(text, "unknown rig kind '" + std::string(kind) + "'");
   }
   const long long upper = spec.kind == Kind::yinyang ? 2LL * spec.rows * spec.columns : spec.cameras_per_shell();

@@ -245,6 +245,15 @@ TEST(RigFile, TextFormat) {
   EXPECT_NEAR(rig.cameras[1].longitude_deg, 90, 1e-12);
   EXPECT_NEAR(rig.cameras[2].radius, 5, 1e-12);
   EXPECT_EQ(make_rig("file:" + path.string(), d).size(), 3);
+  {
+    // A file named like a kind is still a file; the built-in kinds win only when they parse.
+    const std::string cwd_name = "yinyang_cams_panoptes_test.txt";
+    std::filesystem::copy_file(path, cwd_name, std::filesystem::copy_options::overwrite_existing);
+    const RigSpec spec = RigSpec::parse(cwd_name);
+    EXPECT_EQ(spec.kind, RigSpec::Kind::file);
+    EXPECT_EQ(make_rig(spec, d).size(), 3);
+    std::filesystem::remove(cwd_name);
+  }
   std::filesystem::remove(path);
 }
 
