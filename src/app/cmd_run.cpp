@@ -1,0 +1,225 @@
+// `panoptes run CONFIG.toml`: the seismic solver with in-situ visualization from one TOML file
+// (works under mpirun -np N). The seismic sections ([grid], [time], [medium], [boundary],
+// [attenuation], [[source]], [[receiver]], [receiver_line]) go to the solver's own parser; the
+// in-situ sections ([output], [image], [rig], [schedule], [video], [render], [[task]]) to
+// insitu::parse_session_config. Everything is checked before the first step.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "app/command.hpp"
+#include "core/error.hpp"
+#include "insitu/session.hpp"
+#include "seismic/config_toml.hpp"
+#include "seismic/solver.hpp"
+#include "store/database.hpp"
+
+#ifdef PANOPTES_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace panoptes::app {
+
+/// Options of a seismic in-situ run (shared with `panoptes demo`).
+struct SeismicRunOptions {
+  std::string out;  ///< overrides [output] dir when not empty
+  bool overwrite = false;
+  bool quiet = false;
+  std::string command_line;
+};
+
+/// Runs the solver with in-situ visualization from TOML text. Defined here, used by cmd_demo.cpp too.
+void run_seismic_insitu(const std::string& text, const std::string& source, const std::string& base_dir,
+                        const SeismicRunOptions& options);
+
+namespace {
+
+const std::set<std::string> kSeismicSections{"grid",   "time",     "medium",       "boundary",
+                                             "attenuation", "source", "receiver", "receiver_line"};
+
+// Initializes MPI when the process was not started with it initialized, and finalizes it at the end.
+struct MpiScope {
+  bool owned = false;
+  MpiScope() {
+#ifdef PANOPTES_HAVE_MPI
+    int init = 0;
+    MPI_Initialized(&init);
+    if (!init) {
+      int provided = 0;
+      MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+      owned = true;
+    }
+#endif
+  }
+  ~MpiScope() {
+#ifdef PANOPTES_HAVE_MPI
+    if (owned) MPI_Finalize();
+#endif
+  }
+};
+
+std::int64_t directory_bytes(const std::filesystem::path& dir) {
+  std::int64_t n = 0;
+  std::error_code ec;
+  for (auto it = std::filesystem::recursive_directory_iterator(dir, ec); it != std::filesystem::recursive_directory_iterator();
+       it.increment(ec))
+    if (it->is_regular_file(ec)) n += std::int64_t(it->file_size(ec));
+  return n;
+}
+
+std::string human_bytes(double b) {
+  const char* units[] = {"B", "KB", "MB", "GB", "TB"};
+  int u = 0;
+  while (b >= 1000 && u < 4) b /= 1000, ++u;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.1f %s", b, units[u]);
+  return buf;
+}
+
+insitu::FieldInput input_of(const char* name, const seismic::FieldView& v) {
+  return {name, v.data, insitu::ScalarType::f32, {1, std::int64_t(v.stride_y), std::int64_t(v.stride_z)}};
+}
+
+}  // namespace
+
+void run_seismic_insitu(const std::string& text, const std::string& source, const std::string& base_dir,
+                        const SeismicRunOptions& options) {
+  // Split the file: seismic sections to the solver's parser, the rest to the session's.
+  const std::vector<std::string> seismic_sections(kSeismicSections.begin(), kSeismicSections.end());
+  std::string seis_text;
+  insitu::SessionConfig cfg = insitu::parse_combined_config(text, source, seismic_sections, seis_text);
+  const seismic::RunConfig rc = seismic::parse_run_config(seis_text, source, base_dir);
+  rc.solver.validate();
+  if (!options.out.empty()) cfg.output_dir = options.out;
+  if (options.overwrite) cfg.overwrite = true;
+  cfg.validate();
+  cfg.program = "panoptes run";
+  cfg.command_line = options.command_line;
+  cfg.units = "m";
+  // Depth is +z (down): show the free surface at the top of every image.
+  cfg.up = {0, 0, -1};
+  for (const auto& t : cfg.tasks)
+    for (const auto& f : t.fields)
+      if (f != "phi_p" && f != "phi_s")
+        throw FileError(source, "task \"" + t.name + "\": field \"" + f +
+                                    "\"; the seismic run provides phi_p (div v) and phi_s (|curl v|)");
+
+  MpiScope mpi;
+#ifdef PANOPTES_HAVE_MPI
+  seismic::Solver solver(rc.solver, MPI_COMM_WORLD);
+#else
+  seismic::Solver solver(rc.solver);
+#endif
+  const auto& g = rc.solver.grid;
+  const render::GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
+  insitu::LocalBlock block;
+  block.offset = {0, 0, solver.k_begin()};
+  block.extent = {g.nx, g.ny, solver.k_end() - solver.k_begin()};
+#ifdef PANOPTES_HAVE_MPI
+  insitu::Session session(cfg, grid, block, MPI_COMM_WORLD);
+#else
+  insitu::Session session(cfg, grid, block);
+#endif
+  const bool root = solver.rank() == 0;
+  const bool tty = ::isatty(STDERR_FILENO);
+  const int steps = rc.solver.steps;
+  // Expected number of snapshots, for the progress bar.
+  int expected = 0;
+  for (int s = 0; s < steps; ++s) {
+    const double t = (s + 0.5) * solver.dt();
+    if (cfg.schedule.every_steps > 0 ? (s + 1) % cfg.schedule.every_steps == 0
+                                     : std::floor(t / cfg.schedule.every_time) >
+                                           std::floor((t - solver.dt()) / cfg.schedule.every_time))
+      ++expected;
+  }
+  if (cfg.schedule.max_snapshots > 0) expected = std::min(expected, cfg.schedule.max_snapshots);
+  if (root && !options.quiet)
+    std::fprintf(stderr,
+                 "panoptes run: %dx%dx%d grid, %d steps of %.3g s on %d rank(s); %d cameras x %d tasks = %d streams of "
+                 "%dx%d, ~%d snapshots -> %s\n",
+                 g.nx, g.ny, g.nz, steps, solver.dt(), solver.ranks(), session.camera_count(), session.task_count(),
+                 session.camera_count() * session.task_count(), cfg.width, cfg.height, expected,
+                 cfg.output_dir.c_str());
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  double sim = 0;
+  for (int s = 0; s < steps; ++s) {
+    auto ts = Clock::now();
+    solver.step();
+    sim += std::chrono::duration<double>(Clock::now() - ts).count();
+    // Snapshot after steps N, 2N, ... (step s + 1 counted from 1, so the first one shows waves).
+    if (!session.due(s + 1, solver.velocity_time())) continue;
+    ts = Clock::now();
+    solver.compute_derived();
+    sim += std::chrono::duration<double>(Clock::now() - ts).count();
+    session.snapshot(solver.velocity_time(), {input_of("phi_p", solver.phi_p()), input_of("phi_s", solver.phi_s())});
+    if (root && !options.quiet) {
+      const insitu::SessionStats st = session.stats();
+      const double el = std::chrono::duration<double>(Clock::now() - t0).count();
+      const double eta = el * double(steps - s - 1) / double(s + 1);
+      std::fprintf(stderr,
+                   "%ssnapshot %d/%d  step %d/%d  %.0f s elapsed, ETA %.0f s | simulation %.1f s, render %.1f s, "
+                   "composite %.1f s, encode %.1f s%s",
+                   tty ? "\r" : "", st.snapshots, expected, s + 1, steps, el, eta, sim, st.time.render + st.time.copy,
+                   st.time.composite, st.time.encode, tty ? "  " : "\n");
+    }
+  }
+  session.finalize();
+  const insitu::SessionStats st = session.reduced_stats();
+  if (root) {
+    if (tty && !options.quiet) std::fprintf(stderr, "\n");
+    const double el = std::chrono::duration<double>(Clock::now() - t0).count();
+    const std::int64_t db_bytes = directory_bytes(cfg.output_dir);
+    const double raw = double(st.snapshots) * 2.0 * double(g.nx) * g.ny * g.nz * 4.0;
+    const double frames = double(st.frames_encoded);
+    std::printf("wrote %s: %d cameras x %d tasks = %d streams, %d frames each (%.0f camera-frames) of %dx%d\n",
+                cfg.output_dir.c_str(), session.camera_count(), session.task_count(),
+                session.camera_count() * session.task_count(), st.snapshots, frames, cfg.width, cfg.height);
+    std::printf("database %s; the raw fields (phi_p, phi_s as float32, %d snapshots) would take %s (movies = %.1f %%)\n",
+                human_bytes(double(db_bytes)).c_str(), st.snapshots, human_bytes(raw).c_str(),
+                raw > 0 ? 100.0 * double(db_bytes) / raw : 0.0);
+    std::printf("time %.1f s on %d rank(s): simulation %.1f s, render %.1f s, composite %.1f s, encode %.1f s, "
+                "checkpoint %.1f s (slowest rank per phase); %.1f camera-frames/s; peak memory per rank %s\n",
+                el, solver.ranks(), sim, st.time.render + st.time.copy, st.time.composite, st.time.encode,
+                st.time.checkpoint, el > 0 ? frames / el : 0.0, human_bytes(double(st.peak_rss_bytes)).c_str());
+    std::printf("open it with: panoptes play %s\n", cfg.output_dir.c_str());
+  }
+}
+
+namespace {
+
+CommandRegistration reg([](CLI::App& root) {
+  auto config = std::make_shared<std::string>();
+  auto opt = std::make_shared<SeismicRunOptions>();
+  auto* sub = root.add_subcommand(
+      "run",
+      "Run the seismic solver with in-situ visualization from one TOML file: every camera of a rig x every "
+      "task becomes a movie in a database (works under mpirun -np N). Keys of the solver sections are those "
+      "of `panoptes seismic --help`; in-situ keys are listed below. Fields for tasks: phi_p (div v), "
+      "phi_s (|curl v|).");
+  sub->add_option("CONFIG", *config, "TOML configuration file")->required();
+  sub->add_option("--out", opt->out, "Database directory (overrides [output] dir)");
+  sub->add_flag("--overwrite", opt->overwrite, "Replace an existing database");
+  sub->add_flag("-q,--quiet", opt->quiet, "No progress output");
+  sub->footer(std::string(insitu::config_keys_help()));
+  sub->callback([config, opt] {
+    std::ifstream in(*config);
+    if (!in) throw FileError(*config, "cannot open the configuration file");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    opt->command_line = "panoptes run " + *config + (opt->out.empty() ? "" : " --out " + opt->out);
+    const std::string base = std::filesystem::path(*config).parent_path().string();
+    run_seismic_insitu(ss.str(), *config, base.empty() ? "." : base, *opt);
+  });
+});
+
+}  // namespace
+}  // namespace panoptes::app
