@@ -325,7 +325,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--task", args->tasks,
                   "Visualization task (repeatable): volume:PRESET[:LO:HI], iso:VALUE, slice:x|y|z:FRACTION[:PRESET[:LO:HI]]. "
                   "Presets: p-wave, s-wave, diverging, grayscale, hot, rainbow. Without LO:HI the window follows the "
-                  "running maximum of the --percentile of |v| (default task: volume:hot)");
+                  "running maximum of the --percentile of |v| (default task: volume:hot)")
+      ->allow_extra_args(false);
   sub->add_option("--size", args->size, "Image size WIDTHxHEIGHT")->capture_default_str();
   sub->add_option("--out", args->out, "Output database directory")->required();
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in --out");

@@ -39,6 +39,9 @@ if "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 48x40 --out "$t
 fi
 grep -q "panoptes: error:" "$tmp/err.txt" || fail "no error line"
 "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 48x40 --out "$tmp/db" --overwrite > /dev/null
+# One value per --task: a volume after --task is still the input.
+"$panoptes" render --task iso:3 "$tmp/sphere.vtk" --rig fibonacci:2 --size 32x32 --out "$tmp/db2" > "$tmp/out.txt"
+grep -q "2 cameras x 1 tasks" "$tmp/out.txt" || fail "--task took the volume as a task: $(cat "$tmp/out.txt")"
 
 if command -v python3 > /dev/null; then
   # NumPy files without numpy: header + little-endian float32/float64 data; a BINARY VTK (big-endian).
