@@ -11,9 +11,9 @@ out=$("$panoptes" synth-db "$tmp/db" --cameras 3 --tasks 2 --frames 4 --size 64x
 grep -q "3 cameras x 2 tasks = 6 streams, 4 frames of 64x48" <<<"$out" || fail "unexpected output: $out"
 [ -f "$tmp/db/panoptes.json" ] || fail "no manifest"
 [ "$(find "$tmp/db/movies" -name '*.mp4' | wc -l)" -eq 6 ] || fail "expected 6 movies"
-grep -q '"gop": 2' "$tmp/db/panoptes.json" || fail "gop not recorded"
-grep -q '"crf": 28' "$tmp/db/panoptes.json" || fail "crf not recorded"
-grep -q '"status": "complete"' "$tmp/db/panoptes.json" || fail "status not complete"
+grep -Eq '"gop": ?2' "$tmp/db/panoptes.json" || fail "gop not recorded"
+grep -Eq '"crf": ?28' "$tmp/db/panoptes.json" || fail "crf not recorded"
+grep -Eq '"status": ?"complete"' "$tmp/db/panoptes.json" || fail "status not complete"
 
 # An existing database is refused (one line, exit 1) and left intact; --overwrite replaces it.
 if "$panoptes" synth-db "$tmp/db" --cameras 1 --tasks 1 2>"$tmp/err"; then fail "overwrote without --overwrite"; fi
