@@ -46,9 +46,11 @@ struct WriterOptions {
 ///
 /// Memory: every stream that has been appended to keeps one open MovieWriter (an x264 encoder with
 /// its lookahead and reference frames) until finalize(); the in-situ engine appends to every
-/// (camera, task) each snapshot, so all writers stay open. Per-writer memory is measured by
-/// bench/video_bench (resident memory per open writer, see BENCHMARKS.md); with MPI the writers are
-/// spread over ranks by camera ownership. The writer's own bookkeeping is 16 bytes per stream.
+/// (camera, task) each snapshot, so all writers stay open. Per-writer memory at 920x896, measured by
+/// bench/video_bench (docs/formats.md, Movies): about 1 MB with gop 1 (the default: no encoder is
+/// kept between frames), about 25 MB with gop > 1 (a live x264 encoder with reference frames). So
+/// 10^4 streams of one rank need ~10 GB at gop 1: spread cameras over ranks (MPI), or write offline
+/// stream by stream with close_stream(). The writer's own bookkeeping is 16 bytes per stream.
 class DatabaseWriter {
  public:
   /// Creates the directory (and parents) and writes the manifest with status `running`,
