@@ -52,16 +52,18 @@ int MiniMap::draw(int current, const std::vector<int>& neighbours, float size) {
 
   dl->AddCircleFilled(c, radius, IM_COL32(20, 28, 40, 200), 48);
   dl->AddCircle(c, radius, IM_COL32(140, 160, 190, 255), 48, 1.5f);
-  // Equator and the meridian through the view, front halves solid, back halves faint.
-  for (int line = 0; line < 2; ++line) {
+  // Equator and two meridians 45° either side of the view (the meridian through the view would be
+  // seen edge-on), front halves solid, back halves faint.
+  auto circle_point = [&](int line, double a) {
+    if (line == 0) return Vec3{std::cos(a), std::sin(a), 0};
+    const double lon = azimuth_ + (line == 1 ? 1 : -1) * M_PI / 4;
+    return Vec3{std::cos(a) * std::cos(lon), std::cos(a) * std::sin(lon), std::sin(a)};
+  };
+  for (int line = 0; line < 3; ++line) {
     constexpr int n = 72;
     for (int i = 0; i < n; ++i) {
-      const double a0 = 2 * M_PI * i / n, a1 = 2 * M_PI * (i + 1) / n;
-      const Vec3 v0 = line == 0 ? Vec3{std::cos(a0), std::sin(a0), 0}
-                                : Vec3{std::cos(a0) * std::cos(azimuth_), std::cos(a0) * std::sin(azimuth_), std::sin(a0)};
-      const Vec3 v1 = line == 0 ? Vec3{std::cos(a1), std::sin(a1), 0}
-                                : Vec3{std::cos(a1) * std::cos(azimuth_), std::cos(a1) * std::sin(azimuth_), std::sin(a1)};
-      const MapPoint m0 = project_to_map(v0, azimuth_, kElevation), m1 = project_to_map(v1, azimuth_, kElevation);
+      const MapPoint m0 = project_to_map(circle_point(line, 2 * M_PI * i / n), azimuth_, kElevation);
+      const MapPoint m1 = project_to_map(circle_point(line, 2 * M_PI * (i + 1) / n), azimuth_, kElevation);
       const bool front = m0.depth + m1.depth > 0;
       dl->AddLine(to_screen(m0, 1), to_screen(m1, 1), front ? IM_COL32(90, 110, 140, 255) : IM_COL32(60, 70, 90, 110));
     }
