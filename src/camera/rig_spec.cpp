@@ -157,7 +157,10 @@ std::string RigSpec::to_string() const {
     case Kind::file: return "file:" + path;
   }
   s += '@';
-  for (std::size_t k = 0; k < radii.size(); ++k) s += (k ? "," : "") + format_double(radii[k]);
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    if (k) s += ',';
+    s += format_double(radii[k]);
+  }
   return s;
 }
 
