@@ -304,7 +304,11 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     }
   }
   if (const auto* r = table(c, root, "render")) {
-    only_keys(c, *r, "render", {"sample_distance", "percentile", "skip_empty", "termination_alpha"});
+    only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha"});
+    const std::string ref = str(c, *r, "reference", "render.", "snapshot");
+    if (ref != "snapshot" && ref != "running-max")
+      c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\" or \"running-max\"");
+    s.running_max = ref == "running-max";
     s.render.sample_distance = num(c, *r, "sample_distance", "render.", s.render.sample_distance);
     if (!(s.render.sample_distance >= 0.01 && s.render.sample_distance <= 16))
       c.fail("render.sample_distance", "expected 0.01..16 voxels");
@@ -382,9 +386,10 @@ const char* config_keys_help() {
             up = [0, 0, 1] (world direction shown upwards in the images)
 [schedule]  every_steps = 10 | every_time = DT (exactly one); max_snapshots = 0 (unlimited)
 [video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4)
-[render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid
-            whose running maximum is the reference "ref" of relative windows); skip_empty = true;
-            termination_alpha = 0.998
+[render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid:
+            the reference "ref" of relative windows); reference = "snapshot" (this snapshot's quantile)
+            | "running-max" (running maximum over snapshots: colours comparable across frames, but
+            decaying waves fade); skip_empty = true; termination_alpha = 0.998
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |
             "isosurface" | "slice"; field = "name" (volume2: fields = ["a", "b"])
   volume:     preset = "hot" (p-wave, s-wave, diverging, grayscale, hot, rainbow); extinction_scale = 1;

@@ -17,7 +17,8 @@ class table;
 namespace panoptes::insitu {
 
 /// A value window: absolute [lo, hi], or relative (lo·ref, hi·ref) where ref is the running maximum
-/// over snapshots of the `percentile` quantile of |field| over the whole grid.
+/// of the `percentile` quantile of |field| over the whole grid (this snapshot's, or the running
+/// maximum over snapshots: SessionConfig::running_max).
 struct WindowConfig {
   double lo = 0, hi = 1;
   bool relative = true;
@@ -69,6 +70,9 @@ struct SessionConfig {
   std::array<float, 3> background{0, 0, 0};
   bool outline = true;
   double percentile = 0.999;          ///< quantile of |v| used as reference of relative windows
+  /// Reference of relative windows: this snapshot's quantile (false), or its running maximum over
+  /// snapshots (true: colours comparable across frames, but decaying waves fade out).
+  bool running_max = false;
 
   /// Checks ranges and consistency (not the grid); throws panoptes::Error naming the key.
   void validate() const;

@@ -737,7 +737,10 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());
   for (std::size_t f = 0; f < m.field_names.size(); ++f)
-    ref[f] = std::max(m.references[f].update(m.global_percentile(int(f))), 1e-30);
+  {
+    const double q = m.global_percentile(int(f));
+    ref[f] = std::max(m.cfg.running_max ? m.references[f].update(q) : q, 1e-30);
+  }
   for (std::size_t i = 0; i < m.tasks.size(); ++i) {
     const Task& t = m.tasks[i];
     render::TaskSpec& s = m.specs[i];
