@@ -174,6 +174,9 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   }
   session.finalize();
   const insitu::SessionStats st = session.reduced_stats();
+#ifdef PANOPTES_HAVE_MPI
+  MPI_Allreduce(MPI_IN_PLACE, &sim, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+#endif
   if (root) {
     if (tty && !options.quiet) std::fprintf(stderr, "\n");
     const double el = std::chrono::duration<double>(Clock::now() - t0).count();
