@@ -14,25 +14,12 @@
 #include "core/image.hpp"
 #include "store/database.hpp"
 #include "store/manifest.hpp"
+#include "store/test_support.hpp"
 
 namespace panoptes::player::testing {
 
-/// A fresh directory under the system temp dir, removed (recursively) on destruction.
-struct TempDir {
-  std::filesystem::path path;
-  explicit TempDir(const std::string& tag = "player") {
-    std::random_device rd;
-    path = std::filesystem::temp_directory_path() /
-           ("panoptes-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-};
+/// A fresh directory under the system temp dir, removed on destruction (shared with the store tests).
+using TempDir = store::testing::TempDir;
 
 /// A manifest with `cameras` cameras on a ring of latitude 0 (camera c at longitude 360°·c/cameras)
 /// with a wrap-around left/right graph, `tasks` tasks on two axes when tasks = a × b ("iso" with a

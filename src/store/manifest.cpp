@@ -540,7 +540,9 @@ std::string manifest_text(const json& j) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!first) out += ",\n";
     first = false;
-    out += " " + json(it.key()).dump() + ": ";
+    out += ' ';
+    out += json(it.key()).dump();
+    out += ": ";
     const json& v = it.value();
     const json* list = &v;
     std::string suffix;

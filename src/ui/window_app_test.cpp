@@ -15,6 +15,7 @@
 #include "core/frame_stamp.hpp"
 #include "core/png.hpp"
 #include "store/database.hpp"
+#include "store/test_support.hpp"
 #include "ui/window_app.hpp"
 #include "video/movie_reader.hpp"
 
@@ -26,18 +27,8 @@ namespace {
 constexpr int kW = 480, kH = 360, kCameras = 4, kTasks = 2, kFrames = 6;
 constexpr std::uint8_t kGrey = 96;
 
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    std::random_device rd;
-    path = std::filesystem::temp_directory_path() /
-           ("panoptes-ui-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
+struct TempDir : store::testing::TempDir {
+  TempDir() : store::testing::TempDir("ui") {}
 };
 
 // Four cameras on the equator (z up), a left/right ring graph, two tasks on an "iso" axis.
