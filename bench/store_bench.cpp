@@ -74,6 +74,7 @@ void BM_SyntheticDatabase(benchmark::State& state) {
   o.tasks = int(state.range(1));
   o.frames = 10;
   o.width = o.height = 64;
+  o.video.gop = 10;  // as `panoptes synth-db` (one encoder per movie; GOP 1 opens one per frame)
   for (auto _ : state) {
     testing::TempDir dir("bench-synth");
     write_synthetic_database(dir.path / "db", o);
