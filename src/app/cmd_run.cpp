@@ -16,6 +16,7 @@
 #include <string>
 
 #include "app/command.hpp"
+#include "app/mpi_scope.hpp"
 #include "core/error.hpp"
 #include "insitu/session.hpp"
 #include "seismic/config_toml.hpp"
@@ -45,26 +46,6 @@ namespace {
 const std::set<std::string> kSeismicSections{"grid",   "time",     "medium",       "boundary",
                                              "attenuation", "source", "receiver", "receiver_line"};
 
-// Initializes MPI when the process was not started with it initialized, and finalizes it at the end.
-struct MpiScope {
-  bool owned = false;
-  MpiScope() {
-#ifdef PANOPTES_HAVE_MPI
-    int init = 0;
-    MPI_Initialized(&init);
-    if (!init) {
-      int provided = 0;
-      MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-      owned = true;
-    }
-#endif
-  }
-  ~MpiScope() {
-#ifdef PANOPTES_HAVE_MPI
-    if (owned) MPI_Finalize();
-#endif
-  }
-};
 
 std::int64_t directory_bytes(const std::filesystem::path& dir) {
   std::int64_t n = 0;

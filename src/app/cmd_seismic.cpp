@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "app/command.hpp"
+#include "app/mpi_scope.hpp"
 #include "core/error.hpp"
 #include "seismic/config_toml.hpp"
 #include "seismic/solver.hpp"
@@ -18,30 +19,11 @@
 
 namespace {
 
-/// Initialises MPI for the run when the program was not started with it already initialised.
-struct MpiSession {
-  bool owned = false;
-  MpiSession() {
-#ifdef PANOPTES_HAVE_MPI
-    int init = 0;
-    MPI_Initialized(&init);
-    if (!init) {
-      int provided = 0;
-      MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-      owned = true;
-    }
-#endif
-  }
-  ~MpiSession() {
-#ifdef PANOPTES_HAVE_MPI
-    if (owned) MPI_Finalize();
-#endif
-  }
-};
+using MpiScope = panoptes::app::MpiScope;
 
 void run(const std::string& config_path, const std::string& output_override, bool quiet) {
   using namespace panoptes::seismic;
-  MpiSession mpi;
+  MpiScope mpi;
   RunConfig rc = load_run_config(config_path);
   if (!output_override.empty()) rc.output_dir = output_override;
   const auto t0 = std::chrono::steady_clock::now();
