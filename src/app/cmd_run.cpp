@@ -46,7 +46,6 @@ namespace {
 const std::set<std::string> kSeismicSections{"grid",   "time",     "medium",       "boundary",
                                              "attenuation", "source", "receiver", "receiver_line"};
 
-
 std::int64_t directory_bytes(const std::filesystem::path& dir) {
   std::int64_t n = 0;
   std::error_code ec;
