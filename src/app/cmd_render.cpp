@@ -142,15 +142,6 @@ CliTask parse_task(const std::string& text, const render::GridGeometry& grid) {
   return t;
 }
 
-std::string iso_time() {
-  char buf[32];
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
 void progress(bool tty, long long done, long long total, double elapsed) {
   if (!tty) return;
   const int width = 30;
@@ -199,10 +190,6 @@ void run(const Args& a, const std::string& command_line) {
   man.title = a.title.empty() ? "panoptes render " + files[0] : a.title;
   man.provenance.program = "panoptes render";
   man.provenance.version = "0.1.0";
-  man.provenance.created = iso_time();
-  char host[256] = {};
-  ::gethostname(host, sizeof host - 1);
-  man.provenance.host = host;
   man.provenance.command_line = command_line;
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
   man.domain.origin = grid.origin;

@@ -108,15 +108,6 @@ std::string fmt(double v) {
   return s.str();
 }
 
-std::string iso_time() {
-  char buf[32];
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
 std::int64_t peak_rss() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -361,10 +352,6 @@ store::Manifest Session::Impl::make_manifest() const {
   man.title = cfg.title;
   man.provenance.program = cfg.program;
   man.provenance.version = "0.1.0";
-  man.provenance.created = iso_time();
-  char host[256] = {};
-  ::gethostname(host, sizeof host - 1);
-  man.provenance.host = host;
   man.provenance.command_line = cfg.command_line;
   man.provenance.extra["mpi_ranks"] = std::to_string(size);
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};

@@ -5,6 +5,8 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <ctime>
+
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -28,6 +30,16 @@ namespace {
 std::string host_name() {
   char buf[256] = {};
   if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+// Current UTC time as ISO 8601, e.g. "2026-11-21T22:40:00Z".
+std::string utc_now_iso8601() {
+  char buf[32];
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
 
@@ -181,6 +193,9 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     manifest.image.padded_width = (manifest.image.width + 1) & ~1;
     manifest.image.padded_height = (manifest.image.height + 1) & ~1;
   }
+  // Provenance every writer would otherwise fill in by hand.
+  if (manifest.provenance.created.empty()) manifest.provenance.created = utc_now_iso8601();
+  if (manifest.provenance.host.empty()) manifest.provenance.host = host_name();
   manifest.status = Status::running;
   manifest.frames_written = 0;
   manifest.schema_version = kSchemaVersion;

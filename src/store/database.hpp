@@ -54,7 +54,7 @@ struct WriterOptions {
 class DatabaseWriter {
  public:
   /// Creates the directory (and parents) and writes the manifest with status `running`,
-  /// frames_written 0 and image.padded_* filled in. Throws FileError if the directory already holds
+  /// frames_written 0, image.padded_* and (when empty) provenance.created / provenance.host filled in. Throws FileError if the directory already holds
   /// a database and !options.overwrite, or cannot be created; Error if the manifest is invalid.
   static DatabaseWriter create(const std::filesystem::path& dir, Manifest manifest,
                                const WriterOptions& options = {});

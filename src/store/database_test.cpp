@@ -99,6 +99,24 @@ TEST(Database, StampSurvivesAtThePapersFrameSize) {
   expect_stamps(Database::open(dir.path), 0, 0, 3);
 }
 
+TEST(Database, CreateFillsCreationTimeAndHostWhenEmpty) {
+  TempDir dir;
+  Manifest m = sample_manifest(2, 1);
+  m.provenance.created.clear();
+  m.provenance.host.clear();
+  auto w = DatabaseWriter::create(dir / "db", m, false);
+  w.finalize();
+  const Database db = Database::open(dir / "db");
+  EXPECT_EQ(db.manifest().provenance.created.size(), 20u);  // e.g. 2026-11-21T22:40:00Z
+  EXPECT_EQ(db.manifest().provenance.created.back(), 'Z');
+  EXPECT_FALSE(db.manifest().provenance.host.empty());
+  // Given values are kept.
+  m.provenance.created = "2000-01-01T00:00:00Z";
+  auto w2 = DatabaseWriter::create(dir / "db2", m, false);
+  w2.finalize();
+  EXPECT_EQ(Database::open(dir / "db2").manifest().provenance.created, "2000-01-01T00:00:00Z");
+}
+
 TEST(Database, OpenReadsTheManifestOnly) {
   TempDir dir;
   Manifest m = sample_manifest(50, 20);

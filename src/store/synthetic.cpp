@@ -30,17 +30,6 @@ Manifest synthetic_manifest(const SyntheticOptions& o) {
   m.title = o.title;
   m.provenance.program = "panoptes synth-db";
   m.provenance.version = "0.1.0";
-  {
-    char buf[32];
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&now, &tm);
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-    m.provenance.created = buf;
-    char host[256] = {};
-    ::gethostname(host, sizeof host - 1);
-    m.provenance.host = host;
-  }
   m.provenance.command_line = o.command_line;
   m.domain.dims = {64, 64, 64};
   m.domain.origin = {-1, -1, -1};
