@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -80,13 +81,19 @@ FieldAcc make_acc(const FieldView& v) {
   return a;
 }
 
-// Trilinear interpolation at index-space position (x, y, z). The cell index is clamped so float
-// rounding at the brick faces can never read outside the data.
+// Trilinear interpolation at index-space position (x, y, z). With kClamp the cell index is clamped
+// so float rounding at the data's faces can never read outside it; macro-cells that lie at least
+// one cell inside the data on every side use kClamp = false (the march knows which, see
+// Shared::safe_lo/hi), which saves six min/max per field and sample. Both variants compute the same
+// bits whenever the clamp would not change the index, so images do not depend on which one ran.
+template <bool kClamp = true>
 inline float interp(const FieldAcc& f, float x, float y, float z) {
   int i = int(x), j = int(y), k = int(z);
-  i = std::min(std::max(i, f.ilo[0]), f.ihi[0]);
-  j = std::min(std::max(j, f.ilo[1]), f.ihi[1]);
-  k = std::min(std::max(k, f.ilo[2]), f.ihi[2]);
+  if constexpr (kClamp) {
+    i = std::min(std::max(i, f.ilo[0]), f.ihi[0]);
+    j = std::min(std::max(j, f.ilo[1]), f.ihi[1]);
+    k = std::min(std::max(k, f.ilo[2]), f.ihi[2]);
+  }
   const float fx = x - float(i), fy = y - float(j), fz = z - float(k);
   const float* c = f.data + (f.off0 + i * f.sx + j * f.sy + k * f.sz);
   const std::int64_t sx = f.sx, sy = f.sy, sz = f.sz;
@@ -100,11 +107,12 @@ inline float interp(const FieldAcc& f, float x, float y, float z) {
 }
 
 // Interpolation at an arbitrary position (clamped into the data): off the hot path.
+inline float interp_clamped(const FieldAcc& f, float x, float y, float z) {
+  return interp(f, std::clamp(x, f.plo[0], f.phi[0]), std::clamp(y, f.plo[1], f.phi[1]),
+                std::clamp(z, f.plo[2], f.phi[2]));
+}
 inline float interp_clamped(const FieldAcc& f, double x, double y, double z) {
-  const float px = std::clamp(float(x), f.plo[0], f.phi[0]);
-  const float py = std::clamp(float(y), f.plo[1], f.phi[1]);
-  const float pz = std::clamp(float(z), f.plo[2], f.phi[2]);
-  return interp(f, px, py, pz);
+  return interp_clamped(f, float(x), float(y), float(z));
 }
 
 enum class RtKind : std::uint8_t { volume1, volume2, iso, slice };
@@ -163,6 +171,9 @@ struct Shared {
   float termination = 0.998f;
   int mc = 8;
   Index3 mcount{};
+  // Macro-cells mi with safe_lo ≤ mi ≤ safe_hi on every axis lie at least one cell inside the data
+  // of every field: their samples (even rounded one ulp outside) need no index clamps.
+  int safe_lo[3] = {0, 0, 0}, safe_hi[3] = {-1, -1, -1};
   PartialImage* out = nullptr;  // first of rt.size() outputs
   Vec3 spacing;
 };
@@ -185,6 +196,56 @@ void shade_hit(const Shared& S, const FieldAcc& f, const double p[3], const Vec3
   const float spec = float(0.25 * std::pow(ndl, 32.0));
   for (int k = 0; k < 3; ++k) a[k] = std::min(1.0f, T.colour[k] * diffuse + spec);
   a[3] = 1.0f;
+}
+
+// ceil(q) for |q| < 2^62 without a libm call; truncation toward zero already is the ceiling for
+// negative q. Runs between macro-cell faces are short, so this is on the per-macro-cell path.
+inline std::int64_t ceil_index(double q) {
+  const std::int64_t n = std::int64_t(q);
+  return n + (double(n) < q);
+}
+
+// Sample positions are computed from the sample index alone, p_k = base + k·step in float (one
+// multiply-add, no loop-carried chain): every path, run and brick evaluates sample k at the same
+// bits, whatever the macro-cell walk did before it.
+struct RayPos {
+  float bx, by, bz, sx, sy, sz;
+};
+
+// The single-volume-task loop over samples kb … kend with field, LUT and accumulator in registers.
+// Returns one past the last sample marched (< kend + 1 when the ray became opaque).
+template <bool kClamp>
+std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::int64_t kb, std::int64_t kend,
+                           const RayPos& P, std::int64_t k_partial, float partial, float tr_stop, bool& opaque) {
+  const LutEntry* lut = T.lut1;
+  const float lo = T.lo1, sc = T.sc1, last = T.last1;
+  const bool absv = T.abs1;
+  // Transmittance form: the loop-carried chain is one multiply (T ← T·(1 − α)) instead of
+  // α ← α + (1 − α)·α_s, which shortens the per-sample latency.
+  float a0 = a[0], a1 = a[1], a2 = a[2], tr = a[3];
+  float fk = float(kb);  // exact: sample indices stay far below 2^24
+  std::int64_t kk = kb;
+  for (; kk <= kend; ++kk, fk += 1.0f) {
+    const float v = interp<kClamp>(f, P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
+    const LutEntry& e = lut[lut_bin(v, lo, sc, last, absv)];
+    float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
+    if (kk == k_partial) [[unlikely]] {
+      const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
+      const float sf = al > 0 ? an / al : 0.0f;
+      pr *= sf, pg *= sf, pb *= sf, al = an;
+    }
+    a0 += tr * pr;
+    a1 += tr * pg;
+    a2 += tr * pb;
+    tr *= 1.0f - al;
+    if (tr <= tr_stop) [[unlikely]] {
+      opaque = true;
+      ++kk;
+      break;
+    }
+  }
+  a[0] = a0, a[1] = a1, a[2] = a2, a[3] = tr;
+  return kk;
 }
 
 // Marches one ray through the brick for all march tasks; fills acc[i] (premultiplied) per task.
@@ -231,92 +292,42 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   std::uint64_t live = S.march_mask;
   float prev[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   bool have_prev = false;
-  const float Sx = float(dt * D[0]), Sy = float(dt * D[1]), Sz = float(dt * D[2]);
-  const int M = S.mc;
-  const double inv_m = 1.0 / M, inv_dt = 1.0 / dt;
-  const double invD[3] = {D[0] != 0 ? 1.0 / D[0] : 0.0, D[1] != 0 ? 1.0 / D[1] : 0.0, D[2] != 0 ? 1.0 / D[2] : 0.0};
-  const float thr = S.termination;
-  const float tr_stop = 1.0f - thr;
+  const RayPos P{float(O[0] + t0 * D[0]), float(O[1] + t0 * D[1]), float(O[2] + t0 * D[2]),
+                 float(dt * D[0]),        float(dt * D[1]),        float(dt * D[2])};
+  const float tr_stop = 1.0f - S.termination;
 
-  std::int64_t k = ks;
-  while (k <= ke && live) {
-    const double t = t0 + double(k) * dt;
-    const double p[3] = {O[0] + t * D[0], O[1] + t * D[1], O[2] + t * D[2]};
-    int mi[3];
-    double texit = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-      mi[a] = std::clamp(int((p[a] - B.lo[a]) * inv_m), 0, S.mcount[a] - 1);
-      if (D[a] != 0) {
-        const double c0 = B.lo[a] + mi[a] * M, c1 = std::min(c0 + M, double(B.hi[a]));
-        texit = std::min(texit, ((D[a] > 0 ? c1 : c0) - O[a]) * invD[a]);
-      }
-    }
-    // Samples before the exit: ceil((texit − t0)/Δ) − 1, without a libm call (runs are short, so
-    // this bookkeeping is a visible share of the time when most macro-cells are skipped).
-    const double q = (texit - t0) * inv_dt;
-    std::int64_t kend = std::int64_t(q);
-    kend -= (double(kend) >= q);
-    kend = std::clamp(kend, k, ke);
-    const std::uint64_t mask = S.active[std::size_t(mi[0] + S.mcount[0] * (mi[1] + S.mcount[1] * mi[2]))];
-    if (!(mask & live)) {  // empty macro-cell for every live task
-      k = kend + 1;
-      have_prev = false;
-      continue;
-    }
-    if (!have_prev && (live & S.iso_mask) && k > 0) {
+  // Marches samples kb … kend, all in one macro-cell whose live tasks are `mask`; `safe`: the cell
+  // lies inside the data with a one-cell margin, so interpolation needs no clamps.
+  auto run = [&](std::int64_t kb, std::int64_t kend, std::uint64_t mask, bool safe) {
+    if (!have_prev && (live & S.iso_mask) && kb > 0) {
       // The sample before this run (maybe in the previous brick: within the ghost layers).
-      const double tp = t - dt;
+      const float fk = float(kb - 1);
       for (int s = 0; s < nslots; ++s)
-        prev[s] = interp_clamped(fa[s], O[0] + tp * D[0], O[1] + tp * D[1], O[2] + tp * D[2]);
+        prev[s] = interp_clamped(fa[s], P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
       have_prev = true;
     }
-    const float px0 = float(p[0]), py0 = float(p[1]), pz0 = float(p[2]);
-    const std::uint64_t run_tasks = mask & live;
-    if (run_tasks && !(run_tasks & (run_tasks - 1)) && S.rt[std::size_t(std::countr_zero(run_tasks))].kind == RtKind::volume1) {
-      // Fast path: one volume task in this macro-cell; field, LUT and accumulator in registers.
-      const int i = std::countr_zero(run_tasks);
+    if (!(mask & (mask - 1)) && S.rt[std::size_t(std::countr_zero(mask))].kind == RtKind::volume1) {
+      // Fast path: one volume task in this macro-cell.
+      const int i = std::countr_zero(mask);
       const TaskRt& T = S.rt[std::size_t(i)];
-      const FieldAcc f = fa[T.s1];
-      const LutEntry* lut = T.lut1;
-      const float lo = T.lo1, sc = T.sc1, last = T.last1;
-      const bool absv = T.abs1;
-      // Transmittance form: the loop-carried chain is one multiply (T ← T·(1 − α)) instead of
-      // α ← α + (1 − α)·α_s, which shortens the per-sample latency.
-      float a0 = acc[i][0], a1 = acc[i][1], a2 = acc[i][2], tr = acc[i][3];
-      float x = px0, y = py0, z = pz0;
-      std::int64_t kk = k;
-      for (; kk <= kend; ++kk) {
-        const float v = interp(f, x, y, z);
-        x += Sx, y += Sy, z += Sz;
-        const LutEntry& e = lut[lut_bin(v, lo, sc, last, absv)];
-        float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
-        if (kk == k_partial) [[unlikely]] {
-          const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
-          const float sf = al > 0 ? an / al : 0.0f;
-          pr *= sf, pg *= sf, pb *= sf, al = an;
-        }
-        a0 += tr * pr;
-        a1 += tr * pg;
-        a2 += tr * pb;
-        tr *= 1.0f - al;
-        if (tr <= tr_stop) [[unlikely]] {
-          live &= ~(std::uint64_t(1) << i);
-          ++kk;
-          break;
-        }
-      }
-      acc[i][0] = a0, acc[i][1] = a1, acc[i][2] = a2, acc[i][3] = tr;
-      marched += std::uint64_t(kk - k);
+      bool opaque = false;
+      const std::int64_t kk =
+          safe ? march_volume1<false>(fa[T.s1], T, acc[i], kb, kend, P, k_partial, partial, tr_stop, opaque)
+               : march_volume1<true>(fa[T.s1], T, acc[i], kb, kend, P, k_partial, partial, tr_stop, opaque);
+      if (opaque) live &= ~(std::uint64_t(1) << i);
+      marched += std::uint64_t(kk - kb);
       have_prev = false;  // prev values were not tracked (no isosurface task is live here)
-      k = kend + 1;
-      continue;
+      return;
     }
-    std::int64_t kk = k;
-    float x = px0, y = py0, z = pz0;  // advanced exactly as in the fast path: same samples, same bits
-    for (; kk <= kend; ++kk) {
+    std::int64_t kk = kb;
+    float fk = float(kb);
+    for (; kk <= kend; ++kk, fk += 1.0f) {
+      const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
       float v[8];
-      for (int s = 0; s < nslots; ++s) v[s] = interp(fa[s], x, y, z);
-      x += Sx, y += Sy, z += Sz;
+      if (safe)
+        for (int s = 0; s < nslots; ++s) v[s] = interp<false>(fa[s], x, y, z);
+      else
+        for (int s = 0; s < nslots; ++s) v[s] = interp<true>(fa[s], x, y, z);
       std::uint64_t m = mask & live;
       while (m) {
         const int i = std::countr_zero(m);
@@ -387,8 +398,72 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         break;
       }
     }
-    marched += std::uint64_t(kk - k);
-    k = kend + 1;
+    marched += std::uint64_t(kk - kb);
+  };
+
+  // 3-D DDA over the macro-cells (Amanatides–Woo): per cell only a compare, an add and a mask load;
+  // sample indices are computed only for cells that some live task can see, so a run of empty
+  // cells costs a few cycles each. The walk starts in the cell of sample ks (clamped to the brick).
+  const int M = S.mc;
+  const double inv_m = 1.0 / M, inv_dt = 1.0 / dt;
+  const double t_ks = t0 + double(ks) * dt, t_ke = t0 + double(ke) * dt;
+  const double q_max = double(ke) + 1;  // caps q before the integer conversion
+  int mi[3], dstep[3];
+  double tmax[3], tdelta[3];
+  const std::int64_t lin[3] = {1, S.mcount[0], std::int64_t(S.mcount[0]) * S.mcount[1]};
+  std::int64_t lstep[3];
+  for (int a = 0; a < 3; ++a) {
+    const double p = O[a] + t_ks * D[a];
+    mi[a] = std::clamp(int((p - B.lo[a]) * inv_m), 0, S.mcount[a] - 1);
+    const double c0 = B.lo[a] + double(mi[a]) * M, c1 = std::min(c0 + M, double(B.hi[a]));
+    if (D[a] > 0) {
+      tmax[a] = (c1 - O[a]) / D[a];
+      tdelta[a] = M / D[a];
+      dstep[a] = 1;
+    } else if (D[a] < 0) {
+      tmax[a] = (c0 - O[a]) / D[a];
+      tdelta[a] = -M / D[a];
+      dstep[a] = -1;
+    } else {
+      tmax[a] = INFINITY;
+      tdelta[a] = 0;
+      dstep[a] = 0;
+    }
+    lstep[a] = dstep[a] * lin[a];
+  }
+  std::int64_t idx = mi[0] + lin[1] * mi[1] + lin[2] * mi[2];
+  const std::uint64_t* active = S.active.data();
+  std::int64_t k = ks;          // first sample not yet marched or skipped
+  double tenter = t0 - dt;      // the first cell starts before sample ks
+  for (;;) {
+    const int a = tmax[0] < tmax[1] ? (tmax[0] < tmax[2] ? 0 : 2) : (tmax[1] < tmax[2] ? 1 : 2);
+    const double texit = tmax[a];
+    const std::uint64_t mask = active[idx] & live;
+    bool last_cell = false;
+    {
+      const int n = mi[a] + dstep[a];
+      last_cell = unsigned(n) >= unsigned(S.mcount[a]);
+    }
+    if (mask) {
+      const std::int64_t kb = std::max(k, ceil_index(std::min((tenter - t0) * inv_dt, q_max)));
+      // Samples rounded past the last macro-cell's exit stay with it (its margin covers them).
+      const std::int64_t kend = last_cell ? ke : std::min(ke, ceil_index(std::min((texit - t0) * inv_dt, q_max)) - 1);
+      if (kb <= kend) {
+        const bool safe = mi[0] >= S.safe_lo[0] && mi[0] <= S.safe_hi[0] && mi[1] >= S.safe_lo[1] &&
+                          mi[1] <= S.safe_hi[1] && mi[2] >= S.safe_lo[2] && mi[2] <= S.safe_hi[2];
+        run(kb, kend, mask, safe);
+        k = kend + 1;
+        if (k > ke || !live) break;
+      }
+    } else {
+      have_prev = false;
+      if (texit > t_ke) break;  // every remaining sample lies in this empty cell
+    }
+    if (last_cell) break;
+    mi[a] += dstep[a];
+    idx += lstep[a];
+    tenter = texit;
+    tmax[a] += tdelta[a];
   }
   for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
@@ -509,6 +584,19 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
   }
   if (S.acc.size() > 8) throw Error("render: tasks of one call read " + std::to_string(S.acc.size()) + " fields; at most 8");
+  // Macro-cells whose samples cannot reach a data face: cell index c0 − 1 … c1 readable with its
+  // upper neighbour in every field (samples are placed within a small fraction of a voxel of their
+  // macro-cell, so one cell of margin is plenty).
+  for (int a = 0; a < 3; ++a) {
+    int ilo = std::numeric_limits<int>::min(), ihi = std::numeric_limits<int>::max();
+    for (const FieldAcc& f : S.acc) ilo = std::max(ilo, f.ilo[a]), ihi = std::min(ihi, f.ihi[a]);
+    S.safe_lo[a] = S.mcount[a];
+    S.safe_hi[a] = -1;
+    for (int m = 0; m < S.mcount[a]; ++m) {
+      const int c0 = S.brick.lo[a] + m * S.mc, c1 = std::min(c0 + S.mc, S.brick.hi[a]);
+      if (c0 - 1 >= ilo && c1 <= ihi) S.safe_lo[a] = std::min(S.safe_lo[a], m), S.safe_hi[a] = m;
+    }
+  }
 
   // Per macro-cell: which tasks see anything there (volume: non-zero opacity somewhere in the
   // cell's value range; isosurface: the isovalue inside it).
