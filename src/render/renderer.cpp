@@ -9,6 +9,11 @@
 #include <string>
 #include <vector>
 
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#define PANOPTES_RENDER_AVX2 1
+#endif
+
 #include "core/error.hpp"
 
 namespace panoptes::render {
@@ -63,6 +68,9 @@ struct FieldAcc {
   std::int64_t sx, sy, sz, off0;
   int ilo[3], ihi[3];    // clamp range of a cell's lower corner: [points.lo, points.hi − 2]
   float plo[3], phi[3];  // clamp range of positions: [points.lo, points.hi − 1]
+  // Every element offset from the point points.lo fits a signed 32-bit lane and strides are
+  // non-negative: the vectorized interpolation may gather with 32-bit indices.
+  bool gather32 = false;
 };
 
 FieldAcc make_acc(const FieldView& v) {
@@ -78,6 +86,13 @@ FieldAcc make_acc(const FieldView& v) {
     a.plo[k] = float(v.points.lo[k]);
     a.phi[k] = float(v.points.hi[k] - 1);
   }
+  std::int64_t max_off = 0;
+  bool nonneg = true;
+  for (int k = 0; k < 3; ++k) {
+    nonneg = nonneg && v.stride[std::size_t(k)] >= 0;
+    max_off += std::int64_t(v.points.hi[k] - v.points.lo[k] - 1) * v.stride[std::size_t(k)];
+  }
+  a.gather32 = nonneg && max_off + a.sx + a.sy + a.sz < (std::int64_t(1) << 31);
   return a;
 }
 
@@ -212,40 +227,111 @@ struct RayPos {
   float bx, by, bz, sx, sy, sz;
 };
 
+// Samples are interpolated in blocks of kBlock consecutive samples of one ray: the positions,
+// cell indices, eight corner loads (gathers) and the seven lerps of a block run as vector
+// instructions, while compositing, which carries the transmittance from sample to sample, stays
+// scalar. Every path of the march (single volume task or general) interpolates through this one
+// function, so they produce the same bits.
+constexpr int kBlock = 8;
+
+// v[l] = the field at sample k0 + l for l < n (1 ≤ n ≤ kBlock); lanes l ≥ n repeat sample
+// k0 + n − 1 (valid memory, ignored). `safe`: every sample lies at least one cell inside the data,
+// so the scalar fallback may skip the index clamps (the vector version always clamps: it is cheap).
+inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, bool safe, float* v) {
+#ifdef PANOPTES_RENDER_AVX2
+  if (f.gather32) {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i kk =
+        _mm256_min_epi32(_mm256_add_epi32(_mm256_set1_epi32(int(k0)), lane), _mm256_set1_epi32(int(k0) + n - 1));
+    const __m256 fk = _mm256_cvtepi32_ps(kk);
+    const __m256 x = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sx), _mm256_set1_ps(P.bx));
+    const __m256 y = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sy), _mm256_set1_ps(P.by));
+    const __m256 z = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sz), _mm256_set1_ps(P.bz));
+    auto cell = [](__m256 p, int lo, int hi) {
+      return _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(p), _mm256_set1_epi32(lo)), _mm256_set1_epi32(hi));
+    };
+    const __m256i i = cell(x, f.ilo[0], f.ihi[0]), j = cell(y, f.ilo[1], f.ihi[1]), k = cell(z, f.ilo[2], f.ihi[2]);
+    const __m256 fx = _mm256_sub_ps(x, _mm256_cvtepi32_ps(i));
+    const __m256 fy = _mm256_sub_ps(y, _mm256_cvtepi32_ps(j));
+    const __m256 fz = _mm256_sub_ps(z, _mm256_cvtepi32_ps(k));
+    // Offsets from the point points.lo (= ilo), so they stay small whatever the brick's place.
+    const int sx = int(f.sx), sy = int(f.sy), sz = int(f.sz);
+    const __m256i off = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_mullo_epi32(_mm256_sub_epi32(i, _mm256_set1_epi32(f.ilo[0])), _mm256_set1_epi32(sx)),
+                         _mm256_mullo_epi32(_mm256_sub_epi32(j, _mm256_set1_epi32(f.ilo[1])), _mm256_set1_epi32(sy))),
+        _mm256_mullo_epi32(_mm256_sub_epi32(k, _mm256_set1_epi32(f.ilo[2])), _mm256_set1_epi32(sz)));
+    const float* d = f.data;
+    const __m256 c000 = _mm256_i32gather_ps(d, off, 4), c100 = _mm256_i32gather_ps(d + sx, off, 4);
+    const __m256 c010 = _mm256_i32gather_ps(d + sy, off, 4), c110 = _mm256_i32gather_ps(d + sy + sx, off, 4);
+    const __m256 c001 = _mm256_i32gather_ps(d + sz, off, 4), c101 = _mm256_i32gather_ps(d + sz + sx, off, 4);
+    const __m256 c011 = _mm256_i32gather_ps(d + sz + sy, off, 4), c111 = _mm256_i32gather_ps(d + sz + sy + sx, off, 4);
+    const __m256 c00 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c100, c000), c000);
+    const __m256 c10 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c110, c010), c010);
+    const __m256 c01 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c101, c001), c001);
+    const __m256 c11 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c111, c011), c011);
+    const __m256 c0 = _mm256_fmadd_ps(fy, _mm256_sub_ps(c10, c00), c00);
+    const __m256 c1 = _mm256_fmadd_ps(fy, _mm256_sub_ps(c11, c01), c01);
+    _mm256_storeu_ps(v, _mm256_fmadd_ps(fz, _mm256_sub_ps(c1, c0), c0));
+    return;
+  }
+#endif
+  for (int l = 0; l < kBlock; ++l) {
+    const float fk = float(k0 + std::min(l, n - 1));
+    const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
+    v[l] = safe ? interp<false>(f, x, y, z) : interp<true>(f, x, y, z);
+  }
+}
+
+// LUT bins of a block of values: lut_bin() lane by lane (same operations, so the same bins).
+inline void lut_bin_block(const float* v, float lo, float sc, float last, bool absv, int* bin) {
+#ifdef PANOPTES_RENDER_AVX2
+  __m256 u = _mm256_loadu_ps(v);
+  if (absv) u = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), u);
+  u = _mm256_mul_ps(_mm256_sub_ps(u, _mm256_set1_ps(lo)), _mm256_set1_ps(sc));
+  u = _mm256_max_ps(u, _mm256_setzero_ps());  // NaN → 0, as in lut_bin()
+  u = _mm256_min_ps(u, _mm256_set1_ps(last));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(bin), _mm256_cvttps_epi32(u));
+#else
+  for (int l = 0; l < kBlock; ++l) bin[l] = lut_bin(v[l], lo, sc, last, absv);
+#endif
+}
+
 // The single-volume-task loop over samples kb … kend with field, LUT and accumulator in registers.
 // Returns one past the last sample marched (< kend + 1 when the ray became opaque).
-template <bool kClamp>
 std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::int64_t kb, std::int64_t kend,
-                           const RayPos& P, std::int64_t k_partial, float partial, float tr_stop, bool& opaque) {
+                           const RayPos& P, bool safe, std::int64_t k_partial, float partial, float tr_stop,
+                           bool& opaque) {
   const LutEntry* lut = T.lut1;
-  const float lo = T.lo1, sc = T.sc1, last = T.last1;
-  const bool absv = T.abs1;
   // Transmittance form: the loop-carried chain is one multiply (T ← T·(1 − α)) instead of
   // α ← α + (1 − α)·α_s, which shortens the per-sample latency.
   float a0 = a[0], a1 = a[1], a2 = a[2], tr = a[3];
-  float fk = float(kb);  // exact: sample indices stay far below 2^24
-  std::int64_t kk = kb;
-  for (; kk <= kend; ++kk, fk += 1.0f) {
-    const float v = interp<kClamp>(f, P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
-    const LutEntry& e = lut[lut_bin(v, lo, sc, last, absv)];
-    float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
-    if (kk == k_partial) [[unlikely]] {
-      const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
-      const float sf = al > 0 ? an / al : 0.0f;
-      pr *= sf, pg *= sf, pb *= sf, al = an;
-    }
-    a0 += tr * pr;
-    a1 += tr * pg;
-    a2 += tr * pb;
-    tr *= 1.0f - al;
-    if (tr <= tr_stop) [[unlikely]] {
-      opaque = true;
-      ++kk;
-      break;
+  alignas(32) float v[kBlock];
+  alignas(32) int bin[kBlock];
+  for (std::int64_t k0 = kb; k0 <= kend; k0 += kBlock) {
+    const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
+    interp_block(f, P, k0, n, safe, v);
+    lut_bin_block(v, T.lo1, T.sc1, T.last1, T.abs1, bin);
+    for (int l = 0; l < n; ++l) {
+      const LutEntry& e = lut[bin[l]];
+      float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
+      if (k0 + l == k_partial) [[unlikely]] {
+        const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
+        const float sf = al > 0 ? an / al : 0.0f;
+        pr *= sf, pg *= sf, pb *= sf, al = an;
+      }
+      a0 += tr * pr;
+      a1 += tr * pg;
+      a2 += tr * pb;
+      tr *= 1.0f - al;
+      if (tr <= tr_stop) [[unlikely]] {
+        opaque = true;
+        a[0] = a0, a[1] = a1, a[2] = a2, a[3] = tr;
+        return k0 + l + 1;
+      }
     }
   }
   a[0] = a0, a[1] = a1, a[2] = a2, a[3] = tr;
-  return kk;
+  return kend + 1;
 }
 
 // Marches one ray through the brick for all march tasks; fills acc[i] (premultiplied) per task.
@@ -312,93 +398,94 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       const TaskRt& T = S.rt[std::size_t(i)];
       bool opaque = false;
       const std::int64_t kk =
-          safe ? march_volume1<false>(fa[T.s1], T, acc[i], kb, kend, P, k_partial, partial, tr_stop, opaque)
-               : march_volume1<true>(fa[T.s1], T, acc[i], kb, kend, P, k_partial, partial, tr_stop, opaque);
+          march_volume1(fa[T.s1], T, acc[i], kb, kend, P, safe, k_partial, partial, tr_stop, opaque);
       if (opaque) live &= ~(std::uint64_t(1) << i);
       marched += std::uint64_t(kk - kb);
       have_prev = false;  // prev values were not tracked (no isosurface task is live here)
       return;
     }
     std::int64_t kk = kb;
-    float fk = float(kb);
-    for (; kk <= kend; ++kk, fk += 1.0f) {
-      const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
-      float v[8];
-      if (safe)
-        for (int s = 0; s < nslots; ++s) v[s] = interp<false>(fa[s], x, y, z);
-      else
-        for (int s = 0; s < nslots; ++s) v[s] = interp<true>(fa[s], x, y, z);
-      std::uint64_t m = mask & live;
-      while (m) {
-        const int i = std::countr_zero(m);
-        m &= m - 1;
-        const TaskRt& T = S.rt[std::size_t(i)];
-        float* a = acc[i];
-        switch (T.kind) {
-          case RtKind::volume1: {
-            const LutEntry& e = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
-            float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
-            if (kk == k_partial) [[unlikely]] {
-              const float a2 = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
-              const float s = al > 0 ? a2 / al : 0.0f;
-              pr *= s, pg *= s, pb *= s, al = a2;
+    alignas(32) float vb[8][kBlock];  // per march slot: the block's interpolated values
+    bool done = false;
+    for (std::int64_t k0 = kb; k0 <= kend && !done; k0 += kBlock) {
+      const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
+      for (int s = 0; s < nslots; ++s) interp_block(fa[s], P, k0, n, safe, vb[s]);
+      for (int l = 0; l < n; ++l) {
+        kk = k0 + l;
+        float v[8];
+        for (int s = 0; s < nslots; ++s) v[s] = vb[s][l];
+        std::uint64_t m = mask & live;
+        while (m) {
+          const int i = std::countr_zero(m);
+          m &= m - 1;
+          const TaskRt& T = S.rt[std::size_t(i)];
+          float* a = acc[i];
+          switch (T.kind) {
+            case RtKind::volume1: {
+              const LutEntry& e = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
+              float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
+              if (kk == k_partial) [[unlikely]] {
+                const float a2 = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
+                const float s = al > 0 ? a2 / al : 0.0f;
+                pr *= s, pg *= s, pb *= s, al = a2;
+              }
+              const float tr = a[3];
+              a[0] += tr * pr;
+              a[1] += tr * pg;
+              a[2] += tr * pb;
+              a[3] = tr * (1.0f - al);
+              if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
+              break;
             }
-            const float tr = a[3];
-            a[0] += tr * pr;
-            a[1] += tr * pg;
-            a[2] += tr * pb;
-            a[3] = tr * (1.0f - al);
-            if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
-            break;
+            case RtKind::volume2: {
+              const LutEntry& e1 = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
+              const LutEntry& e2 = T.lut2[lut_bin(v[T.s2], T.lo2, T.sc2, T.last2, T.abs2)];
+              const float tau = e1.tau + e2.tau;
+              if (tau <= 0) break;
+              float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
+              if (kk == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
+              const float tr = a[3];
+              const float s = tr * al / tau;
+              a[0] += s * (e1.tau * e1.r + e2.tau * e2.r);
+              a[1] += s * (e1.tau * e1.g + e2.tau * e2.g);
+              a[2] += s * (e1.tau * e1.b + e2.tau * e2.b);
+              a[3] = tr * (1.0f - al);
+              if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
+              break;
+            }
+            case RtKind::iso: {
+              const float d = v[T.s1] - T.iso;
+              if (!have_prev) break;
+              float dp = prev[T.s1] - T.iso;
+              if ((dp < 0) == (d < 0)) break;
+              // First crossing between samples kk−1 and kk: linear estimate, one regula-falsi step.
+              const FieldAcc& f = fa[T.s1];
+              double ta = t0 + double(kk - 1) * dt, tb = ta + dt;
+              double dpa = dp, dpb = d;
+              double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+              const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - T.iso;
+              if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+              else tb = th, dpb = vh;
+              if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+              const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+              shade_hit(S, f, ph, dir, T, a);
+              a[3] = 0;  // opaque: transmittance 0
+              live &= ~(std::uint64_t(1) << i);
+              break;
+            }
+            case RtKind::slice:
+              break;
           }
-          case RtKind::volume2: {
-            const LutEntry& e1 = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
-            const LutEntry& e2 = T.lut2[lut_bin(v[T.s2], T.lo2, T.sc2, T.last2, T.abs2)];
-            const float tau = e1.tau + e2.tau;
-            if (tau <= 0) break;
-            float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
-            if (kk == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
-            const float tr = a[3];
-            const float s = tr * al / tau;
-            a[0] += s * (e1.tau * e1.r + e2.tau * e2.r);
-            a[1] += s * (e1.tau * e1.g + e2.tau * e2.g);
-            a[2] += s * (e1.tau * e1.b + e2.tau * e2.b);
-            a[3] = tr * (1.0f - al);
-            if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
-            break;
-          }
-          case RtKind::iso: {
-            const float d = v[T.s1] - T.iso;
-            if (!have_prev) break;
-            float dp = prev[T.s1] - T.iso;
-            if ((dp < 0) == (d < 0)) break;
-            // First crossing between samples kk−1 and kk: linear estimate, one regula-falsi step.
-            const FieldAcc& f = fa[T.s1];
-            double ta = t0 + double(kk - 1) * dt, tb = ta + dt;
-            double dpa = dp, dpb = d;
-            double th = ta + (tb - ta) * (dpa / (dpa - dpb));
-            const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - T.iso;
-            if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
-            else tb = th, dpb = vh;
-            if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
-            const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
-            shade_hit(S, f, ph, dir, T, a);
-            a[3] = 0;  // opaque: transmittance 0
-            live &= ~(std::uint64_t(1) << i);
-            break;
-          }
-          case RtKind::slice:
-            break;
+        }
+        for (int s = 0; s < nslots; ++s) prev[s] = v[s];
+        have_prev = true;
+        if (!live) {
+          done = true;
+          break;
         }
       }
-      for (int s = 0; s < nslots; ++s) prev[s] = v[s];
-      have_prev = true;
-      if (!live) {
-        ++kk;
-        break;
-      }
     }
-    marched += std::uint64_t(kk - kb);
+    marched += std::uint64_t(kk + 1 - kb);
   };
 
   // 3-D DDA over the macro-cells (Amanatides–Woo): per cell only a compare, an add and a mask load;
