@@ -6,7 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <cstdlib>
+#include <cstring>
 #include <map>
+#include <unordered_map>
 #include <numbers>
 #include <sstream>
 
@@ -40,6 +43,42 @@ struct Injection {
   int k;             // local plane
   double weight;     // kernel weight × amplitude (see Impl::inject_*)
   int source;        // source index
+  int mat;           // buoyancy coefficient of a force's velocity component (BX, BY, BZ)
+};
+
+// Material coefficients per cell, all premultiplied by dt/h: buoyancy at the three velocity
+// points, λ and 2μ at the node, μ at the three shear-stress edges, and per relaxation mechanism l
+// the memory-variable coefficients at index MECH + 5l + {0: λY^λ, 1: 2μY^μ, 2..4: μY^μ at xy, xz, yz}.
+enum : int { BX, BY, BZ, LAM, TWOMU, MUXY, MUXZ, MUYZ, MECH };
+constexpr int CL(int l) { return MECH + 5 * l; }
+constexpr int CM(int l) { return MECH + 5 * l + 1; }
+constexpr int CMXY(int l) { return MECH + 5 * l + 2; }
+constexpr int CMXZ(int l) { return MECH + 5 * l + 3; }
+constexpr int CMYZ(int l) { return MECH + 5 * l + 4; }
+
+// The kernels read the material through one of two row accessors, chosen once per run: a table of
+// the distinct coefficient tuples indexed by a 16-bit id per cell (piecewise-constant media: 2 bytes
+// per cell instead of 32 elastic / 92 viscoelastic, which is most of the memory traffic saved), or
+// one array per coefficient (media with more than 65,536 distinct cells, e.g. from files).
+struct TableMat {
+  const std::uint16_t* id;
+  const float* tab;  // coefficient-major: tab[f·nt + id]
+  std::size_t nt;
+  TableMat row(std::size_t b) const { return {id + b, tab, nt}; }
+  float operator()(int f, long i) const { return tab[std::size_t(f) * nt + id[i]]; }
+};
+// A row of one material (every row of a layered medium): the coefficients are loop constants, so
+// the row streams no material data at all.
+struct UniformMat {
+  const float* c;  // K coefficients
+  UniformMat row(std::size_t) const { return *this; }
+  float operator()(int f, long) const { return c[f]; }
+};
+struct DenseMat {
+  const float* const* base;  // one array per coefficient
+  std::size_t b;
+  DenseMat row(std::size_t r) const { return {base, b + r}; }
+  float operator()(int f, long i) const { return base[f][b + i]; }
 };
 
 struct ReceiverComp {
@@ -69,11 +108,23 @@ struct Solver::Impl {
   int npml = 0;
 
   Vec vx, vy, vz, sxx, syy, szz, sxy, sxz, syz;
-  Vec bx, by, bz, lam, twomu, muxy, muxz, muyz;
+  // Material coefficients (see the enum above): K = MECH + 5L per cell.
+  int K = MECH;
+  bool mat_table = true;
+  std::size_t ntypes = 0;
+  std::vector<std::uint16_t> mat_id;  // per cell (table mode); ghost cells have id 0 (all zero)
+  std::vector<float> mat_tab;         // K × ntypes
+  std::vector<float> mat_tuples;      // ntypes × K (tuple-major)
+  std::vector<int> row_mat;           // per row (k·ny + j): its id when all its cells share it, else −1
+  std::vector<Vec> mat_dense;         // K arrays of N (dense mode)
+  std::vector<const float*> mat_ptr;  // mat_dense[f].data()
+  float mat(int f, std::size_t n) const { return mat_table ? mat_tab[std::size_t(f) * ntypes + mat_id[n]] : mat_dense[f][n]; }
+  TableMat table_mat() const { return {mat_id.data(), mat_tab.data(), ntypes}; }
+  DenseMat dense_mat() const { return {mat_ptr.data(), 0}; }
   // Attenuation (empty when elastic).
   int L = 0;
   std::vector<float> relax_a, relax_b;
-  std::vector<Vec> rxx, ryy, rzz, rxy, rxz, ryz, cl, cm, cmxy, cmxz, cmyz;
+  std::vector<Vec> rxx, ryy, rzz, rxy, rxz, ryz;
   std::vector<Vec> rowbuf;  // per thread: 6 rows of nx strain rates
   // CPML.
   PmlAxis pmlx, pmly, pmlz;
@@ -115,31 +166,43 @@ struct Solver::Impl {
 
   // ---------------------------------------------------------------- stepping
   void step();
-  void velocity_planes(int k0, int k1, double t);
-  void stress_planes(int k0, int k1, double t);
-  template <int Z>
-  void stress_row_elastic(int k, int j);
-  template <int Z>
-  void stress_row_visco(int k, int j);
-  void pml_velocity(int k0, int k1);
-  void pml_stress(int k0, int k1);
+  // One z plane of the velocity (stress) update: plain update, CPML corrections, sources. Called
+  // inside an OpenMP parallel region (worksharing over rows).
+  void velocity_plane(int k, double t) { velocity_rows(k, 0, ny, t); }
+  void stress_plane(int k, double t) { stress_rows_(k, 0, ny, t); }
+  template <class M>
+  void velocity_row(int k, int j, const M& mat0);
+  template <int Z, class M>
+  void stress_row(int k, int j, const M& mat0);
+  // Sources per row (k, j): entries [first[k·ny + j], first[k·ny + j + 1]) in their original order.
+  std::vector<Injection> force_rows, stress_rows;
+  std::vector<int> force_first, stress_first;
+  // Rows per cache block of the fused sweep (see step()).
+  int yblock = 32;
+  void sweep(int kv0, int kv1, int ks0, int ks1, double tv, double ts);
+  void velocity_rows(int k, int j0, int j1, double t);
+  void stress_rows_(int k, int j0, int j1, double t);
+  void velocity_row_at(int k, int j, double t);
+  void stress_row_at(int k, int j, double t);
   // Memory variables see the stretched derivative inside the CPML too: when ψ is added to a strain
   // rate, their update (linear in the rate) and the stress they relax get the matching increments.
-  void visco_normal(std::size_t n, float psi, int axis) {
+  template <class M>
+  void visco_normal(const M& m, long i, std::size_t n, float psi, int axis) {
     Vec* norm[3] = {&sxx, &syy, &szz};
     std::vector<Vec>* mem[3] = {&rxx, &ryy, &rzz};
     for (int l = 0; l < L; ++l) {
-      const float base = relax_b[l] * cl[l][n] * psi;
+      const float base = relax_b[l] * m(CL(l), i) * psi;
       for (int c = 0; c < 3; ++c) {
-        const float d = base + (c == axis ? relax_b[l] * cm[l][n] * psi : 0.0f);
+        const float d = base + (c == axis ? relax_b[l] * m(CM(l), i) * psi : 0.0f);
         (*mem[c])[l][n] += d;
         (*norm[c])[n] -= 0.5f * d;
       }
     }
   }
-  void visco_shear(std::size_t n, float psi, Vec& stress, std::vector<Vec>& mem, std::vector<Vec>& coef) {
+  template <class M>
+  void visco_shear(const M& m, long i, std::size_t n, float psi, Vec& stress, std::vector<Vec>& mem, int coef0) {
     for (int l = 0; l < L; ++l) {
-      const float d = relax_b[l] * coef[l][n] * psi;
+      const float d = relax_b[l] * m(coef0 + 5 * l, i) * psi;
       mem[l][n] += d;
       stress[n] -= 0.5f * d;
     }
@@ -231,6 +294,9 @@ void Solver::Impl::init(const SolverConfig& c) {
   for (auto& r : rec)
     for (auto& c3 : r) c3.reserve(reserve);
   rowbuf.assign(std::size_t(omp_get_max_threads()), Vec(6 * std::size_t(nx)));
+  // The sweep keeps about 28 rows-planes per block row in cache (σ: 3 fields × 5 planes + 3, v:
+  // 3 × 5, material ids): aim at 1 MiB, half of an L2.
+  yblock = std::clamp(int((1 << 20) / (28 * 4 * sy)), 8, 64);
 }
 
 void Solver::Impl::setup_materials(const MediumBlock& mb) {
@@ -302,8 +368,7 @@ void Solver::Impl::setup_materials(const MediumBlock& mb) {
     k = std::clamp(k, kb, kb + mk - 1);
     return mb.index(i, j, k);
   };
-  for (Vec* v : {&vx, &vy, &vz, &sxx, &syy, &szz, &sxy, &sxz, &syz, &bx, &by, &bz, &lam, &twomu, &muxy, &muxz, &muyz})
-    v->assign(N, 0.0f);
+  for (Vec* v : {&vx, &vy, &vz, &sxx, &syy, &szz, &sxy, &sxz, &syz}) v->assign(N, 0.0f);
   const double s = dt / h;
   auto harm4 = [&](std::size_t a, std::size_t b, std::size_t c, std::size_t d) {
     return 4.0 / (1.0 / muU[a] + 1.0 / muU[b] + 1.0 / muU[c] + 1.0 / muU[d]);
@@ -317,41 +382,95 @@ void Solver::Impl::setup_materials(const MediumBlock& mb) {
       relax_a[l] = float((1 - wdt / 2) / (1 + wdt / 2));
       relax_b[l] = float(wdt / (1 + wdt / 2));
     }
-    for (auto* v : {&rxx, &ryy, &rzz, &rxy, &rxz, &ryz, &cl, &cm, &cmxy, &cmxz, &cmyz}) v->assign(L, Vec(N, 0.0f));
+    for (auto* v : {&rxx, &ryy, &rzz, &rxy, &rxz, &ryz}) v->assign(L, Vec(N, 0.0f));
   }
-  for (int k = kb; k < ke; ++k)
-    for (int j = 0; j < ny; ++j)
+  K = MECH + 5 * L;
+  // The coefficients of node (i, j, k) (global k).
+  auto coefficients = [&](int i, int j, int k, float* t) {
+    const auto c = m(i, j, k);
+    t[BX] = float(s / (0.5 * (rho[c] + rho[m(i + 1, j, k)])));
+    t[BY] = float(s / (0.5 * (rho[c] + rho[m(i, j + 1, k)])));
+    t[BZ] = float(s / (0.5 * (rho[c] + rho[m(i, j, k + 1)])));
+    t[LAM] = float(s * (piU[c] - 2 * muU[c]));
+    t[TWOMU] = float(s * 2 * muU[c]);
+    const std::array<std::size_t, 4> cxy = {c, m(i + 1, j, k), m(i, j + 1, k), m(i + 1, j + 1, k)};
+    const std::array<std::size_t, 4> cxz = {c, m(i + 1, j, k), m(i, j, k + 1), m(i + 1, j, k + 1)};
+    const std::array<std::size_t, 4> cyz = {c, m(i, j + 1, k), m(i, j, k + 1), m(i, j + 1, k + 1)};
+    auto h4 = [&](const std::array<std::size_t, 4>& q) { return harm4(q[0], q[1], q[2], q[3]); };
+    t[MUXY] = float(s * h4(cxy));
+    t[MUXZ] = float(s * h4(cxz));
+    t[MUYZ] = float(s * h4(cyz));
+    for (int l = 0; l < L; ++l) {
+      t[CL(l)] = float(s * (ya[c * L + l] - 2 * yb[c * L + l]));
+      t[CM(l)] = float(s * 2 * yb[c * L + l]);
+      auto avg = [&](const std::array<std::size_t, 4>& q) {
+        double v = 0;
+        for (auto x : q) v += yb[x * L + l];
+        return s * v / 4;
+      };
+      t[CMXY(l)] = float(avg(cxy));
+      t[CMXZ(l)] = float(avg(cxz));
+      t[CMYZ(l)] = float(avg(cyz));
+    }
+  };
+  // Table of distinct tuples (compared bytewise, so the stored floats are exactly the computed
+  // ones); falls back to one array per coefficient beyond 65,536 tuples. Type 0 = all zero (ghosts).
+  const std::size_t max_types = std::getenv("PANOPTES_SEISMIC_DENSE_MATERIALS") ? 1 : 65536;
+  std::vector<float> t(std::size_t(K), 0.0f);
+  const std::size_t tb = std::size_t(K) * sizeof(float);
+  std::string key(tb, '\0'), last;
+  std::unordered_map<std::string, std::uint16_t> ids;
+  std::vector<float>& types = mat_tuples;
+  types = t;
+  ids.emplace(key, 0);
+  mat_id.assign(N, 0);
+  std::uint16_t last_id = 0;
+  mat_table = true;
+  for (int k = kb; k < ke && mat_table; ++k)
+    for (int j = 0; j < ny && mat_table; ++j)
       for (int i = 0; i < nx; ++i) {
-        const std::size_t n = idx(i, j, k - kb);
-        const auto c = m(i, j, k);
-        bx[n] = float(s / (0.5 * (rho[c] + rho[m(i + 1, j, k)])));
-        by[n] = float(s / (0.5 * (rho[c] + rho[m(i, j + 1, k)])));
-        bz[n] = float(s / (0.5 * (rho[c] + rho[m(i, j, k + 1)])));
-        lam[n] = float(s * (piU[c] - 2 * muU[c]));
-        twomu[n] = float(s * 2 * muU[c]);
-        const auto cxy = {c, m(i + 1, j, k), m(i, j + 1, k), m(i + 1, j + 1, k)};
-        const auto cxz = {c, m(i + 1, j, k), m(i, j, k + 1), m(i + 1, j, k + 1)};
-        const auto cyz = {c, m(i, j + 1, k), m(i, j, k + 1), m(i, j + 1, k + 1)};
-        auto h4 = [&](std::initializer_list<std::size_t> q) {
-          auto it = q.begin();
-          return harm4(it[0], it[1], it[2], it[3]);
-        };
-        muxy[n] = float(s * h4(cxy));
-        muxz[n] = float(s * h4(cxz));
-        muyz[n] = float(s * h4(cyz));
-        for (int l = 0; l < L; ++l) {
-          cl[l][n] = float(s * (ya[c * L + l] - 2 * yb[c * L + l]));
-          cm[l][n] = float(s * 2 * yb[c * L + l]);
-          auto avg = [&](std::initializer_list<std::size_t> q) {
-            double t = 0;
-            for (auto x : q) t += yb[x * L + l];
-            return s * t / 4;
-          };
-          cmxy[l][n] = float(avg(cxy));
-          cmxz[l][n] = float(avg(cxz));
-          cmyz[l][n] = float(avg(cyz));
+        coefficients(i, j, k, t.data());
+        std::memcpy(key.data(), t.data(), tb);
+        if (key != last) {  // layered media repeat the previous cell's tuple almost always
+          auto it = ids.find(key);
+          if (it == ids.end()) {
+            if (ids.size() >= max_types) {
+              mat_table = false;
+              break;
+            }
+            it = ids.emplace(key, std::uint16_t(ids.size())).first;
+            types.insert(types.end(), t.begin(), t.end());
+          }
+          last = key;
+          last_id = it->second;
         }
+        mat_id[idx(i, j, k - kb)] = last_id;
       }
+  if (mat_table) {
+    ntypes = ids.size();
+    mat_tab.assign(std::size_t(K) * ntypes, 0.0f);
+    for (std::size_t q = 0; q < ntypes; ++q)
+      for (int f = 0; f < K; ++f) mat_tab[std::size_t(f) * ntypes + q] = types[q * K + f];
+    row_mat.assign(std::size_t(nzl) * ny, -1);
+    for (int k = 0; k < nzl; ++k)
+      for (int j = 0; j < ny; ++j) {
+        const std::uint16_t* r = mat_id.data() + idx(0, j, k);
+        if (std::all_of(r, r + nx, [&](std::uint16_t v) { return v == r[0]; })) row_mat[std::size_t(k) * ny + j] = r[0];
+      }
+  } else {
+    row_mat.assign(std::size_t(nzl) * ny, -1);
+    mat_tuples.clear();
+    std::vector<std::uint16_t>().swap(mat_id);
+    mat_dense.assign(std::size_t(K), Vec(N, 0.0f));
+    for (int k = kb; k < ke; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          coefficients(i, j, k, t.data());
+          const std::size_t n = idx(i, j, k - kb);
+          for (int f = 0; f < K; ++f) mat_dense[f][n] = t[f];
+        }
+    for (const Vec& v : mat_dense) mat_ptr.push_back(v.data());
+  }
 }
 
 void Solver::Impl::setup_pml() {
@@ -411,7 +530,7 @@ void Solver::Impl::setup_sources() {
     return sinc * std::cyl_bessel_i(0.0, b * std::sqrt(q)) / std::cyl_bessel_i(0.0, b);
   };
   auto spread = [&](const std::array<double, 3>& p, std::array<double, 3> st, Vec& field, double amp, int src,
-                    std::vector<Injection>& out) {
+                    std::vector<Injection>& out, int mat = -1) {
     const bool sinc = !free_surface || p[2] / h >= 4.5;
     std::array<std::vector<std::pair<int, double>>, 3> ax;
     const int dims[3] = {nx, ny, nz};
@@ -440,7 +559,7 @@ void Solver::Impl::setup_sources() {
     for (const auto& [k, wz] : ax[2])
       if (k >= kb && k < ke)
         for (const auto& [j, wy] : ax[1])
-          for (const auto& [i, wx] : ax[0]) out.push_back({field.data(), idx(i, j, k - kb), k - kb, amp * wx * wy * wz, src});
+          for (const auto& [i, wx] : ax[0]) out.push_back({field.data(), idx(i, j, k - kb), k - kb, amp * wx * wy * wz, src, mat});
   };
   const double h3 = h * h * h;
   for (int s = 0; s < int(sources.size()); ++s) {
@@ -457,13 +576,27 @@ void Solver::Impl::setup_sources() {
       spread(S.position, {0, 0.5, 0.5}, syz, -a * M[5], s, stress_inj);
     } else {
       // v += dt·F·S(t)/(ρ h³) = F·S(t)·b/h² with b = dt/(ρ h) the stored buoyancy.
-      spread(S.position, {0.5, 0, 0}, vx, S.force[0] / (h * h), s, force_inj);
-      spread(S.position, {0, 0.5, 0}, vy, S.force[1] / (h * h), s, force_inj);
-      spread(S.position, {0, 0, 0.5}, vz, S.force[2] / (h * h), s, force_inj);
+      spread(S.position, {0.5, 0, 0}, vx, S.force[0] / (h * h), s, force_inj, BX);
+      spread(S.position, {0, 0.5, 0}, vy, S.force[1] / (h * h), s, force_inj, BY);
+      spread(S.position, {0, 0, 0.5}, vz, S.force[2] / (h * h), s, force_inj, BZ);
     }
   }
   std::erase_if(stress_inj, [](const Injection& q) { return q.weight == 0; });
   std::erase_if(force_inj, [](const Injection& q) { return q.weight == 0; });
+  // σzz on the free-surface plane is set to 0 after each update: a moment there has no effect.
+  if (free_surface && kb == 0)
+    std::erase_if(stress_inj, [&](const Injection& q) { return q.field == szz.data() && q.k == 0; });
+  // Per row, in the original order (several entries may hit the same cell).
+  auto by_row = [&](const std::vector<Injection>& in, std::vector<Injection>& out, std::vector<int>& first) {
+    auto row = [&](const Injection& q) { return long(q.n / std::size_t(sy)) - long(G) - long(sz / sy) * (q.k + G) + long(q.k) * ny; };
+    out = in;
+    std::stable_sort(out.begin(), out.end(), [&](const Injection& a, const Injection& b) { return row(a) < row(b); });
+    first.assign(std::size_t(nzl) * ny + 1, 0);
+    for (const auto& q : out) ++first[row(q) + 1];
+    for (std::size_t r = 1; r < first.size(); ++r) first[r] += first[r - 1];
+  };
+  by_row(force_inj, force_rows, force_first);
+  by_row(stress_inj, stress_rows, stress_first);
 }
 
 void Solver::Impl::setup_receivers() {
@@ -504,52 +637,108 @@ void Solver::Impl::setup_receivers() {
 
 // ==================================================================== kernels
 
-void Solver::Impl::velocity_planes(int k0, int k1, double t) {
-  if (k0 >= k1) return;
+// One row (k, j) of the velocity update, followed by its CPML corrections (x, then y, then z: the
+// same order per cell as separate passes) while the row is in cache. The corrections of v read
+// only σ, so doing them row by row is exact.
+template <class M>
+void Solver::Impl::velocity_row(int k, int j, const M& mat0) {
+  const std::size_t b = idx(0, j, k);
+  const M m = mat0.row(b);
   const long Y = sy, Z = sz;
-#pragma omp parallel for collapse(2) schedule(static)
-  for (int k = k0; k < k1; ++k)
-    for (int j = 0; j < ny; ++j) {
-      const std::size_t b = idx(0, j, k);
-      float* __restrict ux = vx.data() + b;
-      float* __restrict uy = vy.data() + b;
-      float* __restrict uz = vz.data() + b;
-      const float* __restrict xx = sxx.data() + b;
-      const float* __restrict yy = syy.data() + b;
-      const float* __restrict zz = szz.data() + b;
-      const float* __restrict xy = sxy.data() + b;
-      const float* __restrict xz = sxz.data() + b;
-      const float* __restrict yz = syz.data() + b;
-      const float* __restrict px = bx.data() + b;
-      const float* __restrict py = by.data() + b;
-      const float* __restrict pz = bz.data() + b;
+  float* __restrict ux = vx.data() + b;
+  float* __restrict uy = vy.data() + b;
+  float* __restrict uz = vz.data() + b;
+  const float* __restrict xx = sxx.data() + b;
+  const float* __restrict yy = syy.data() + b;
+  const float* __restrict zz = szz.data() + b;
+  const float* __restrict xy = sxy.data() + b;
+  const float* __restrict xz = sxz.data() + b;
+  const float* __restrict yz = syz.data() + b;
 #pragma omp simd
-      for (int i = 0; i < nx; ++i) {
-        ux[i] += px[i] * (C1 * (xx[i + 1] - xx[i]) + C2 * (xx[i + 2] - xx[i - 1]) + C1 * (xy[i] - xy[i - Y]) +
-                          C2 * (xy[i + Y] - xy[i - 2 * Y]) + C1 * (xz[i] - xz[i - Z]) + C2 * (xz[i + Z] - xz[i - 2 * Z]));
-        uy[i] += py[i] * (C1 * (xy[i] - xy[i - 1]) + C2 * (xy[i + 1] - xy[i - 2]) + C1 * (yy[i + Y] - yy[i]) +
-                          C2 * (yy[i + 2 * Y] - yy[i - Y]) + C1 * (yz[i] - yz[i - Z]) + C2 * (yz[i + Z] - yz[i - 2 * Z]));
-        uz[i] += pz[i] * (C1 * (xz[i] - xz[i - 1]) + C2 * (xz[i + 1] - xz[i - 2]) + C1 * (yz[i] - yz[i - Y]) +
-                          C2 * (yz[i + Y] - yz[i - 2 * Y]) + C1 * (zz[i + Z] - zz[i]) + C2 * (zz[i + 2 * Z] - zz[i - Z]));
-      }
+  for (int i = 0; i < nx; ++i) {
+    ux[i] += m(BX, i) * (C1 * (xx[i + 1] - xx[i]) + C2 * (xx[i + 2] - xx[i - 1]) + C1 * (xy[i] - xy[i - Y]) +
+                         C2 * (xy[i + Y] - xy[i - 2 * Y]) + C1 * (xz[i] - xz[i - Z]) + C2 * (xz[i + Z] - xz[i - 2 * Z]));
+    uy[i] += m(BY, i) * (C1 * (xy[i] - xy[i - 1]) + C2 * (xy[i + 1] - xy[i - 2]) + C1 * (yy[i + Y] - yy[i]) +
+                         C2 * (yy[i + 2 * Y] - yy[i - Y]) + C1 * (yz[i] - yz[i - Z]) + C2 * (yz[i + Z] - yz[i - 2 * Z]));
+    uz[i] += m(BZ, i) * (C1 * (xz[i] - xz[i - 1]) + C2 * (xz[i + 1] - xz[i - 2]) + C1 * (yz[i] - yz[i - Y]) +
+                         C2 * (yz[i + Y] - yz[i - 2 * Y]) + C1 * (zz[i + Z] - zz[i]) + C2 * (zz[i + 2 * Z] - zz[i - Z]));
+  }
+  // CPML: ψ ← b·ψ + a·∂f and f += coefficient·ψ after the plain update (κ = 1), layers only.
+  const int cx = pmlx.count();
+  for (int s = 0; s < cx; ++s) {
+    const int i = pmlx.indices[s];
+    const std::size_t p = (std::size_t(k) * ny + j) * cx + s;
+    const float* f = xx + i;
+    float& a = psix[0][p];
+    a = pmlx.b_half[i] * a + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
+    ux[i] += m(BX, i) * a;
+    f = xy + i;
+    float& bb = psix[1][p];
+    bb = pmlx.b_full[i] * bb + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
+    uy[i] += m(BY, i) * bb;
+    f = xz + i;
+    float& c = psix[2][p];
+    c = pmlx.b_full[i] * c + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
+    uz[i] += m(BZ, i) * c;
+  }
+  if (const int s = pmly.count() > 0 ? pmly.slot[j] : -1; s >= 0) {
+    const float bf = pmly.b_full[j], af = pmly.a_full[j], bh = pmly.b_half[j], ah = pmly.a_half[j];
+    float* __restrict p0 = psiy[0].data() + (std::size_t(k) * pmly.count() + s) * nx;
+    float* __restrict p1 = psiy[1].data() + (std::size_t(k) * pmly.count() + s) * nx;
+    float* __restrict p2 = psiy[2].data() + (std::size_t(k) * pmly.count() + s) * nx;
+    for (int i = 0; i < nx; ++i) {
+      p0[i] = bf * p0[i] + af * (C1 * (xy[i] - xy[i - Y]) + C2 * (xy[i + Y] - xy[i - 2 * Y]));
+      ux[i] += m(BX, i) * p0[i];
+      p1[i] = bh * p1[i] + ah * (C1 * (yy[i + Y] - yy[i]) + C2 * (yy[i + 2 * Y] - yy[i - Y]));
+      uy[i] += m(BY, i) * p1[i];
+      p2[i] = bf * p2[i] + af * (C1 * (yz[i] - yz[i - Y]) + C2 * (yz[i + Y] - yz[i - 2 * Y]));
+      uz[i] += m(BZ, i) * p2[i];
     }
-  pml_velocity(k0, k1);
-  for (const auto& q : force_inj)
-    if (q.k >= k0 && q.k < k1) {
-      const Vec& b = q.field == vx.data() ? bx : q.field == vy.data() ? by : bz;
-      q.field[q.n] += float(q.weight * sources[q.source].stf.value(t) * b[q.n]);
+  }
+  if (const int s = pmlz.count() > 0 ? pmlz.slot[k] : -1; s >= 0) {
+    const float bf = pmlz.b_full[k], af = pmlz.a_full[k], bh = pmlz.b_half[k], ah = pmlz.a_half[k];
+    float* __restrict p0 = psiz[0].data() + (std::size_t(s) * ny + j) * nx;
+    float* __restrict p1 = psiz[1].data() + (std::size_t(s) * ny + j) * nx;
+    float* __restrict p2 = psiz[2].data() + (std::size_t(s) * ny + j) * nx;
+    for (int i = 0; i < nx; ++i) {
+      p0[i] = bf * p0[i] + af * (C1 * (xz[i] - xz[i - Z]) + C2 * (xz[i + Z] - xz[i - 2 * Z]));
+      ux[i] += m(BX, i) * p0[i];
+      p1[i] = bf * p1[i] + af * (C1 * (yz[i] - yz[i - Z]) + C2 * (yz[i + Z] - yz[i - 2 * Z]));
+      uy[i] += m(BY, i) * p1[i];
+      p2[i] = bh * p2[i] + ah * (C1 * (zz[i + Z] - zz[i]) + C2 * (zz[i + 2 * Z] - zz[i - Z]));
+      uz[i] += m(BZ, i) * p2[i];
     }
+  }
+}
+
+// Velocity row (k, j) with its CPML corrections and body forces.
+void Solver::Impl::velocity_row_at(int k, int j, double t) {
+  const std::size_t r = std::size_t(k) * ny + j;
+  if (const int u = row_mat[r]; u >= 0) velocity_row(k, j, UniformMat{mat_tuples.data() + std::size_t(u) * K});
+  else if (mat_table) velocity_row(k, j, table_mat());
+  else velocity_row(k, j, dense_mat());
+  for (int e = force_first[r]; e < force_first[r + 1]; ++e) {
+    const Injection& q = force_rows[e];
+    q.field[q.n] += float(q.weight * sources[q.source].stf.value(t) * mat(q.mat, q.n));
+  }
+}
+
+// Rows [j0, j1) of velocity plane k (worksharing when called inside a parallel region).
+void Solver::Impl::velocity_rows(int k, int j0, int j1, double t) {
+#pragma omp for schedule(static)
+  for (int j = j0; j < j1; ++j) velocity_row_at(k, j, t);
 }
 
 // Strain-rate differences (times h) at node / edge positions of plane k. Z selects the z stencil:
 // 0 interior, 1 the free-surface plane (ezz from σzz = 0; 2nd-order ∂z for the edges at z = h/2),
 // 2 the plane below it (2nd-order ∂z vz: vz above the surface is not a model value).
+// Expects la = λ, tm = 2μ of the cell.
 #define PANOPTES_STRAIN(Zm)                                                                                       \
   const float exx = C1 * (ux[i] - ux[i - 1]) + C2 * (ux[i + 1] - ux[i - 2]);                                       \
   const float eyy = C1 * (uy[i] - uy[i - Y]) + C2 * (uy[i + Y] - uy[i - 2 * Y]);                                   \
   float ezz;                                                                                                       \
   if constexpr (Zm == 0) ezz = C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]);                         \
-  else if constexpr (Zm == 1) ezz = -pl[i] / (pl[i] + pm[i]) * (exx + eyy);                                        \
+  else if constexpr (Zm == 1) ezz = -la / (la + tm) * (exx + eyy);                                                 \
   else ezz = uz[i] - uz[i - Z];                                                                                    \
   const float exy = C1 * (ux[i + Y] - ux[i]) + C2 * (ux[i + 2 * Y] - ux[i - Y]) + C1 * (uy[i + 1] - uy[i]) +        \
                     C2 * (uy[i + 2] - uy[i - 1]);                                                                  \
@@ -565,61 +754,54 @@ void Solver::Impl::velocity_planes(int k0, int k1, double t) {
   }                                                                                                                \
   const float th = exx + eyy + ezz;
 
-#define PANOPTES_ROW_POINTERS                         \
-  const std::size_t b = idx(0, j, k);                 \
-  const float* __restrict ux = vx.data() + b;         \
-  const float* __restrict uy = vy.data() + b;         \
-  const float* __restrict uz = vz.data() + b;         \
-  float* __restrict xx = sxx.data() + b;              \
-  float* __restrict yy = syy.data() + b;              \
-  float* __restrict zz = szz.data() + b;              \
-  float* __restrict xy = sxy.data() + b;              \
-  float* __restrict xz = sxz.data() + b;              \
-  float* __restrict yz = syz.data() + b;              \
-  const float* __restrict pl = lam.data() + b;        \
-  const float* __restrict pm = twomu.data() + b;      \
-  const float* __restrict mxy = muxy.data() + b;      \
-  const float* __restrict mxz = muxz.data() + b;      \
-  const float* __restrict myz = muyz.data() + b;      \
+// One row of the stress update (plus memory variables when attenuating), then its CPML
+// corrections x, y, z; on the free-surface plane σzz is set to 0 last. Corrections of σ read only v.
+template <int Zm, class M>
+void Solver::Impl::stress_row(int k, int j, const M& mat0) {
+  const std::size_t b = idx(0, j, k);
+  const M m = mat0.row(b);
   const long Y = sy, Z = sz;
-
-template <int Zm>
-void Solver::Impl::stress_row_elastic(int k, int j) {
   {
-    PANOPTES_ROW_POINTERS
+  // Restrict-qualified only here: the CPML part below also writes σ through visco_normal/shear.
+  const float* __restrict ux = vx.data() + b;
+  const float* __restrict uy = vy.data() + b;
+  const float* __restrict uz = vz.data() + b;
+  float* __restrict xx = sxx.data() + b;
+  float* __restrict yy = syy.data() + b;
+  float* __restrict zz = szz.data() + b;
+  float* __restrict xy = sxy.data() + b;
+  float* __restrict xz = sxz.data() + b;
+  float* __restrict yz = syz.data() + b;
+  if (L == 0) {
 #pragma omp simd
     for (int i = 0; i < nx; ++i) {
+      const float la = m(LAM, i), tm = m(TWOMU, i);
       PANOPTES_STRAIN(Zm)
-      xx[i] += pl[i] * th + pm[i] * exx;
-      yy[i] += pl[i] * th + pm[i] * eyy;
-      zz[i] += pl[i] * th + pm[i] * ezz;
-      xy[i] += mxy[i] * exy;
-      xz[i] += mxz[i] * exz;
-      yz[i] += myz[i] * eyz;
+      xx[i] += la * th + tm * exx;
+      yy[i] += la * th + tm * eyy;
+      zz[i] += la * th + tm * ezz;
+      xy[i] += m(MUXY, i) * exy;
+      xz[i] += m(MUXZ, i) * exz;
+      yz[i] += m(MUYZ, i) * eyz;
     }
-  }
-}
-
-template <int Zm>
-void Solver::Impl::stress_row_visco(int k, int j) {
-  float* rows = rowbuf[std::size_t(omp_get_thread_num())].data();
-  float* __restrict rxx_ = rows;
-  float* __restrict ryy_ = rows + nx;
-  float* __restrict rzz_ = rows + 2 * nx;
-  float* __restrict rxy_ = rows + 3 * nx;
-  float* __restrict rxz_ = rows + 4 * nx;
-  float* __restrict ryz_ = rows + 5 * nx;
-  {
-    PANOPTES_ROW_POINTERS
+  } else {
+    float* rows = rowbuf[std::size_t(omp_get_thread_num())].data();
+    float* __restrict rxx_ = rows;
+    float* __restrict ryy_ = rows + nx;
+    float* __restrict rzz_ = rows + 2 * nx;
+    float* __restrict rxy_ = rows + 3 * nx;
+    float* __restrict rxz_ = rows + 4 * nx;
+    float* __restrict ryz_ = rows + 5 * nx;
 #pragma omp simd
     for (int i = 0; i < nx; ++i) {
+      const float la = m(LAM, i), tm = m(TWOMU, i);
       PANOPTES_STRAIN(Zm)
-      xx[i] += pl[i] * th + pm[i] * exx;
-      yy[i] += pl[i] * th + pm[i] * eyy;
-      zz[i] += pl[i] * th + pm[i] * ezz;
-      xy[i] += mxy[i] * exy;
-      xz[i] += mxz[i] * exz;
-      yz[i] += myz[i] * eyz;
+      xx[i] += la * th + tm * exx;
+      yy[i] += la * th + tm * eyy;
+      zz[i] += la * th + tm * ezz;
+      xy[i] += m(MUXY, i) * exy;
+      xz[i] += m(MUXZ, i) * exz;
+      yz[i] += m(MUYZ, i) * eyz;
       rxx_[i] = exx;
       ryy_[i] = eyy;
       rzz_[i] = ezz;
@@ -635,216 +817,216 @@ void Solver::Impl::stress_row_visco(int k, int j) {
       float* __restrict mxy_ = rxy[l].data() + b;
       float* __restrict mxz_ = rxz[l].data() + b;
       float* __restrict myz_ = ryz[l].data() + b;
-      const float* __restrict cl_ = cl[l].data() + b;
-      const float* __restrict cm_ = cm[l].data() + b;
-      const float* __restrict cxy = cmxy[l].data() + b;
-      const float* __restrict cxz = cmxz[l].data() + b;
-      const float* __restrict cyz = cmyz[l].data() + b;
+      const int fl = CL(l), fm = CM(l), fxy = CMXY(l), fxz = CMXZ(l), fyz = CMYZ(l);
 #pragma omp simd
       for (int i = 0; i < nx; ++i) {
         const float th = rxx_[i] + ryy_[i] + rzz_[i];
+        const float cl_ = m(fl, i), cm_ = m(fm, i);
         float o, n;
-        o = mx[i]; n = A * o + B * (cl_[i] * th + cm_[i] * rxx_[i]); mx[i] = n; xx[i] -= 0.5f * (o + n);
-        o = my[i]; n = A * o + B * (cl_[i] * th + cm_[i] * ryy_[i]); my[i] = n; yy[i] -= 0.5f * (o + n);
-        o = mz[i]; n = A * o + B * (cl_[i] * th + cm_[i] * rzz_[i]); mz[i] = n; zz[i] -= 0.5f * (o + n);
-        o = mxy_[i]; n = A * o + B * (cxy[i] * rxy_[i]); mxy_[i] = n; xy[i] -= 0.5f * (o + n);
-        o = mxz_[i]; n = A * o + B * (cxz[i] * rxz_[i]); mxz_[i] = n; xz[i] -= 0.5f * (o + n);
-        o = myz_[i]; n = A * o + B * (cyz[i] * ryz_[i]); myz_[i] = n; yz[i] -= 0.5f * (o + n);
+        o = mx[i]; n = A * o + B * (cl_ * th + cm_ * rxx_[i]); mx[i] = n; xx[i] -= 0.5f * (o + n);
+        o = my[i]; n = A * o + B * (cl_ * th + cm_ * ryy_[i]); my[i] = n; yy[i] -= 0.5f * (o + n);
+        o = mz[i]; n = A * o + B * (cl_ * th + cm_ * rzz_[i]); mz[i] = n; zz[i] -= 0.5f * (o + n);
+        o = mxy_[i]; n = A * o + B * (m(fxy, i) * rxy_[i]); mxy_[i] = n; xy[i] -= 0.5f * (o + n);
+        o = mxz_[i]; n = A * o + B * (m(fxz, i) * rxz_[i]); mxz_[i] = n; xz[i] -= 0.5f * (o + n);
+        o = myz_[i]; n = A * o + B * (m(fyz, i) * ryz_[i]); myz_[i] = n; yz[i] -= 0.5f * (o + n);
       }
     }
   }
-}
-
-void Solver::Impl::stress_planes(int k0, int k1, double t) {
-  if (k0 >= k1) return;
-  // One parallel loop over all rows of the planes (few barriers: the machine may be oversubscribed).
-  const int rows = (k1 - k0) * ny;
-#pragma omp parallel for schedule(static)
-  for (int r = 0; r < rows; ++r) {
-    const int k = k0 + r / ny, j = r % ny;
-    const int g = k + kb;
-    const int zm = !free_surface ? 0 : g == 0 ? 1 : g == 1 ? 2 : 0;
+  }
+  // CPML corrections.
+  const float* ux = vx.data() + b;
+  const float* uy = vy.data() + b;
+  const float* uz = vz.data() + b;
+  float* xx = sxx.data() + b;
+  float* yy = syy.data() + b;
+  float* zz = szz.data() + b;
+  float* xy = sxy.data() + b;
+  float* xz = sxz.data() + b;
+  float* yz = syz.data() + b;
+  const int cx = pmlx.count();
+  for (int s = 0; s < cx; ++s) {
+    const int i = pmlx.indices[s];
+    const std::size_t n = b + i, p = (std::size_t(k) * ny + j) * cx + s;
+    const float* f = ux + i;
+    float& a = psix[3][p];
+    a = pmlx.b_full[i] * a + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
+    xx[i] += (m(LAM, i) + m(TWOMU, i)) * a;
+    yy[i] += m(LAM, i) * a;
+    zz[i] += m(LAM, i) * a;
+    f = uy + i;
+    float& bb = psix[4][p];
+    bb = pmlx.b_half[i] * bb + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
+    xy[i] += m(MUXY, i) * bb;
+    f = uz + i;
+    float& c = psix[5][p];
+    c = pmlx.b_half[i] * c + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
+    xz[i] += m(MUXZ, i) * c;
+    if (L > 0) {
+      visco_normal(m, i, n, a, 0);
+      visco_shear(m, i, n, bb, sxy, rxy, CMXY(0));
+      visco_shear(m, i, n, c, sxz, rxz, CMXZ(0));
+    }
+  }
+  if (const int s = pmly.count() > 0 ? pmly.slot[j] : -1; s >= 0) {
+    const float bf = pmly.b_full[j], af = pmly.a_full[j], bh = pmly.b_half[j], ah = pmly.a_half[j];
+    const std::size_t p = (std::size_t(k) * pmly.count() + s) * nx;
+    float* p0 = psiy[3].data() + p;
+    float* p1 = psiy[4].data() + p;
+    float* p2 = psiy[5].data() + p;
+    if (L == 0) {  // the same arithmetic, restrict-qualified so that it vectorizes
+      float* __restrict q0 = p0;
+      float* __restrict q1 = p1;
+      float* __restrict q2 = p2;
+      float* __restrict X = xx;
+      float* __restrict YY = yy;
+      float* __restrict ZZ = zz;
+      float* __restrict XY = xy;
+      float* __restrict YZ = yz;
+      const float* __restrict U = ux;
+      const float* __restrict V = uy;
+      const float* __restrict W = uz;
+#pragma omp simd
+      for (int i = 0; i < nx; ++i) {
+        q0[i] = bf * q0[i] + af * (C1 * (V[i] - V[i - Y]) + C2 * (V[i + Y] - V[i - 2 * Y]));
+        YY[i] += (m(LAM, i) + m(TWOMU, i)) * q0[i];
+        X[i] += m(LAM, i) * q0[i];
+        ZZ[i] += m(LAM, i) * q0[i];
+        q1[i] = bh * q1[i] + ah * (C1 * (U[i + Y] - U[i]) + C2 * (U[i + 2 * Y] - U[i - Y]));
+        XY[i] += m(MUXY, i) * q1[i];
+        q2[i] = bh * q2[i] + ah * (C1 * (W[i + Y] - W[i]) + C2 * (W[i + 2 * Y] - W[i - Y]));
+        YZ[i] += m(MUYZ, i) * q2[i];
+      }
+    } else
+    for (int i = 0; i < nx; ++i) {
+      p0[i] = bf * p0[i] + af * (C1 * (uy[i] - uy[i - Y]) + C2 * (uy[i + Y] - uy[i - 2 * Y]));
+      yy[i] += (m(LAM, i) + m(TWOMU, i)) * p0[i];
+      xx[i] += m(LAM, i) * p0[i];
+      zz[i] += m(LAM, i) * p0[i];
+      p1[i] = bh * p1[i] + ah * (C1 * (ux[i + Y] - ux[i]) + C2 * (ux[i + 2 * Y] - ux[i - Y]));
+      xy[i] += m(MUXY, i) * p1[i];
+      p2[i] = bh * p2[i] + ah * (C1 * (uz[i + Y] - uz[i]) + C2 * (uz[i + 2 * Y] - uz[i - Y]));
+      yz[i] += m(MUYZ, i) * p2[i];
+      if (L > 0) {
+        visco_normal(m, i, b + i, p0[i], 1);
+        visco_shear(m, i, b + i, p1[i], sxy, rxy, CMXY(0));
+        visco_shear(m, i, b + i, p2[i], syz, ryz, CMYZ(0));
+      }
+    }
+  }
+  if (const int s = pmlz.count() > 0 ? pmlz.slot[k] : -1; s >= 0) {
+    const float bf = pmlz.b_full[k], af = pmlz.a_full[k], bh = pmlz.b_half[k], ah = pmlz.a_half[k];
+    const std::size_t p = (std::size_t(s) * ny + j) * nx;
+    float* p0 = psiz[3].data() + p;
+    float* p1 = psiz[4].data() + p;
+    float* p2 = psiz[5].data() + p;
     if (L == 0) {
-      if (zm == 0) stress_row_elastic<0>(k, j);
-      else if (zm == 1) stress_row_elastic<1>(k, j);
-      else stress_row_elastic<2>(k, j);
-    } else {
-      if (zm == 0) stress_row_visco<0>(k, j);
-      else if (zm == 1) stress_row_visco<1>(k, j);
-      else stress_row_visco<2>(k, j);
+      float* __restrict q0 = p0;
+      float* __restrict q1 = p1;
+      float* __restrict q2 = p2;
+      float* __restrict X = xx;
+      float* __restrict YY = yy;
+      float* __restrict ZZ = zz;
+      float* __restrict XZ = xz;
+      float* __restrict YZ = yz;
+      const float* __restrict U = ux;
+      const float* __restrict V = uy;
+      const float* __restrict W = uz;
+#pragma omp simd
+      for (int i = 0; i < nx; ++i) {
+        q0[i] = bf * q0[i] + af * (C1 * (W[i] - W[i - Z]) + C2 * (W[i + Z] - W[i - 2 * Z]));
+        ZZ[i] += (m(LAM, i) + m(TWOMU, i)) * q0[i];
+        X[i] += m(LAM, i) * q0[i];
+        YY[i] += m(LAM, i) * q0[i];
+        q1[i] = bh * q1[i] + ah * (C1 * (U[i + Z] - U[i]) + C2 * (U[i + 2 * Z] - U[i - Z]));
+        XZ[i] += m(MUXZ, i) * q1[i];
+        q2[i] = bh * q2[i] + ah * (C1 * (V[i + Z] - V[i]) + C2 * (V[i + 2 * Z] - V[i - Z]));
+        YZ[i] += m(MUYZ, i) * q2[i];
+      }
+    } else
+    for (int i = 0; i < nx; ++i) {
+      p0[i] = bf * p0[i] + af * (C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]));
+      zz[i] += (m(LAM, i) + m(TWOMU, i)) * p0[i];
+      xx[i] += m(LAM, i) * p0[i];
+      yy[i] += m(LAM, i) * p0[i];
+      p1[i] = bh * p1[i] + ah * (C1 * (ux[i + Z] - ux[i]) + C2 * (ux[i + 2 * Z] - ux[i - Z]));
+      xz[i] += m(MUXZ, i) * p1[i];
+      p2[i] = bh * p2[i] + ah * (C1 * (uy[i + Z] - uy[i]) + C2 * (uy[i + 2 * Z] - uy[i - Z]));
+      yz[i] += m(MUYZ, i) * p2[i];
+      if (L > 0) {
+        visco_normal(m, i, b + i, p0[i], 2);
+        visco_shear(m, i, b + i, p1[i], sxz, rxz, CMXZ(0));
+        visco_shear(m, i, b + i, p2[i], syz, ryz, CMYZ(0));
+      }
     }
   }
-  pml_stress(k0, k1);
-  for (const auto& q : stress_inj)
-    if (q.k >= k0 && q.k < k1) q.field[q.n] += float(q.weight * sources[q.source].stf.rate(t));
-  if (free_surface && kb == 0 && k0 == 0) {
-    float* zz = szz.data() + idx(0, 0, 0);
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) zz[i + j * sy] = 0.0f;
+  if constexpr (Zm == 1)
+    for (int i = 0; i < nx; ++i) zz[i] = 0.0f;
+}
+
+// Stress row (k, j) with its memory variables, CPML corrections and moment sources.
+void Solver::Impl::stress_row_at(int k, int j, double t) {
+  const int g = k + kb;
+  const int zm = !free_surface ? 0 : g == 0 ? 1 : g == 1 ? 2 : 0;
+  const std::size_t r = std::size_t(k) * ny + j;
+  if (const int u = row_mat[r]; u >= 0) {
+    const UniformMat um{mat_tuples.data() + std::size_t(u) * K};
+    if (zm == 0) stress_row<0>(k, j, um);
+    else if (zm == 1) stress_row<1>(k, j, um);
+    else stress_row<2>(k, j, um);
+  } else if (mat_table) {
+    if (zm == 0) stress_row<0>(k, j, table_mat());
+    else if (zm == 1) stress_row<1>(k, j, table_mat());
+    else stress_row<2>(k, j, table_mat());
+  } else {
+    if (zm == 0) stress_row<0>(k, j, dense_mat());
+    else if (zm == 1) stress_row<1>(k, j, dense_mat());
+    else stress_row<2>(k, j, dense_mat());
+  }
+  for (int e = stress_first[r]; e < stress_first[r + 1]; ++e) {
+    const Injection& q = stress_rows[e];
+    q.field[q.n] += float(q.weight * sources[q.source].stf.rate(t));
   }
 }
 
-// CPML: ψ ← b·ψ + a·∂f and f += coefficient·ψ, applied after the plain update (κ = 1), over the
-// layers of each axis only. The interior loops above stay branch-free.
-void Solver::Impl::pml_velocity(int k0, int k1) {
-  const long Y = sy, Z = sz;
-  const int cx = pmlx.count(), cy = pmly.count();
-  if (cx > 0) {
-#pragma omp parallel for collapse(2) schedule(static)
-    for (int k = k0; k < k1; ++k)
-      for (int j = 0; j < ny; ++j)
-        for (int s = 0; s < cx; ++s) {
-          const int i = pmlx.indices[s];
-          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * ny + j) * cx + s;
-          const float* f = sxx.data() + n;
-          float& a = psix[0][p];
-          a = pmlx.b_half[i] * a + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
-          vx[n] += bx[n] * a;
-          f = sxy.data() + n;
-          float& b = psix[1][p];
-          b = pmlx.b_full[i] * b + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
-          vy[n] += by[n] * b;
-          f = sxz.data() + n;
-          float& c = psix[2][p];
-          c = pmlx.b_full[i] * c + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
-          vz[n] += bz[n] * c;
-        }
-  }
-  if (cy > 0) {
-#pragma omp parallel for collapse(2) schedule(static)
-    for (int k = k0; k < k1; ++k)
-      for (int s = 0; s < cy; ++s) {
-        const int j = pmly.indices[s];
-        for (int i = 0; i < nx; ++i) {
-          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * cy + s) * nx + i;
-          const float* f = sxy.data() + n;
-          float& a = psiy[0][p];
-          a = pmly.b_full[j] * a + pmly.a_full[j] * (C1 * (f[0] - f[-Y]) + C2 * (f[Y] - f[-2 * Y]));
-          vx[n] += bx[n] * a;
-          f = syy.data() + n;
-          float& b = psiy[1][p];
-          b = pmly.b_half[j] * b + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
-          vy[n] += by[n] * b;
-          f = syz.data() + n;
-          float& c = psiy[2][p];
-          c = pmly.b_full[j] * c + pmly.a_full[j] * (C1 * (f[0] - f[-Y]) + C2 * (f[Y] - f[-2 * Y]));
-          vz[n] += bz[n] * c;
-        }
-      }
-  }
-  const auto zlo = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k0) - pmlz.indices.begin();
-  const auto zhi = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k1) - pmlz.indices.begin();
-#pragma omp parallel for collapse(2) schedule(static)
-  for (long s = zlo; s < zhi; ++s)
-    for (int j = 0; j < ny; ++j) {
-      const int k = pmlz.indices[s];
-      for (int i = 0; i < nx; ++i) {
-        const std::size_t n = idx(i, j, k), p = (std::size_t(s) * ny + j) * nx + i;
-        const float* f = sxz.data() + n;
-        float& a = psiz[0][p];
-        a = pmlz.b_full[k] * a + pmlz.a_full[k] * (C1 * (f[0] - f[-Z]) + C2 * (f[Z] - f[-2 * Z]));
-        vx[n] += bx[n] * a;
-        f = syz.data() + n;
-        float& b = psiz[1][p];
-        b = pmlz.b_full[k] * b + pmlz.a_full[k] * (C1 * (f[0] - f[-Z]) + C2 * (f[Z] - f[-2 * Z]));
-        vy[n] += by[n] * b;
-        f = szz.data() + n;
-        float& c = psiz[2][p];
-        c = pmlz.b_half[k] * c + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
-        vz[n] += bz[n] * c;
-      }
-  }
+// Rows [j0, j1) of stress plane k (worksharing when called inside a parallel region).
+void Solver::Impl::stress_rows_(int k, int j0, int j1, double t) {
+#pragma omp for schedule(static)
+  for (int j = j0; j < j1; ++j) stress_row_at(k, j, t);
 }
 
-void Solver::Impl::pml_stress(int k0, int k1) {
-  const long Y = sy, Z = sz;
-  const int cx = pmlx.count(), cy = pmly.count();
-  if (cx > 0) {
-#pragma omp parallel for collapse(2) schedule(static)
-    for (int k = k0; k < k1; ++k)
-      for (int j = 0; j < ny; ++j)
-        for (int s = 0; s < cx; ++s) {
-          const int i = pmlx.indices[s];
-          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * ny + j) * cx + s;
-          const float* f = vx.data() + n;
-          float& a = psix[3][p];
-          a = pmlx.b_full[i] * a + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
-          sxx[n] += (lam[n] + twomu[n]) * a;
-          syy[n] += lam[n] * a;
-          szz[n] += lam[n] * a;
-          f = vy.data() + n;
-          float& b = psix[4][p];
-          b = pmlx.b_half[i] * b + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
-          sxy[n] += muxy[n] * b;
-          f = vz.data() + n;
-          float& c = psix[5][p];
-          c = pmlx.b_half[i] * c + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
-          sxz[n] += muxz[n] * c;
-          if (L > 0) {
-            visco_normal(n, a, 0);
-            visco_shear(n, b, sxy, rxy, cmxy);
-            visco_shear(n, c, sxz, rxz, cmxz);
-          }
-        }
-  }
-  if (cy > 0) {
-#pragma omp parallel for collapse(2) schedule(static)
-    for (int k = k0; k < k1; ++k)
-      for (int s = 0; s < cy; ++s) {
-        const int j = pmly.indices[s];
-        for (int i = 0; i < nx; ++i) {
-          const std::size_t n = idx(i, j, k), p = (std::size_t(k) * cy + s) * nx + i;
-          const float* f = vy.data() + n;
-          float& a = psiy[3][p];
-          a = pmly.b_full[j] * a + pmly.a_full[j] * (C1 * (f[0] - f[-Y]) + C2 * (f[Y] - f[-2 * Y]));
-          syy[n] += (lam[n] + twomu[n]) * a;
-          sxx[n] += lam[n] * a;
-          szz[n] += lam[n] * a;
-          f = vx.data() + n;
-          float& b = psiy[4][p];
-          b = pmly.b_half[j] * b + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
-          sxy[n] += muxy[n] * b;
-          f = vz.data() + n;
-          float& c = psiy[5][p];
-          c = pmly.b_half[j] * c + pmly.a_half[j] * (C1 * (f[Y] - f[0]) + C2 * (f[2 * Y] - f[-Y]));
-          syz[n] += muyz[n] * c;
-          if (L > 0) {
-            visco_normal(n, a, 1);
-            visco_shear(n, b, sxy, rxy, cmxy);
-            visco_shear(n, c, syz, ryz, cmyz);
-          }
-        }
+// The fused, cache-blocked sweep over velocity planes [kv0, kv1) and stress planes [ks0, ks1)
+// (every velocity plane a stress plane needs must be new, either in the range or already done).
+// Along z, stress plane m follows velocity plane m+2. Along y the rows are cut into blocks of
+// `yblock` rows, swept one after the other through all planes so that the z neighbourhood of a
+// block (≈ 5 planes of each field) stays in L2; the stress rows of a block lag its velocity rows
+// by 2 (stress row j needs velocity rows j−2 … j+2 and is read, old, by the same ones). Each
+// OpenMP thread sweeps its own contiguous range of rows; the 4 stress rows around the seams
+// between threads follow after a barrier.
+void Solver::Impl::sweep(int kv0, int kv1, int ks0, int ks1, double tv, double ts) {
+  const int nth = std::max(1, std::min(omp_get_num_threads(), ny / 16));
+  const int t = omp_get_thread_num();
+  if (t < nth) {
+    const int J0 = int(long(ny) * t / nth), J1 = int(long(ny) * (t + 1) / nth);
+    const int S0 = J0 == 0 ? 0 : J0 + 2, S1 = J1 == ny ? ny : J1 - 2;
+    for (int jb = J0; jb < J1; jb += yblock) {
+      const int v0 = jb, v1 = std::min(jb + yblock, J1);
+      const int s0 = jb == J0 ? S0 : jb - 2, s1 = v1 == J1 ? S1 : v1 - 2;
+      for (int k = kv0; k < kv1; ++k) {
+        for (int j = v0; j < v1; ++j) velocity_row_at(k, j, tv);
+        if (k - 2 >= ks0 && k - 2 < ks1)
+          for (int j = s0; j < s1; ++j) stress_row_at(k - 2, j, ts);
       }
+      for (int m = std::max(ks0, kv1 - 2); m < ks1; ++m)
+        for (int j = s0; j < s1; ++j) stress_row_at(m, j, ts);
+    }
   }
-  const auto zlo = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k0) - pmlz.indices.begin();
-  const auto zhi = std::lower_bound(pmlz.indices.begin(), pmlz.indices.end(), k1) - pmlz.indices.begin();
-#pragma omp parallel for collapse(2) schedule(static)
-  for (long s = zlo; s < zhi; ++s)
-    for (int j = 0; j < ny; ++j) {
-      const int k = pmlz.indices[s];
-      for (int i = 0; i < nx; ++i) {
-        const std::size_t n = idx(i, j, k), p = (std::size_t(s) * ny + j) * nx + i;
-        const float* f = vz.data() + n;
-        float& a = psiz[3][p];
-        a = pmlz.b_full[k] * a + pmlz.a_full[k] * (C1 * (f[0] - f[-Z]) + C2 * (f[Z] - f[-2 * Z]));
-        szz[n] += (lam[n] + twomu[n]) * a;
-        sxx[n] += lam[n] * a;
-        syy[n] += lam[n] * a;
-        f = vx.data() + n;
-        float& b = psiz[4][p];
-        b = pmlz.b_half[k] * b + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
-        sxz[n] += muxz[n] * b;
-        f = vy.data() + n;
-        float& c = psiz[5][p];
-        c = pmlz.b_half[k] * c + pmlz.a_half[k] * (C1 * (f[Z] - f[0]) + C2 * (f[2 * Z] - f[-Z]));
-        syz[n] += muyz[n] * c;
-        if (L > 0) {
-          visco_normal(n, a, 2);
-          visco_shear(n, b, sxz, rxz, cmxz);
-          visco_shear(n, c, syz, ryz, cmyz);
-        }
-      }
+#pragma omp barrier
+  if (t + 1 < nth) {
+    const int J1 = int(long(ny) * (t + 1) / nth);
+    for (int m = ks0; m < ks1; ++m)
+      for (int j = J1 - 2; j < J1 + 2; ++j) stress_row_at(m, j, ts);
   }
+#pragma omp barrier
 }
 
 // Stress imaging (Levander 1988): σzz is antisymmetric about the surface plane z = 0, as are σxz
@@ -901,33 +1083,41 @@ void Solver::Impl::finish_exchange() {
 
 // ==================================================================== stepping
 
+// Fused sweep: stress plane m needs the new velocities of planes m−2 … m+2 and is needed (old)
+// by the velocity planes m−2 … m+2, so it is updated right after velocity plane m+2. Each field
+// plane is then read from memory about once per step instead of twice (velocity and stress
+// passes), and the CPML corrections are applied while their row is in cache. Per cell the
+// arithmetic (and its order) is that of separate passes, so results do not depend on the order
+// of planes or on the decomposition.
 void Solver::Impl::step() {
   const double tv = nsteps * dt;          // σ^n: body forces act at t_n
   const double ts = (nsteps + 0.5) * dt;  // v^{n+½}: moment rates act at t_{n+½}
-  // Rank-boundary planes first, then their halos travel while the interior is updated.
-  const bool overlap = size > 1 && nzl >= 4;
-  if (overlap) {
-    velocity_planes(0, 2, tv);
-    velocity_planes(nzl - 2, nzl, tv);
-    start_exchange({&vx, &vy, &vz});
-    velocity_planes(2, nzl - 2, tv);
+  if (size == 1) {
+#pragma omp parallel
+    sweep(0, nzl, 0, nzl, tv, ts);
   } else {
-    velocity_planes(0, nzl, tv);
+    // Rank-boundary velocity planes first; their halos travel while the interior is swept (the
+    // interior stress planes 2 … nzl−3 need no velocity halo). The stress halos (6 fields × 2 planes)
+    // are exchanged after the boundary stress planes: the next step's boundary velocity planes need
+    // them at once.
+    std::vector<int> edge;
+    for (int k : {0, 1, nzl - 2, nzl - 1})
+      if (k >= 0 && k < nzl && std::find(edge.begin(), edge.end(), k) == edge.end()) edge.push_back(k);
+#pragma omp parallel
+    for (int k : edge) velocity_plane(k, tv);
     start_exchange({&vx, &vy, &vz});
-  }
-  finish_exchange();
-  if (nsteps % cfg.record_every == 0) record();
-  if (overlap) {
-    stress_planes(0, 2, ts);
-    stress_planes(nzl - 2, nzl, ts);
+    if (nzl > 4) {
+#pragma omp parallel
+      sweep(2, nzl - 2, 2, nzl - 2, tv, ts);
+    }
+    finish_exchange();
+#pragma omp parallel
+    for (int k : edge) stress_plane(k, ts);
     start_exchange({&sxx, &syy, &szz, &sxy, &sxz, &syz});
-    stress_planes(2, nzl - 2, ts);
-  } else {
-    stress_planes(0, nzl, ts);
-    start_exchange({&sxx, &syy, &szz, &sxy, &sxz, &syz});
+    finish_exchange();
   }
-  finish_exchange();
   free_surface_images();
+  if (nsteps % cfg.record_every == 0) record();
   ++nsteps;
 }
 
@@ -1043,14 +1233,14 @@ double Solver::energy() const {
     for (int j = j0; j < j1; ++j)
       for (int i = i0; i < i1; ++i) {
         const std::size_t m = s.idx(i, j, k);
-        const double rx = 1.0 / (q * s.bx[m]), ry = 1.0 / (q * s.by[m]), rz = 1.0 / (q * s.bz[m]);
+        const double rx = 1.0 / (q * s.mat(BX, m)), ry = 1.0 / (q * s.mat(BY, m)), rz = 1.0 / (q * s.mat(BZ, m));
         const double kin = 0.5 * (rx * s.vx[m] * s.vx[m] + ry * s.vy[m] * s.vy[m] + rz * s.vz[m] * s.vz[m]);
-        const double mu = 0.5 * q * s.twomu[m], la = q * s.lam[m];
+        const double mu = 0.5 * q * s.mat(TWOMU, m), la = q * s.mat(LAM, m);
         const double tr = double(s.sxx[m]) + s.syy[m] + s.szz[m];
         const double sq = double(s.sxx[m]) * s.sxx[m] + double(s.syy[m]) * s.syy[m] + double(s.szz[m]) * s.szz[m];
         double w = sq / (4 * mu) - la * tr * tr / (4 * mu * (3 * la + 2 * mu));
-        w += double(s.sxy[m]) * s.sxy[m] / (2 * q * s.muxy[m]) + double(s.sxz[m]) * s.sxz[m] / (2 * q * s.muxz[m]) +
-             double(s.syz[m]) * s.syz[m] / (2 * q * s.muyz[m]);
+        w += double(s.sxy[m]) * s.sxy[m] / (2 * q * s.mat(MUXY, m)) +
+             double(s.sxz[m]) * s.sxz[m] / (2 * q * s.mat(MUXZ, m)) + double(s.syz[m]) * s.syz[m] / (2 * q * s.mat(MUYZ, m));
         e += kin + w;
       }
   return s.allreduce_sum(e * s.h * s.h * s.h);
@@ -1106,8 +1296,10 @@ void Solver::write_seismograms(const std::string& dir) const {
 
 std::size_t Solver::memory_bytes() const {
   const Impl& s = *impl_;
-  std::size_t b = 17 * s.N * sizeof(float);
-  b += std::size_t(s.L) * 11 * s.N * sizeof(float);
+  std::size_t b = 9 * s.N * sizeof(float);                              // fields
+  b += std::size_t(s.L) * 6 * s.N * sizeof(float);                      // memory variables
+  b += s.mat_id.size() * sizeof(std::uint16_t) + s.mat_tab.size() * sizeof(float);
+  for (const auto& v : s.mat_dense) b += v.size() * sizeof(float);
   for (const auto* p : {&s.psix, &s.psiy, &s.psiz})
     for (const auto& v : *p) b += v.size() * sizeof(float);
   b += s.phip.size() * 2 * sizeof(float);
