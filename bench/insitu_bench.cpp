@@ -1,105 +1,223 @@
-// In-situ engine benchmark: one snapshot of a synthetic two-field wave scene rendered from a rig for
-// the paper's three tasks (p-wave, s-wave, both), composited and encoded into a database; a reduced
-// paper setting (the 256x512x160 grid at 1/4 per axis, 1/2 the image size) and the demo's image size.
-// Counters: seconds per snapshot split into copy / render / composite / encode / checkpoint,
-// camera-frames per core-second, database bytes vs raw-field bytes, memory per open stream.
+// In-situ benchmark with the simulation phase (issue 5): the seismic solver and the in-situ pipeline
+// as `panoptes run` drives them (bench/insitu_bench.hpp), one process, for
+//   demo          examples/demo.toml: 48x96x32 grid, 130 Yin-Yang cameras x 3 tasks at 256x224;
+//   paper_quarter examples/paper_quarter.toml: the paper's setting at 1/4 grid resolution per axis
+//                 (64x128x40) and the paper's 920x896 images, 8 of its Yin-Yang cameras (yinyang:2x2)
+//                 x 3 tasks, so that per-camera-frame costs at the paper's image size are measured.
+// Counters (per snapshot, seconds): simulation / copy / render / composite / encode / checkpoint,
+// camera-frames per core-second, database bytes vs raw-field bytes (phi_p, phi_s as float32), the
+// process's resident memory with everything open, and memory per open stream.
+//
+// `insitu_bench --video-study` (not run by scripts/bench; minutes) measures what the video settings
+// give on the real frames of a setting: it runs the demo (every snapshot) and a stretch of
+// paper_quarter, keeps the finished frames of a sample of streams, and encodes them with several
+// GOP / quality / preset choices: bytes per frame, encode CPU time, PSNR, memory per open writer.
+// docs/insitu.md reports the result and the demo's choice.
 #include <benchmark/benchmark.h>
-#include <sys/resource.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cmath>
-#include <filesystem>
-#include <thread>
+#include <cstring>
+#include <map>
 
-#include "insitu/session.hpp"
-#include "render/synthetic_fields.hpp"
+#include "bench/insitu_bench.hpp"
+#include "video/movie_reader.hpp"
+#include "video/movie_writer.hpp"
 
 using namespace panoptes;
 
 namespace {
 
-std::int64_t rss_bytes() {
-  long pages = 0, resident = 0;
-  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
-    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
-    std::fclose(f);
-  }
-  return std::int64_t(resident) * ::sysconf(_SC_PAGESIZE);
+void BM_Run(benchmark::State& state, bench::InsituSetting setting) {
+  setting.config = std::string(PANOPTES_SOURCE_DIR) + "/" + setting.config;
+  const std::string out =
+      (std::filesystem::temp_directory_path() / ("insitu_bench_" + std::to_string(::getpid()))).string();
+  bench::InsituResult r;
+  for (auto _ : state) r = bench::run_insitu_setting(setting, out);
+  std::filesystem::remove_all(out);
+  auto& c = state.counters;
+  c["simulation_s"] = r.simulation_s;
+  c["copy_s"] = r.copy_s;
+  c["render_s"] = r.render_s;
+  c["composite_s"] = r.composite_s;
+  c["encode_s"] = r.encode_s;
+  c["checkpoint_s"] = r.checkpoint_s;
+  c["snapshot_s"] = r.wall_s;
+  c["streams"] = r.streams;
+  c["cam_frames_per_core_s"] = r.frames_per_core_s();
+  c["db_kB_per_snap"] = r.db_bytes / r.snapshots / 1e3;
+  c["raw_kB_per_snap"] = r.raw_bytes / r.snapshots / 1e3;
+  c["db_over_raw_pct"] = 100 * r.db_bytes / r.raw_bytes;
+  c["rss_MB"] = r.rss_bytes_max / 1e6;
+  c["MB_per_open_stream"] = r.stream_bytes_max / 1e6;
 }
 
-std::int64_t dir_bytes(const std::filesystem::path& d) {
-  std::int64_t n = 0;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(d))
-    if (e.is_regular_file()) n += std::int64_t(e.file_size());
-  return n;
+// Waves fill the domain after ~150 of the demo's 360 steps (and ~200 of paper_quarter's 480).
+BENCHMARK_CAPTURE(BM_Run, demo, bench::InsituSetting{"examples/demo.toml", "", 150, 4})
+    ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Run, paper_quarter, bench::InsituSetting{"examples/paper_quarter.toml", "yinyang:2x2", 200, 3})
+    ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+double cpu_seconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-void BM_Snapshot(benchmark::State& state, const char* rig, int width, int height, render::Index3 dims) {
-  const render::GridGeometry grid{dims, {0, 0, 0}, {1, 1, 1}};
-  insitu::SessionConfig cfg = insitu::parse_session_config_text(R"(
-[schedule]
-every_steps = 1
-[render]
-sample_distance = 1.0
-[[task]]
-name = "p-wave"
-field = "phi_p"
-preset = "p-wave"
-[[task]]
-name = "s-wave"
-field = "phi_s"
-preset = "s-wave"
-[[task]]
-name = "p+s"
-type = "volume2"
-fields = ["phi_p", "phi_s"]
-)",
-                                                                "bench");
-  cfg.rig = rig;
-  cfg.width = width;
-  cfg.height = height;
+// Runs a setting like panoptes run and keeps the finished frames of the streams (camera, task) with
+// camera % camera_step == 0: frames[stream][snapshot].
+std::vector<std::vector<Image>> capture_frames(const bench::InsituSetting& s, int camera_step) {
+  std::ifstream in(s.config);
+  if (!in) throw FileError(s.config, "cannot open");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string seis_text;
+  insitu::SessionConfig cfg = insitu::parse_combined_config(
+      ss.str(), s.config, {"grid", "time", "medium", "boundary", "attenuation", "source", "receiver", "receiver_line"},
+      seis_text);
+  const seismic::RunConfig rc = seismic::parse_run_config(seis_text, s.config, ".");
+  if (!s.rig.empty()) cfg.rig = s.rig;
+  cfg.output_dir = (std::filesystem::temp_directory_path() / ("insitu_study_" + std::to_string(::getpid()))).string();
   cfg.overwrite = true;
-  cfg.output_dir = (std::filesystem::temp_directory_path() / ("insitu_bench_" + std::to_string(::getpid()))).string();
-  const Vec3 c = grid.centre();
-  std::vector<render::WaveFront> p{{c, 0.3 * dims[0], 2.0, 1.0}}, s{{c + Vec3{0, 0, 3}, 0.2 * dims[0], 2.5, 1.0}};
-  const std::vector<float> fp = render::wave_field(grid, p), fs = render::wave_field(grid, s);
-  std::vector<float> fs_abs(fs);
-  for (float& v : fs_abs) v = std::fabs(v);
-  const std::int64_t rss0 = rss_bytes();
+  cfg.up = {0, 0, -1};
+  seismic::Solver solver(rc.solver);
+  const auto& g = rc.solver.grid;
+  const render::GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
   insitu::Session session(cfg, grid, insitu::LocalBlock::whole(grid));
-  const std::vector<insitu::FieldInput> in{{"phi_p", fp.data(), insitu::ScalarType::f32, {0, 0, 0}},
-                                           {"phi_s", fs_abs.data(), insitu::ScalarType::f32, {0, 0, 0}}};
-  double t = 0;
-  for (auto _ : state) session.snapshot(t += 1, in);
-  const std::int64_t rss1 = rss_bytes();
-  const insitu::SessionStats st = session.stats();
+  const int tasks = session.task_count();
+  std::map<int, std::vector<Image>> kept;
+  session.set_frame_observer([&](int camera, int task, int, const Image& img) {
+    if (camera % camera_step == 0) kept[camera * tasks + task].push_back(img);
+  });
+  solver.run(s.warmup_steps);
+  auto input = [](const char* name, const seismic::FieldView& v) {
+    return insitu::FieldInput{name, v.data, insitu::ScalarType::f32,
+                              {1, std::int64_t(v.stride_y), std::int64_t(v.stride_z)}};
+  };
+  for (int n = 0; n < s.snapshots; ++n) {
+    for (std::int64_t k = 0; k < cfg.schedule.every_steps; ++k) solver.step();
+    solver.compute_derived();
+    session.snapshot(solver.velocity_time(), {input("phi_p", solver.phi_p()), input("phi_s", solver.phi_s())});
+    std::fprintf(stderr, "\rvideo study: %s snapshot %d/%d", s.config.c_str(), n + 1, s.snapshots);
+  }
+  std::fprintf(stderr, "\n");
   session.finalize();
-  const double n = double(st.snapshots);
-  const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
-  state.counters["copy_s"] = st.time.copy / n;
-  state.counters["render_s"] = st.time.render / n;
-  state.counters["composite_s"] = st.time.composite / n;
-  state.counters["encode_s"] = st.time.encode / n;
-  state.counters["checkpoint_s"] = st.time.checkpoint / n;
-  state.counters["cam_frames_per_core_s"] = double(st.frames_encoded) / (st.time.total() * cores);
-  const double raw = n * 2 * double(grid.dims[0]) * grid.dims[1] * grid.dims[2] * 4;
-  const double db = double(dir_bytes(cfg.output_dir));
-  state.counters["db_MB"] = db / 1e6;
-  state.counters["raw_MB"] = raw / 1e6;
-  state.counters["db_over_raw_pct"] = 100 * db / raw;
-  const int streams = session.camera_count() * session.task_count();
-  state.counters["streams"] = streams;
-  state.counters["MB_per_open_stream"] = double(rss1 - rss0 - st.field_buffer_bytes - st.partial_buffer_bytes) / streams / 1e6;
   std::filesystem::remove_all(cfg.output_dir);
+  std::vector<std::vector<Image>> out;
+  for (auto& [id, frames] : kept) out.push_back(std::move(frames));
+  return out;
 }
 
-// Reduced paper setting: 64x128x40 grid (1/4 per axis), 26 of the 130 cameras, 460x448 images.
-BENCHMARK_CAPTURE(BM_Snapshot, reduced_paper, "fibonacci:26", 460, 448, render::Index3{64, 128, 40})
-    ->Unit(benchmark::kSecond)->Iterations(3)->UseRealTime();
-// The demo's setting: 48x96x32 grid, 130 Yin-Yang cameras, 256x224 images.
-BENCHMARK_CAPTURE(BM_Snapshot, demo, "yinyang", 256, 224, render::Index3{48, 96, 32})
-    ->Unit(benchmark::kSecond)->Iterations(2)->UseRealTime();
+double psnr_rgb(const Image& a, const Image& b) {
+  double se = 0;
+  std::size_t n = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(a.row(y)[std::size_t(x) * a.channels + c]) - double(b.row(y)[std::size_t(x) * b.channels + c]);
+        se += d * d;
+        ++n;
+      }
+  return se == 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / (se / double(n)));
+}
+
+// Encodes the captured streams with one setting, all writers open at once and one flush per snapshot
+// (as the session does), and prints a table row.
+void study_row(const char* setting, const std::vector<std::vector<Image>>& streams, const video::VideoSettings& v,
+               double raw_field_bytes_per_frame) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("insitu_study_movies_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const int w = streams[0][0].width, h = streams[0][0].height, frames = int(streams[0].size());
+  ::malloc_trim(0);
+  const std::int64_t rss0 = bench::resident_bytes();
+  std::int64_t rss_max = rss0;
+  double cpu = 0;
+  {
+    std::vector<std::unique_ptr<video::MovieWriter>> writers;
+    for (std::size_t i = 0; i < streams.size(); ++i)
+      writers.push_back(std::make_unique<video::MovieWriter>((dir / (std::to_string(i) + ".mp4")).string(), w, h, v));
+    for (int f = 0; f < frames; ++f) {
+      const double c0 = cpu_seconds();
+      for (std::size_t i = 0; i < streams.size(); ++i) writers[i]->append(streams[i][std::size_t(f)]);
+      for (auto& wr : writers) wr->flush();
+      cpu += cpu_seconds() - c0;
+      rss_max = std::max(rss_max, bench::resident_bytes());
+    }
+    for (auto& wr : writers) wr->close();
+  }
+  double bytes = 0, psnr_sum = 0, psnr_min = 99;
+  for (std::size_t i = 0; i < streams.size(); ++i) {
+    const std::string path = (dir / (std::to_string(i) + ".mp4")).string();
+    bytes += double(std::filesystem::file_size(path));
+    video::MovieReader r(path);
+    r.set_crop(w, h);
+    for (int f = 0; f < frames; ++f) {
+      const double p = psnr_rgb(streams[i][std::size_t(f)], r.read_rgba(f));
+      psnr_sum += p;
+      psnr_min = std::min(psnr_min, p);
+    }
+  }
+  std::filesystem::remove_all(dir);
+  const double n = double(streams.size()) * frames;
+  std::printf("| %s | %dx%d | %d | %d | %s | %.0f | %.1f | %.0f | %.1f / %.1f | %.2f |\n", setting, w, h, v.gop, v.crf,
+              v.preset.c_str(), bytes / n, 100 * (bytes / n) / raw_field_bytes_per_frame, n / cpu, psnr_sum / n,
+              psnr_min, double(rss_max - rss0) / double(streams.size()) / 1e6);
+  std::fflush(stdout);
+}
+
+int video_study() {
+  const std::string src = PANOPTES_SOURCE_DIR;
+  // The whole demo (24 snapshots), every 10th of its 130 cameras: 39 streams.
+  const auto demo = capture_frames({src + "/examples/demo.toml", "", 0, 24}, 10);
+  // paper_quarter from the middle of the run: 4 of yinyang:2x2's 8 cameras, 20 snapshots, 920x896.
+  const auto paper = capture_frames({src + "/examples/paper_quarter.toml", "yinyang:2x2", 200, 20}, 2);
+  // Raw fields per camera-frame of the real run: phi_p + phi_s per snapshot / (130 x 3) frames.
+  const double demo_raw = 2.0 * 48 * 96 * 32 * 4 / 390, paper_raw = 2.0 * 256 * 512 * 160 * 4 / 390;
+  std::printf("| setting | image | gop | crf | preset | bytes/frame | %% of raw fields | encode frames/CPU-s | PSNR dB mean / min | "
+              "MB per open writer |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  struct V {
+    int gop, crf;
+    const char* preset;
+  };
+  const V variants[] = {{1, 20, "superfast"}, {10, 20, "superfast"}, {24, 20, "superfast"}, {10, 23, "superfast"},
+                        {1, 23, "superfast"}, {1, 26, "superfast"},  {10, 26, "superfast"}, {1, 23, "veryfast"},
+                        {10, 20, "ultrafast"}};
+  for (const V& x : variants) {
+    video::VideoSettings v;
+    v.gop = x.gop;
+    v.crf = x.crf;
+    v.preset = x.preset;
+    study_row("demo", demo, v, demo_raw);
+  }
+  for (const V& x : variants) {
+    if (x.gop == 24) continue;
+    video::VideoSettings v;
+    v.gop = x.gop;
+    v.crf = x.crf;
+    v.preset = x.preset;
+    study_row("paper", paper, v, paper_raw);
+  }
+  return 0;
+}
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], "--video-study") == 0) {
+      try {
+        return video_study();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "insitu_bench: %s\n", e.what());
+        return 1;
+      }
+    }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
