@@ -14,11 +14,13 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <mutex>
 #include <thread>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "store/camera_table.hpp"
 #include "video/movie_writer.hpp"
 
 namespace panoptes::store {
@@ -100,6 +102,7 @@ struct DatabaseWriter::Impl {
   std::mutex mutex;                 // guards manifest.image padding updates and directory creation
   int lock_fd = -1;
   bool finalized = false;
+  CameraTableRef table;  // the camera table written by create() (manifest writer only)
 
   Stream& stream(int camera, int task) {
     if (finalized) throw Error(dir.string() + ": database already finalized; cannot append");
@@ -129,13 +132,21 @@ struct DatabaseWriter::Impl {
     });
   }
 
+  // Rewrites panoptes.json only: the camera table, written once by create(), cannot change during a
+  // run (a checkpoint of 10^5 cameras would otherwise rewrite megabytes every snapshot). No copy of
+  // the manifest either: the fields are restored if the write fails.
   void write_manifest(Status status, int frames_written) {
-    Manifest m = manifest;
-    m.status = status;
-    m.frames_written = frames_written;
-    write_manifest_atomic(dir / kManifestFileName, m);
+    const Status old_status = manifest.status;
+    const int old_frames = manifest.frames_written;
     manifest.status = status;
     manifest.frames_written = frames_written;
+    try {
+      write_manifest_atomic(dir / kManifestFileName, manifest, table);
+    } catch (...) {
+      manifest.status = old_status;
+      manifest.frames_written = old_frames;
+      throw;
+    }
   }
 
   void release_lock() {
@@ -235,6 +246,7 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   impl->take_lock();  // before looking at an old database, so two creators cannot both proceed
 
   const fs::path manifest_path = dir / kManifestFileName;
+  std::string old_table;
   if (fs::exists(manifest_path, ec)) {
     if (!options.overwrite) {
       impl->release_lock();
@@ -245,10 +257,16 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     // has a fixed first directory (a flat pattern's files are simply truncated when rewritten).
     std::vector<std::string> patterns{impl->manifest.movie_pattern};
     try {
-      patterns.push_back(read_manifest(manifest_path).movie_pattern);
-    } catch (const Error&) {
+      // The JSON only: the old camera table does not matter here (and may be damaged).
+      std::ifstream in(manifest_path, std::ios::binary);
+      const nlohmann::json old = nlohmann::json::parse(in);
+      const std::string pattern = old.at("movie_pattern").get<std::string>();
+      validate_movie_pattern(pattern);
+      patterns.push_back(pattern);
+    } catch (const std::exception&) {
       // An unreadable old manifest: only the new pattern's tree is removed.
     }
+    old_table = referenced_camera_table(manifest_path);
     for (const auto& pattern : patterns) {
       const auto slash = pattern.find('/');
       if (slash == std::string::npos) continue;
@@ -268,11 +286,13 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     fs::remove(manifest_path, ec);
   }
   try {
+    impl->table = write_camera_table(dir, impl->manifest);
     impl->write_manifest(Status::running, 0);
   } catch (...) {
     impl->release_lock();
     throw;
   }
+  if (!old_table.empty() && old_table != impl->table.file) fs::remove(dir / old_table, ec);
   return DatabaseWriter(std::move(impl));
 }
 

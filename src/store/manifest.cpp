@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "store/atomic_file.hpp"
+#include "store/camera_table.hpp"
 
 namespace panoptes::store {
 
@@ -123,9 +126,9 @@ void validate_movie_pattern(const std::string& pattern) {
 
 void Manifest::validate() const {
   const auto fail = [](const std::string& m) { throw Error("manifest: " + m); };
-  if (schema_version != kSchemaVersion)
-    fail("schema_version " + std::to_string(schema_version) + " is not supported (this build reads version " +
-         std::to_string(kSchemaVersion) + ")");
+  if (schema_version < kOldestSchemaVersion || schema_version > kSchemaVersion)
+    fail("schema_version " + std::to_string(schema_version) + " is not supported (this build reads versions " +
+         std::to_string(kOldestSchemaVersion) + " to " + std::to_string(kSchemaVersion) + ")");
   if (image.width <= 0 || image.height <= 0)
     fail("image size " + std::to_string(image.width) + "x" + std::to_string(image.height) + " must be positive");
   if (image.padded_width != 0 || image.padded_height != 0)
@@ -145,11 +148,12 @@ void Manifest::validate() const {
   if (frames_written < 0) fail("frames_written " + std::to_string(frames_written) + " is negative");
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const auto& c = cameras[i];
-    const std::string at = "cameras[" + std::to_string(i) + "]";
-    if (c.id != int(i)) fail(at + ".id is " + std::to_string(c.id) + ", expected its index " + std::to_string(i));
+    // The message is built only on failure: this loop runs over 10^5-10^6 cameras at every checkpoint.
+    const auto at = [i] { return "cameras[" + std::to_string(i) + "]"; };
+    if (c.id != int(i)) fail(at() + ".id is " + std::to_string(c.id) + ", expected its index " + std::to_string(i));
     if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180))
-      fail(at + ".fov_y_deg " + std::to_string(c.fov_y_deg) + " is not in (0, 180)");
-    if (c.position == c.look_at) fail(at + ": position equals look_at");
+      fail(at() + ".fov_y_deg " + std::to_string(c.fov_y_deg) + " is not in (0, 180)");
+    if (c.position == c.look_at) fail(at() + ": position equals look_at");
   }
   if (!graph.neighbours.empty()) {
     if (graph.neighbours.size() != cameras.size())
@@ -258,7 +262,10 @@ struct Reader {
 
 }  // namespace
 
-json to_json(const Manifest& m) {
+namespace {
+
+// The manifest as JSON: with `table`, the cameras and the graph are replaced by a reference to it.
+json manifest_json(const Manifest& m, const CameraTableRef* table) {
   json j;
   j["schema_version"] = m.schema_version;
   j["format"] = "panoptes movie database";
@@ -289,6 +296,16 @@ json to_json(const Manifest& m) {
                 {"threads", m.video.threads},
                 {"fps", m.video.fps}};
   j["rig"] = {{"kind", m.rig.kind}, {"parameters", m.rig.parameters}};
+  const json columns = json::array({"left", "right", "up", "down", "in", "out"});
+  if (table) {
+    j["camera_table"] = {{"file", table->file},
+                         {"format", "panoptes camera table " + std::to_string(kCameraTableVersion)},
+                         {"bytes", table->bytes},
+                         {"crc32", table->crc32},
+                         {"cameras", table->cameras},
+                         {"navigation", table->navigation}};
+    j["navigation"] = {{"columns", columns}};
+  } else {
   json cams = json::array();
   for (const auto& c : m.cameras) {
     json labels = {{"patch", c.labels.patch}, {"lat_deg", c.labels.lat_deg}, {"lon_deg", c.labels.lon_deg},
@@ -305,7 +322,8 @@ json to_json(const Manifest& m) {
   // One compact row per camera keeps the graph small for 10^5 cameras.
   json rows = json::array();
   for (const auto& g : m.graph.neighbours) rows.push_back(json::array({g.left, g.right, g.up, g.down, g.in, g.out}));
-  j["navigation"] = {{"columns", json::array({"left", "right", "up", "down", "in", "out"})}, {"neighbours", std::move(rows)}};
+  j["navigation"] = {{"columns", columns}, {"neighbours", std::move(rows)}};
+  }
   json axes = json::array();
   for (const auto& a : m.axes) axes.push_back({{"name", a.name}, {"values", a.values}, {"units", a.units}});
   j["axes"] = std::move(axes);
@@ -324,7 +342,11 @@ json to_json(const Manifest& m) {
   return j;
 }
 
-Manifest manifest_from_json(const json& j, const std::string& source) {
+}  // namespace
+
+json to_json(const Manifest& m) { return manifest_json(m, nullptr); }
+
+Manifest manifest_from_json(const json& j, const std::string& source, const std::filesystem::path& dir) {
   const Reader r{source};
   if (!j.is_object()) r.fail("manifest", "expected a JSON object at the top level");
   Manifest m;
@@ -332,9 +354,9 @@ Manifest manifest_from_json(const json& j, const std::string& source) {
     const auto it = j.find("schema_version");
     if (it == j.end()) r.fail("schema_version", "missing (not a Panoptes manifest?)");
     const std::int64_t v = r.integer(*it, "schema_version");
-    if (v != kSchemaVersion)
-      throw Error(source + ": schema_version " + std::to_string(v) + " is not supported (this build reads version " +
-                  std::to_string(kSchemaVersion) + "; " +
+    if (v < kOldestSchemaVersion || v > kSchemaVersion)
+      throw Error(source + ": schema_version " + std::to_string(v) + " is not supported (this build reads versions " +
+                  std::to_string(kOldestSchemaVersion) + " to " + std::to_string(kSchemaVersion) + "; " +
                   (v > kSchemaVersion ? "written by a newer Panoptes" : "unknown version") + ")");
     m.schema_version = int(v);
   }
@@ -395,7 +417,34 @@ Manifest manifest_from_json(const json& j, const std::string& source) {
       m.rig.parameters = *p;
     }
   }
-  {
+  // Schema 2: the cameras and the graph are in the binary camera table (read after the JSON checks);
+  // inline cameras as in schema 1 are still accepted (hand-written and old manifests).
+  std::optional<CameraTableRef> table;
+  if (const json* t = r.optional(j, "camera_table", "")) {
+    if (m.schema_version < 2) r.fail("camera_table", "is not part of schema_version 1");
+    if (j.contains("cameras")) r.fail("cameras", "present although the cameras are in camera_table (one or the other)");
+    CameraTableRef ref;
+    ref.file = r.str(r.field(*t, "file", "camera_table"), "camera_table.file");
+    try {
+      validate_camera_table_name(ref.file);
+    } catch (const Error& e) {
+      r.fail("camera_table.file", e.what());
+    }
+    const std::int64_t bytes = r.integer(r.field(*t, "bytes", "camera_table"), "camera_table.bytes");
+    const std::int64_t crc = r.integer(r.field(*t, "crc32", "camera_table"), "camera_table.crc32");
+    ref.cameras = r.integer(r.field(*t, "cameras", "camera_table"), "camera_table.cameras");
+    if (bytes < 0) r.fail("camera_table.bytes", std::to_string(bytes) + " is negative");
+    if (crc < 0 || crc > INT64_C(0xFFFFFFFF)) r.fail("camera_table.crc32", std::to_string(crc) + " is not a 32-bit value");
+    if (ref.cameras < 0 || ref.cameras > INT32_MAX) r.fail("camera_table.cameras", std::to_string(ref.cameras) + " out of range");
+    ref.bytes = std::uint64_t(bytes);
+    ref.crc32 = std::uint32_t(crc);
+    if (const json* nav = r.optional(*t, "navigation", "camera_table")) {
+      if (!nav->is_boolean()) r.fail("camera_table.navigation", "expected true or false");
+      ref.navigation = nav->get<bool>();
+    }
+    if (dir.empty()) r.fail("camera_table", "refers to the file " + ref.file + ", but no database directory was given");
+    table = ref;
+  } else {
     const json& cams = r.array(r.field(j, "cameras", ""), "cameras");
     m.cameras.resize(cams.size());
     for (std::size_t i = 0; i < cams.size(); ++i) {
@@ -425,6 +474,7 @@ Manifest manifest_from_json(const json& j, const std::string& source) {
         if ((*cols)[k] != kColumns[k]) r.fail("navigation.columns", "expected [left,right,up,down,in,out]");
     }
     if (const json* rows = r.optional(*nav, "neighbours", "navigation")) {
+      if (table) r.fail("navigation.neighbours", "present although the graph is in camera_table (one or the other)");
       r.array(*rows, "navigation.neighbours");
       m.graph.neighbours.resize(rows->size());
       for (std::size_t i = 0; i < rows->size(); ++i) {
@@ -476,6 +526,13 @@ Manifest manifest_from_json(const json& j, const std::string& source) {
       }
     }
   }
+  if (table) {
+    read_camera_table(dir, *table, m);
+    if (m.graph.empty() == table->navigation)
+      throw FileError((dir / table->file).string(), std::string("camera table ") +
+                                                        (table->navigation ? "lacks" : "holds") +
+                                                        " a navigation graph, the manifest says the opposite");
+  }
   try {
     m.validate();
   } catch (const Error& e) {
@@ -484,7 +541,10 @@ Manifest manifest_from_json(const json& j, const std::string& source) {
   return m;
 }
 
-Manifest read_manifest(const std::filesystem::path& path) {
+namespace {
+
+// Reads and parses a manifest file's JSON. Throws FileError.
+json read_manifest_json(const std::filesystem::path& path) {
   const std::string name = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) {
@@ -494,40 +554,51 @@ Manifest read_manifest(const std::filesystem::path& path) {
   }
   std::ostringstream buffer;
   buffer << in.rdbuf();
-  json j;
   try {
-    j = json::parse(buffer.str());
+    return json::parse(buffer.str());
   } catch (const json::parse_error& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..."; keep the useful tail.
     std::string what = e.what();
     const auto pos = what.find("parse error");
     throw FileError(name, "malformed manifest (not valid JSON): " + (pos == std::string::npos ? what : what.substr(pos)));
   }
-  try {
-    return manifest_from_json(j, name);
-  } catch (const FileError&) {
-    throw;
-  } catch (const Error& e) {
-    // Messages already start with the file name.
-    throw FileError(name, std::string(e.what()).substr(name.size() + 2));
-  }
-}
-
-namespace {
-
-void write_all(int fd, const std::string& data, const std::string& path) {
-  std::size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throw FileError(path, std::string("cannot write: ") + std::strerror(errno));
-    }
-    done += std::size_t(n);
-  }
 }
 
 }  // namespace
+
+Manifest read_manifest(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  for (int attempt = 0;; ++attempt) {
+    const json j = read_manifest_json(path);
+    try {
+      return manifest_from_json(j, name, dir);
+    } catch (const FileError& e) {
+      // A writer that replaced the cameras renames the new manifest into place and then removes the old
+      // table: a reader between the two reads an old manifest whose table is gone. Read once more.
+      const json* t = j.is_object() && j.contains("camera_table") ? &j["camera_table"] : nullptr;
+      std::error_code ec;
+      if (attempt == 0 && t && t->is_object() && t->contains("file") && (*t)["file"].is_string() &&
+          !std::filesystem::exists(dir / (*t)["file"].get<std::string>(), ec))
+        continue;
+      throw;
+    } catch (const Error& e) {
+      // Messages already start with the file name.
+      throw FileError(name, std::string(e.what()).substr(name.size() + 2));
+    }
+  }
+}
+
+std::string referenced_camera_table(const std::filesystem::path& manifest_path) {
+  try {
+    const json j = read_manifest_json(manifest_path);
+    const std::string file = j.at("camera_table").at("file").get<std::string>();
+    validate_camera_table_name(file);
+    return file;
+  } catch (const std::exception&) {
+    return {};
+  }
+}
 
 namespace {
 
@@ -565,38 +636,28 @@ std::string manifest_text(const json& j) {
 
 }  // namespace
 
+void write_manifest_atomic(const std::filesystem::path& path, const Manifest& manifest, const CameraTableRef& table) {
+  manifest.validate();
+  if (table.cameras != manifest.camera_count() || table.navigation == manifest.graph.empty())
+    throw Error(path.string() + ": the camera table " + table.file + " holds " + std::to_string(table.cameras) +
+                " cameras" + (table.navigation ? " and a graph" : "") + ", the manifest has " +
+                std::to_string(manifest.camera_count()) + (manifest.graph.empty() ? "" : " and a graph"));
+  write_file_atomic(path, manifest_text(manifest_json(manifest, &table)), "manifest");
+}
+
 void write_manifest_atomic(const std::filesystem::path& path, const Manifest& manifest) {
   manifest.validate();
-  const std::string data = manifest_text(to_json(manifest));
-  // A unique temp name per writer: two processes writing at once must not share a temp file.
-  const std::filesystem::path tmp =
-      path.string() + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(std::random_device{}());
-  const std::string tmp_name = tmp.string();
-  const int fd = ::open(tmp_name.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw FileError(tmp_name, std::string("cannot create the manifest: ") + std::strerror(errno));
-  bool closed = false;
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  const std::string previous = referenced_camera_table(path);
+  // Table first: its name is content-addressed, so the manifest on disk stays valid until the rename.
+  const CameraTableRef table = write_camera_table(dir, manifest);
   try {
-    write_all(fd, data, tmp_name);
-    if (::fsync(fd) != 0) throw FileError(tmp_name, std::string("cannot sync: ") + std::strerror(errno));
-    closed = true;  // close() releases the descriptor even when it reports an error
-    if (::close(fd) != 0) throw FileError(tmp_name, std::string("cannot close: ") + std::strerror(errno));
+    write_manifest_atomic(path, manifest, table);
   } catch (...) {
-    if (!closed) ::close(fd);
-    ::unlink(tmp_name.c_str());
+    if (table.file != previous) ::unlink((dir / table.file).c_str());  // nothing refers to it
     throw;
   }
-  if (::rename(tmp_name.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp_name.c_str());
-    throw FileError(path.string(), std::string("cannot replace the manifest: ") + std::strerror(err));
-  }
-  // Make the rename itself durable (best effort: some file systems refuse fsync on directories).
-  const std::string dir = path.has_parent_path() ? path.parent_path().string() : ".";
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  if (!previous.empty() && previous != table.file) ::unlink((dir / previous).c_str());
 }
 
 }  // namespace panoptes::store

@@ -1,6 +1,8 @@
 #pragma once
 // The manifest of a movie database (`panoptes.json`): plain data + versioned JSON (de)serialization.
 // Its size grows with cameras + tasks, never cameras × tasks: streams are found by a file-name pattern.
+// Since schema 2 the per-camera table (cameras and navigation graph) is written to a binary sidecar
+// file (store/camera_table.hpp) that panoptes.json references with its size and checksum.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -16,8 +18,11 @@
 
 namespace panoptes::store {
 
-/// Schema version this build writes; reading any other version is refused with a clear error.
-inline constexpr int kSchemaVersion = 1;
+/// Schema version this build writes. It reads kOldestSchemaVersion .. kSchemaVersion and refuses any
+/// other version with a clear error.
+inline constexpr int kSchemaVersion = 2;
+/// Oldest schema version this build still reads (1: cameras and graph inline in the JSON).
+inline constexpr int kOldestSchemaVersion = 1;
 /// File name of the manifest inside the database directory.
 inline constexpr const char* kManifestFileName = "panoptes.json";
 /// Default movie file-name pattern, relative to the database directory.
@@ -119,6 +124,17 @@ struct TaskEntry {
   bool operator==(const TaskEntry&) const = default;
 };
 
+/// The camera table sidecar a manifest refers to (schema 2, field `camera_table`): a file in the
+/// database directory holding every camera and the navigation graph (see store/camera_table.hpp).
+struct CameraTableRef {
+  std::string file;          ///< plain file name in the database directory, e.g. "cameras.1a2b3c4d.bin"
+  std::uint64_t bytes = 0;   ///< its size
+  std::uint32_t crc32 = 0;   ///< CRC-32 of its bytes 16..end (recorded in its header too)
+  std::int64_t cameras = 0;  ///< cameras it holds
+  bool navigation = false;   ///< it holds a navigation graph
+  bool operator==(const CameraTableRef&) const = default;
+};
+
 /// Lifecycle of a database. `running` on disk with no live writer is reported as interrupted by
 /// Database::open (see database.hpp).
 enum class Status { running, complete, interrupted };
@@ -163,7 +179,7 @@ struct Manifest {
   /// is moved by `delta`; -1 if there is none (end of the axis, or task not on that axis).
   int step_task_on_axis(int task, std::string_view axis, int delta) const;
 
-  /// Checks internal consistency (ids, graph size and targets, axis references, pattern safety, image
+  /// Checks internal consistency (schema_version must be one this build reads) (ids, graph size and targets, axis references, pattern safety, image
   /// size, video settings, frames_written). Throws Error naming the first bad field and its value.
   void validate() const;
   // No operator==: compare to_json() results (VideoSettings has no comparison).
@@ -173,16 +189,32 @@ struct Manifest {
 /// contains {camera} and {task}, no other {...} placeholders. Throws Error with the reason.
 void validate_movie_pattern(const std::string& pattern);
 
-/// Serializes to JSON (schema_version included).
+/// Serializes to one self-contained JSON document (current schema_version) with the cameras and the
+/// navigation graph inline (`cameras`, `navigation.neighbours`), as schema 1 stored them. Files on disk
+/// are written by write_manifest_atomic, which puts those two into the camera table instead.
 nlohmann::json to_json(const Manifest& manifest);
-/// Parses and validates. `source` names the origin (file path) in error messages. Throws Error on an
-/// unknown schema version, a missing or mistyped field, or a failed validate().
-Manifest manifest_from_json(const nlohmann::json& json, const std::string& source);
+/// Parses and validates. `source` names the origin (file path) in error messages. Cameras and graph
+/// are either inline or in the camera table `dir / camera_table.file` (then `dir` must be given).
+/// Throws Error on an unknown schema version, a missing or mistyped field, or a failed validate();
+/// FileError for a missing, corrupt or mismatched camera table.
+Manifest manifest_from_json(const nlohmann::json& json, const std::string& source,
+                            const std::filesystem::path& dir = {});
 
-/// Reads `path` (a panoptes.json file). Throws FileError if missing/unreadable/not JSON/invalid.
+/// Reads `path` (a panoptes.json file) and the camera table it refers to. Throws FileError if either is
+/// missing/unreadable/malformed/invalid.
 Manifest read_manifest(const std::filesystem::path& path);
-/// Writes atomically: temp file in the same directory, fsync, rename over `path`, fsync the directory.
-/// On failure (e.g. disk full) the previous file at `path` is left untouched and FileError is thrown.
+/// Writes the camera table (write_camera_table) and then the manifest referring to it, each atomically
+/// (temp file in the same directory, fsync, rename, fsync of the directory); then removes the table the
+/// previous manifest referred to if it differs. On failure (e.g. disk full) the previous manifest and
+/// its table are left untouched and FileError is thrown.
 void write_manifest_atomic(const std::filesystem::path& path, const Manifest& manifest);
+/// Writes only panoptes.json (atomically), referring to an already written camera table `table`,
+/// which must hold manifest.cameras and manifest.graph (checkpoints: the cameras never change during
+/// a run, so the table is written once). Throws Error if table's camera count differs.
+void write_manifest_atomic(const std::filesystem::path& path, const Manifest& manifest, const CameraTableRef& table);
+
+/// The camera table file an existing manifest refers to (parsing the JSON only); empty if it has none
+/// or cannot be read.
+std::string referenced_camera_table(const std::filesystem::path& manifest_path);
 
 }  // namespace panoptes::store

@@ -72,10 +72,10 @@ TEST(Manifest, SchemaRoundTripKeepsEveryField) {
   write_manifest_atomic(dir / "panoptes.json", m);
   const Manifest from_file = read_manifest(dir / "panoptes.json");
   EXPECT_EQ(to_json(from_file), j);
-  // No temp file is left behind.
+  // No temp file is left behind: the manifest and its camera table only.
   int files = 0;
   for (auto& e : std::filesystem::directory_iterator(dir.path)) files += bool(e.is_regular_file());
-  EXPECT_EQ(files, 1);
+  EXPECT_EQ(files, 2);
 }
 
 TEST(Manifest, EmptyGraphAndMinimalFieldsAreValid) {
@@ -136,9 +136,11 @@ TEST(Manifest, StepsOnOneAxisOfATwoAxisGrid) {
 
 TEST(Manifest, UnknownSchemaVersionIsRefused) {
   json j = to_json(sample_manifest(2, 2));
-  j["schema_version"] = 2;
+  j["schema_version"] = 3;
   expect_error([&] { manifest_from_json(j, "db/panoptes.json"); },
-               {"db/panoptes.json", "schema_version 2 is not supported", "reads version 1", "newer"});
+               {"db/panoptes.json", "schema_version 3 is not supported", "reads versions 1 to 2", "newer"});
+  j["schema_version"] = 0;
+  expect_error([&] { manifest_from_json(j, "x"); }, {"schema_version 0 is not supported", "unknown version"});
   j["schema_version"] = "1";
   expect_error([&] { manifest_from_json(j, "x"); }, {"schema_version", "expected an integer"});
   j.erase("schema_version");
@@ -235,7 +237,7 @@ TEST(Manifest, PatternsEscapingTheDirectoryAreRefused) {
 TEST(Manifest, AtomicWriteFailureLeavesNoTempFile) {
   TempDir dir;
   expect_error([&] { write_manifest_atomic(dir / "no-such-dir" / "panoptes.json", sample_manifest(1, 1)); },
-               {"no-such-dir", "cannot create the manifest"});
+               {"no-such-dir", "cannot create the camera table"});
   Manifest bad = sample_manifest(1, 1);
   bad.image.width = -3;
   write_manifest_atomic(dir / "panoptes.json", sample_manifest(1, 1));
