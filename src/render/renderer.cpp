@@ -406,10 +406,19 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     }
     std::int64_t kk = kb;
     alignas(32) float vb[8][kBlock];  // per march slot: the block's interpolated values
+    alignas(32) int bins[kMaxTasksPerMarch][2][kBlock];
     bool done = false;
     for (std::int64_t k0 = kb; k0 <= kend && !done; k0 += kBlock) {
       const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
       for (int s = 0; s < nslots; ++s) interp_block(fa[s], P, k0, n, safe, vb[s]);
+      // LUT bins of the block per volume task, vectorized (the same bins lut_bin() gives).
+      for (std::uint64_t m = mask & live; m; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        const TaskRt& T = S.rt[std::size_t(i)];
+        if (T.kind != RtKind::volume1 && T.kind != RtKind::volume2) continue;
+        lut_bin_block(vb[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bins[i][0]);
+        if (T.kind == RtKind::volume2) lut_bin_block(vb[T.s2], T.lo2, T.sc2, T.last2, T.abs2, bins[i][1]);
+      }
       for (int l = 0; l < n; ++l) {
         kk = k0 + l;
         float v[8];
@@ -422,7 +431,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
           float* a = acc[i];
           switch (T.kind) {
             case RtKind::volume1: {
-              const LutEntry& e = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
+              const LutEntry& e = T.lut1[bins[i][0][l]];
               float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
               if (kk == k_partial) [[unlikely]] {
                 const float a2 = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
@@ -438,8 +447,8 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
               break;
             }
             case RtKind::volume2: {
-              const LutEntry& e1 = T.lut1[lut_bin(v[T.s1], T.lo1, T.sc1, T.last1, T.abs1)];
-              const LutEntry& e2 = T.lut2[lut_bin(v[T.s2], T.lo2, T.sc2, T.last2, T.abs2)];
+              const LutEntry& e1 = T.lut1[bins[i][0][l]];
+              const LutEntry& e2 = T.lut2[bins[i][1][l]];
               const float tau = e1.tau + e2.tau;
               if (tau <= 0) break;
               float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
