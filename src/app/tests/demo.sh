@@ -10,10 +10,20 @@ export OMP_NUM_THREADS=1
 "$bin" demo --help | grep -q "130 Yin-Yang" || { echo "FAIL: help"; exit 1; }
 "$bin" demo --print-config > demo.toml
 grep -q 'spec = "yinyang"' demo.toml || { echo "FAIL: demo config is not the Yin-Yang rig"; exit 1; }
-sed -e 's/^steps = 360 .*/steps = 30/' -e 's/^every_steps = 15 .*/every_steps = 15/' \
+# examples/demo.toml is documented as the same text as the embedded configuration.
+example=$(dirname "$0")/../../../examples/demo.toml
+if [ -f "$example" ]; then
+  diff -u "$example" demo.toml || { echo "FAIL: examples/demo.toml differs from panoptes demo --print-config"; exit 1; }
+fi
+sed -e 's/^steps = 480 .*/steps = 30/' -e 's/^every_steps = 20 .*/every_steps = 15/' \
     -e 's/^spec = "yinyang" .*/spec = "yinyang:2x3"/' -e 's/^width = 256/width = 48/' -e 's/^height = 224/height = 40/' \
-    -e 's/^nx = 48/nx = 24/' -e 's/^ny = 96/ny = 48/' -e 's/^nz = 32/nz = 16/' -e 's/^h = 533.3333/h = 1066.6667/' \
-    -e 's/^pml_cells = 8/pml_cells = 4/' demo.toml > short.toml
+    -e 's/^nx = 64/nx = 24/' -e 's/^ny = 128/ny = 48/' -e 's/^nz = 40/nz = 16/' -e 's/^h = 400.0/h = 1066.6667/' \
+    -e 's/^pml_cells = 10/pml_cells = 4/' demo.toml > short.toml
+# Every substitution must have applied (the demo configuration changed otherwise).
+for line in 'steps = 30' 'every_steps = 15' 'spec = "yinyang:2x3"' 'width = 48' 'height = 40' 'nx = 24' 'ny = 48' \
+            'nz = 16' 'h = 1066.6667' 'pml_cells = 4'; do
+  grep -q "^$line" short.toml || { echo "FAIL: the shortened demo config lacks '$line'"; exit 1; }
+done
 "$bin" run short.toml --out short_db -q > run.log 2>&1 || { cat run.log; echo "FAIL: shortened demo"; exit 1; }
 out=$("$bin" info --json short_db)
 echo "$out" | grep -Eq '"status": *"complete"' || { echo "FAIL: not complete: $out"; exit 1; }
