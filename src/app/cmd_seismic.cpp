@@ -5,11 +5,14 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "app/command.hpp"
 #include "app/mpi_scope.hpp"
 #include "core/error.hpp"
 #include "seismic/config_toml.hpp"
+#include "seismic/medium.hpp"
 #include "seismic/solver.hpp"
 
 #ifdef PANOPTES_HAVE_MPI
@@ -20,6 +23,39 @@
 namespace {
 
 using MpiScope = panoptes::app::MpiScope;
+
+/// Throws on every rank the error that rank 0 met (empty: none), so no rank is left in a collective.
+void agree_with_root(std::string err, int rank) {
+#ifdef PANOPTES_HAVE_MPI
+  int len = int(err.size());
+  MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  err.resize(std::size_t(len));
+  MPI_Bcast(err.data(), len, MPI_CHAR, 0, MPI_COMM_WORLD);
+#endif
+  (void)rank;
+  if (!err.empty()) throw panoptes::Error(err);
+}
+
+/// Writes the configured snapshot fields after `step` steps (collective; rank 0 writes).
+double write_snapshots(panoptes::seismic::Solver& solver, const panoptes::seismic::RunConfig& rc, int step) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto& g = rc.solver.grid;
+  for (const auto& name : rc.snapshot_fields) {
+    const std::vector<float> data = solver.gather_field(name);
+    std::string err;
+    if (solver.rank() == 0) {
+      char file[64];
+      std::snprintf(file, sizeof file, "%s_%06d.npy", name.c_str(), step);
+      try {
+        panoptes::seismic::write_npy(rc.output_dir + "/snapshots/" + file, data, g.nx, g.ny, g.nz);
+      } catch (const std::exception& e) {
+        err = e.what();
+      }
+    }
+    agree_with_root(err, solver.rank());
+  }
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 void run(const std::string& config_path, const std::string& output_override, bool quiet) {
   using namespace panoptes::seismic;
@@ -35,12 +71,29 @@ void run(const std::string& config_path, const std::string& output_override, boo
     std::printf("seismic: grid %dx%dx%d, h = %g m, dt = %.6g s, %d steps (%.4g s), %d rank(s) x %d thread(s), %s\n",
                 g.nx, g.ny, g.nz, g.h, solver.dt(), rc.solver.steps, rc.solver.steps * solver.dt(), solver.ranks(),
                 omp_get_max_threads(), solver.viscoelastic() ? "viscoelastic" : "elastic");
+  const bool snapshots = !rc.snapshot_fields.empty();
+  if (snapshots) {
+    std::string err;
+    if (root) {
+      std::error_code ec;
+      std::filesystem::create_directories(rc.output_dir + "/snapshots", ec);
+      if (ec) err = panoptes::FileError(rc.output_dir + "/snapshots", "cannot create directory: " + ec.message()).what();
+    }
+    agree_with_root(err, solver.rank());
+  }
   const auto t1 = std::chrono::steady_clock::now();
   const int report_every = std::max(1, rc.solver.steps / 10);
+  double snapshot_seconds = 0;
+  int snapshot_count = 0;
   for (int s = 0; s < rc.solver.steps; ++s) {
     solver.step();
-    if (root && !quiet && (s + 1) % report_every == 0) {
-      std::printf("  step %d / %d\n", s + 1, rc.solver.steps);
+    const int done = s + 1;
+    if (snapshots && (rc.snapshot_every > 0 ? done % rc.snapshot_every == 0 : done == rc.solver.steps)) {
+      snapshot_seconds += write_snapshots(solver, rc, done);
+      ++snapshot_count;
+    }
+    if (root && !quiet && done % report_every == 0) {
+      std::printf("  step %d / %d\n", done, rc.solver.steps);
       std::fflush(stdout);
     }
   }
@@ -52,7 +105,7 @@ void run(const std::string& config_path, const std::string& output_override, boo
 #endif
   if (!root) return;
   const double setup = std::chrono::duration<double>(t1 - t0).count();
-  const double wall = std::chrono::duration<double>(t2 - t1).count();
+  const double wall = std::chrono::duration<double>(t2 - t1).count() - snapshot_seconds;
   const double rate = wall > 0 ? cells * rc.solver.steps / wall : 0;
   std::ostringstream r;
   r << "config: " << config_path << "\n"
@@ -68,6 +121,12 @@ void run(const std::string& config_path, const std::string& output_override, boo
     << " M per core)\n"
     << "memory (all ranks): " << mem / (1 << 20) << " MiB (" << mem / cells << " bytes per cell)\n"
     << "receivers: " << rc.solver.receivers.size() << " -> " << rc.output_dir << "/<name>.csv\n";
+  if (snapshots) {
+    r << "snapshots: " << snapshot_count << " x {";
+    for (std::size_t i = 0; i < rc.snapshot_fields.size(); ++i) r << (i ? ", " : "") << rc.snapshot_fields[i];
+    r << "} -> " << rc.output_dir << "/snapshots/<field>_<step>.npy (" << snapshot_seconds
+      << " s, not in the wall time above)\n";
+  }
   const std::string report = rc.output_dir + "/report.txt";
   std::filesystem::create_directories(rc.output_dir);
   std::ofstream out(report);
@@ -79,7 +138,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto* sub = root.add_subcommand(
       "seismic",
       "Run the 3-D viscoelastic finite-difference seismic wave solver alone (works under mpirun -np N): "
-      "writes one CSV seismogram (time,vx,vy,vz) per receiver and report.txt");
+      "writes one CSV seismogram (time,vx,vy,vz) per receiver, report.txt and optional field snapshots (.npy)");
   auto config = std::make_shared<std::string>();
   auto output = std::make_shared<std::string>();
   auto quiet = std::make_shared<bool>(false);

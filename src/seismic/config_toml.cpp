@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "seismic/solver.hpp"
 
 namespace panoptes::seismic {
 
@@ -295,8 +297,27 @@ RunConfig parse_run_config(const std::string& text, const std::string& source_na
     }
   }
   if (const auto* o = table(c, root, "output", "")) {
-    only_keys(c, *o, "output", {"directory"});
+    only_keys(c, *o, "output", {"directory", "snapshot_fields", "snapshot_every"});
     rc.output_dir = str(c, *o, "directory", "output.", rc.output_dir);
+    if (const auto* n = o->get("snapshot_fields")) {
+      const auto* arr = n->as_array();
+      if (!arr) c.fail("output.snapshot_fields", "expected an array of field names");
+      const auto& known = Solver::field_names();
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      for (std::size_t i = 0; i < arr->size(); ++i) {
+        const auto v = arr->get(i)->value_exact<std::string>();
+        const std::string w = "output.snapshot_fields[" + std::to_string(i) + "]";
+        if (!v) c.fail(w, "expected a string (one of " + list + ")");
+        if (std::find(known.begin(), known.end(), *v) == known.end())
+          c.fail(w, "unknown field '" + *v + "' (expected one of " + list + ")");
+        if (std::find(rc.snapshot_fields.begin(), rc.snapshot_fields.end(), *v) == rc.snapshot_fields.end())
+          rc.snapshot_fields.push_back(*v);
+      }
+    }
+    const long long every = integer(c, *o, "snapshot_every", "output.", 0);
+    if (every < 0 || every > 1000000000) c.fail("output.snapshot_every", std::to_string(every) + " (expected >= 0 steps)");
+    rc.snapshot_every = int(every);
   }
   try {
     s.validate();
@@ -347,7 +368,13 @@ Unknown keys and wrong types are errors.
                 time s, delay default 0; S rises from 0 to 1, so M0 is the final moment)
 [[receiver]]    name, position = [x, y, z]  -> <output>/<name>.csv (time,vx,vy,vz in m/s)
 [[receiver_line]] name, start = [x,y,z], end = [x,y,z], count -> receivers <name>_000 ...
-[output]        directory (default "seismic_out"; --output overrides)
+[output]        directory (default "seismic_out"; --output overrides);
+                snapshot_fields = ["vz", "phi_p", ...] (default none): fields written as .npy
+                float32 of the GLOBAL grid, shape (nz, ny, nx), x fastest, to
+                <output>/snapshots/<field>_<step>.npy (step = steps done, 6 digits). Fields: vx, vy,
+                vz (m/s), sxx, syy, szz, sxy, sxz, syz (Pa), phi_p = div v, phi_s = |curl v| (1/s);
+                each field at its own staggered points, indexed like the nodes (see docs/seismic.md)
+                snapshot_every (steps, default 0 = only after the last step)
 )";
 }
 

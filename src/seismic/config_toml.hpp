@@ -2,6 +2,7 @@
 // `panoptes seismic` configuration files (TOML). Every key is documented by config_keys_help();
 // unknown keys, wrong types and out-of-range values are errors naming the file and the key.
 #include <string>
+#include <vector>
 
 #include "seismic/config.hpp"
 
@@ -11,6 +12,8 @@ namespace panoptes::seismic {
 struct RunConfig {
   SolverConfig solver;
   std::string output_dir = "seismic_out";  ///< [output] directory (relative to the working directory)
+  std::vector<std::string> snapshot_fields;  ///< [output] snapshot_fields (Solver::field_names())
+  int snapshot_every = 0;                    ///< [output] snapshot_every in steps (0: only after the last step)
 };
 
 /// Parses a TOML configuration file. Relative medium-file paths are relative to the file's folder.

@@ -1252,6 +1252,54 @@ void Solver::compute_derived() {
     }
 }
 
+const std::vector<std::string>& Solver::field_names() {
+  static const std::vector<std::string> names = {"vx",  "vy",  "vz",  "sxx",   "syy",  "szz",
+                                                 "sxy", "sxz", "syz", "phi_p", "phi_s"};
+  return names;
+}
+
+std::vector<float> Solver::gather_field(const std::string& name) {
+  Impl& s = *impl_;
+  const Vec* f = name == "vx" ? &s.vx : name == "vy" ? &s.vy : name == "vz" ? &s.vz : name == "sxx" ? &s.sxx
+               : name == "syy" ? &s.syy : name == "szz" ? &s.szz : name == "sxy" ? &s.sxy : name == "sxz" ? &s.sxz
+               : name == "syz" ? &s.syz : nullptr;
+  if (name == "phi_p" || name == "phi_s") {
+    compute_derived();
+    f = name == "phi_p" ? &s.phip : &s.phis;
+  }
+  if (!f) {
+    std::string list;
+    for (const auto& n : field_names()) list += (list.empty() ? "" : ", ") + n;
+    throw Error("unknown field '" + name + "' (expected one of " + list + ")");
+  }
+  // This rank's planes without ghosts, packed.
+  const std::size_t plane = std::size_t(s.nx) * s.ny;
+  if (plane * std::size_t(s.nz) > std::size_t(std::numeric_limits<int>::max()))
+    throw Error("field '" + name + "' has more than 2^31 values: too large to gather on one rank");
+  std::vector<float> local(plane * s.nzl);
+  for (int k = 0; k < s.nzl; ++k)
+    for (int j = 0; j < s.ny; ++j) {
+      const float* src = f->data() + s.idx(0, j, k);
+      std::copy(src, src + s.nx, local.begin() + std::ptrdiff_t((std::size_t(k) * s.ny + j) * s.nx));
+    }
+#ifdef PANOPTES_HAVE_MPI
+  if (s.comm != MPI_COMM_NULL && s.size > 1) {
+    // Slabs are contiguous in k and in rank order: a plain Gatherv assembles the global array.
+    std::vector<int> counts(s.size), displs(s.size);
+    for (int r = 0; r < s.size; ++r) {
+      const int b = int((long long)s.nz * r / s.size), e = int((long long)s.nz * (r + 1) / s.size);
+      counts[r] = int(plane * (e - b));
+      displs[r] = int(plane * b);
+    }
+    std::vector<float> global(s.rank == 0 ? plane * s.nz : 0);
+    MPI_Gatherv(local.data(), int(local.size()), MPI_FLOAT, global.data(), counts.data(), displs.data(), MPI_FLOAT, 0,
+                s.comm);
+    return global;
+  }
+#endif
+  return local;
+}
+
 double Solver::energy() const {
   const Impl& s = *impl_;
   const int n = s.npml;

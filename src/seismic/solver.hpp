@@ -89,6 +89,15 @@ class Solver {
   FieldView phi_p() const;  ///< valid after compute_derived()
   FieldView phi_s() const;  ///< valid after compute_derived()
 
+  /// Names of the fields gather_field() knows: vx, vy, vz, sxx, syy, szz, sxy, sxz, syz, phi_p, phi_s.
+  static const std::vector<std::string>& field_names();
+  /// One field on the whole global grid, nz × ny × nx floats with x fastest (index
+  /// i + nx·(j + ny·k)), complete on rank 0 and empty on the other ranks (collective). Each field
+  /// is sampled at its own staggered points (element (i, j, k) of vx is at ((i + ½)h, jh, kh)).
+  /// phi_p / phi_s are computed from the current velocities (compute_derived()). Throws
+  /// panoptes::Error for an unknown name (on every rank).
+  std::vector<float> gather_field(const std::string& name);
+
   /// Total mechanical energy (kinetic + strain) [J] inside the non-absorbing region (collective).
   double energy() const;
   /// Seismograms of all receivers, complete on rank 0 (collective; other ranks get an empty list).
