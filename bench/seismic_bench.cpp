@@ -1,10 +1,7 @@
 // Seismic solver throughput: million cell-updates per second (one cell update = one time step of
-// one cell for all its fields, CPML and memory variables included) on a slab of the paper's grid.
-// The paper's 256×512×160 grid needs 1.4 GB (elastic) to 3.9 GB (viscoelastic) in one process; on
-// the shared build machine we time a 256×512×32 slab of it, which exercises the same kernels
-// (x/y CPML faces, bottom CPML, free surface) with the same row length and plane size.
-// Two MPI ranks are not benchmarked here (a Google Benchmark program is one process); run
-// `mpirun -np 2 panoptes seismic examples/seismic/paper_reduced.toml`, whose report gives the rate.
+// one cell for all its fields, CPML and memory variables included) on a 256×512×32 slab of the
+// paper's 256×512×160 grid, one process, 1 or 2 OpenMP threads. The full grid under MPI (1 and 2
+// ranks) is bench/seismic_mpi_bench.cpp.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
