@@ -66,6 +66,7 @@ struct PmlAxis {
   std::vector<int> slot;            // per local index: slot in ψ arrays, −1 outside the layers
   std::vector<int> indices;         // local indices with a slot, ascending
   std::vector<float> a_full, b_full, a_half, b_half;
+  std::vector<std::array<int, 3>> runs;  // contiguous runs of indices: {first, end, first slot}
   int count() const { return int(indices.size()); }
 };
 
@@ -218,27 +219,49 @@ struct Solver::Impl {
   void stress_row_at(int k, int j, double t);
   // Memory variables see the stretched derivative inside the CPML too: when ψ is added to a strain
   // rate, their update (linear in the rate) and the stress they relax get the matching increments.
+  // For cells [i0, i1) of the row at base b: psi_n is the normal-strain correction along `axis`,
+  // psi1 / psi2 those of the shear stresses s1 / s2 (memory variables r1 / r2, coefficients c1 / c2
+  // of mechanism 0), all indexed from i0.
   template <class M>
-  void visco_normal(const M& m, long i, std::size_t n, float psi, int axis) {
-    Vec* norm[3] = {&sxx, &syy, &szz};
-    std::vector<Vec>* mem[3] = {&rxx, &ryy, &rzz};
+  void visco_pml(const M& m, std::size_t b, int i0, int i1, const float* psi_n, int axis, const float* psi1, Vec& s1,
+                 std::vector<Vec>& r1, int c1, const float* psi2, Vec& s2, std::vector<Vec>& r2, int c2) {
     for (int l = 0; l < L; ++l) {
-      const float base = relax_b[l] * m(CL(l), i) * psi;
-      for (int c = 0; c < 3; ++c) {
-        const float d = base + (c == axis ? relax_b[l] * m(CM(l), i) * psi : 0.0f);
-        (*mem[c])[l][n] += d;
-        (*norm[c])[n] -= 0.5f * d;
+      const float B = relax_b[l];
+      float* __restrict n0 = sxx.data() + b;
+      float* __restrict n1 = syy.data() + b;
+      float* __restrict n2 = szz.data() + b;
+      float* __restrict q0 = rxx[l].data() + b;
+      float* __restrict q1 = ryy[l].data() + b;
+      float* __restrict q2 = rzz[l].data() + b;
+      float* __restrict S1 = s1.data() + b;
+      float* __restrict R1 = r1[l].data() + b;
+      float* __restrict S2 = s2.data() + b;
+      float* __restrict R2 = r2[l].data() + b;
+      const int fl = CL(l), fm = CM(l), f1 = c1 + 5 * l, f2 = c2 + 5 * l;
+#pragma omp simd
+      for (int i = i0; i < i1; ++i) {
+        const float a = psi_n[i - i0];
+        const float base = B * m(fl, i) * a;
+        const float da = B * m(fm, i) * a;
+        const float d0 = base + (axis == 0 ? da : 0.0f);
+        const float d1 = base + (axis == 1 ? da : 0.0f);
+        const float d2 = base + (axis == 2 ? da : 0.0f);
+        q0[i] += d0;
+        n0[i] -= 0.5f * d0;
+        q1[i] += d1;
+        n1[i] -= 0.5f * d1;
+        q2[i] += d2;
+        n2[i] -= 0.5f * d2;
+        const float e1 = B * m(f1, i) * psi1[i - i0];
+        R1[i] += e1;
+        S1[i] -= 0.5f * e1;
+        const float e2 = B * m(f2, i) * psi2[i - i0];
+        R2[i] += e2;
+        S2[i] -= 0.5f * e2;
       }
     }
   }
-  template <class M>
-  void visco_shear(const M& m, long i, std::size_t n, float psi, Vec& stress, std::vector<Vec>& mem, int coef0) {
-    for (int l = 0; l < L; ++l) {
-      const float d = relax_b[l] * m(coef0 + 5 * l, i) * psi;
-      mem[l][n] += d;
-      stress[n] -= 0.5f * d;
-    }
-  }
+
   void free_surface_images();
   void record();
 
@@ -538,6 +561,10 @@ void Solver::Impl::setup_pml() {
     }
   };
   build(pmlx, nx, 0, nx, true, true);
+  // The x layers are two runs of consecutive cells per row: their corrections are simd loops.
+  for (int s = 0; s < pmlx.count(); ++s)
+    if (s == 0 || pmlx.indices[s] != pmlx.indices[s - 1] + 1) pmlx.runs.push_back({pmlx.indices[s], pmlx.indices[s] + 1, s});
+    else pmlx.runs.back()[1] = pmlx.indices[s] + 1;
   build(pmly, ny, 0, ny, true, true);
   build(pmlz, nz, kb, nzl, !free_surface, true);
   for (auto& v : psix) v.assign(std::size_t(pmlx.count()) * ny * nzl, 0.0f);
@@ -697,21 +724,25 @@ void Solver::Impl::velocity_row(int k, int j, const M& mat0) {
   }
   // CPML: ψ ← b·ψ + a·∂f and f += coefficient·ψ after the plain update (κ = 1), layers only.
   const int cx = pmlx.count();
-  for (int s = 0; s < cx; ++s) {
-    const int i = pmlx.indices[s];
-    const std::size_t p = (std::size_t(k) * ny + j) * cx + s;
-    const float* f = xx + i;
-    float& a = psix[0][p];
-    a = pmlx.b_half[i] * a + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
-    ux[i] += m(BX, i) * a;
-    f = xy + i;
-    float& bb = psix[1][p];
-    bb = pmlx.b_full[i] * bb + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
-    uy[i] += m(BY, i) * bb;
-    f = xz + i;
-    float& c = psix[2][p];
-    c = pmlx.b_full[i] * c + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
-    uz[i] += m(BZ, i) * c;
+  for (const auto& [i0, i1, s0] : pmlx.runs) {
+    const std::size_t p = (std::size_t(k) * ny + j) * cx + s0;
+    float* __restrict q0 = psix[0].data() + p;
+    float* __restrict q1 = psix[1].data() + p;
+    float* __restrict q2 = psix[2].data() + p;
+    const float* __restrict bh = pmlx.b_half.data();
+    const float* __restrict ah = pmlx.a_half.data();
+    const float* __restrict bf = pmlx.b_full.data();
+    const float* __restrict af = pmlx.a_full.data();
+#pragma omp simd
+    for (int i = i0; i < i1; ++i) {
+      const int q = i - i0;
+      q0[q] = bh[i] * q0[q] + ah[i] * (C1 * (xx[i + 1] - xx[i]) + C2 * (xx[i + 2] - xx[i - 1]));
+      ux[i] += m(BX, i) * q0[q];
+      q1[q] = bf[i] * q1[q] + af[i] * (C1 * (xy[i] - xy[i - 1]) + C2 * (xy[i + 1] - xy[i - 2]));
+      uy[i] += m(BY, i) * q1[q];
+      q2[q] = bf[i] * q2[q] + af[i] * (C1 * (xz[i] - xz[i - 1]) + C2 * (xz[i + 1] - xz[i - 2]));
+      uz[i] += m(BZ, i) * q2[q];
+    }
   }
   if (const int s = pmly.count() > 0 ? pmly.slot[j] : -1; s >= 0) {
     const float bf = pmly.b_full[j], af = pmly.a_full[j], bh = pmly.b_half[j], ah = pmly.a_half[j];
@@ -794,7 +825,7 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
   const M m = mat0.row(b);
   const long Y = sy, Z = sz;
   {
-  // Restrict-qualified only here: the CPML part below also writes σ through visco_normal/shear.
+  // Restrict-qualified only here: the CPML part below also writes σ through visco_pml (own restrict scopes).
   const float* __restrict ux = vx.data() + b;
   const float* __restrict uy = vy.data() + b;
   const float* __restrict uz = vz.data() + b;
@@ -876,36 +907,51 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
   float* xz = sxz.data() + b;
   float* yz = syz.data() + b;
   const int cx = pmlx.count();
-  for (int s = 0; s < cx; ++s) {
-    const int i = pmlx.indices[s];
-    const std::size_t n = b + i, p = (std::size_t(k) * ny + j) * cx + s;
-    const float* f = ux + i;
-    float& a = psix[3][p];
-    a = pmlx.b_full[i] * a + pmlx.a_full[i] * (C1 * (f[0] - f[-1]) + C2 * (f[1] - f[-2]));
-    xx[i] += (m(LAM, i) + m(TWOMU, i)) * a;
-    yy[i] += m(LAM, i) * a;
-    zz[i] += m(LAM, i) * a;
-    f = uy + i;
-    float& bb = psix[4][p];
-    bb = pmlx.b_half[i] * bb + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
-    xy[i] += m(MUXY, i) * bb;
-    f = uz + i;
-    float& c = psix[5][p];
-    c = pmlx.b_half[i] * c + pmlx.a_half[i] * (C1 * (f[1] - f[0]) + C2 * (f[2] - f[-1]));
-    xz[i] += m(MUXZ, i) * c;
-    if (L > 0) {
-      visco_normal(m, i, n, a, 0);
-      visco_shear(m, i, n, bb, sxy, rxy, CMXY(0));
-      visco_shear(m, i, n, c, sxz, rxz, CMXZ(0));
+  {  // restrict-qualified so that it vectorizes; memory variables below
+    float* __restrict X = xx;
+    float* __restrict YY = yy;
+    float* __restrict ZZ = zz;
+    float* __restrict XY = xy;
+    float* __restrict XZ = xz;
+    const float* __restrict U = ux;
+    const float* __restrict V = uy;
+    const float* __restrict W = uz;
+    const float* __restrict bh = pmlx.b_half.data();
+    const float* __restrict ah = pmlx.a_half.data();
+    const float* __restrict bf = pmlx.b_full.data();
+    const float* __restrict af = pmlx.a_full.data();
+    for (const auto& [i0, i1, s0] : pmlx.runs) {
+      const std::size_t p = (std::size_t(k) * ny + j) * cx + s0;
+      float* __restrict q0 = psix[3].data() + p;
+      float* __restrict q1 = psix[4].data() + p;
+      float* __restrict q2 = psix[5].data() + p;
+#pragma omp simd
+      for (int i = i0; i < i1; ++i) {
+        const int q = i - i0;
+        q0[q] = bf[i] * q0[q] + af[i] * (C1 * (U[i] - U[i - 1]) + C2 * (U[i + 1] - U[i - 2]));
+        X[i] += (m(LAM, i) + m(TWOMU, i)) * q0[q];
+        YY[i] += m(LAM, i) * q0[q];
+        ZZ[i] += m(LAM, i) * q0[q];
+        q1[q] = bh[i] * q1[q] + ah[i] * (C1 * (V[i + 1] - V[i]) + C2 * (V[i + 2] - V[i - 1]));
+        XY[i] += m(MUXY, i) * q1[q];
+        q2[q] = bh[i] * q2[q] + ah[i] * (C1 * (W[i + 1] - W[i]) + C2 * (W[i + 2] - W[i - 1]));
+        XZ[i] += m(MUXZ, i) * q2[q];
+      }
     }
   }
+  if (L > 0)
+    for (const auto& [i0, i1, s0] : pmlx.runs) {
+      const std::size_t p = (std::size_t(k) * ny + j) * cx + s0;
+      visco_pml(m, b, i0, i1, psix[3].data() + p, 0, psix[4].data() + p, sxy, rxy, CMXY(0), psix[5].data() + p, sxz, rxz,
+                CMXZ(0));
+    }
   if (const int s = pmly.count() > 0 ? pmly.slot[j] : -1; s >= 0) {
     const float bf = pmly.b_full[j], af = pmly.a_full[j], bh = pmly.b_half[j], ah = pmly.a_half[j];
     const std::size_t p = (std::size_t(k) * pmly.count() + s) * nx;
     float* p0 = psiy[3].data() + p;
     float* p1 = psiy[4].data() + p;
     float* p2 = psiy[5].data() + p;
-    if (L == 0) {  // the same arithmetic, restrict-qualified so that it vectorizes
+    {
       float* __restrict q0 = p0;
       float* __restrict q1 = p1;
       float* __restrict q2 = p2;
@@ -928,22 +974,8 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
         q2[i] = bh * q2[i] + ah * (C1 * (W[i + Y] - W[i]) + C2 * (W[i + 2 * Y] - W[i - Y]));
         YZ[i] += m(MUYZ, i) * q2[i];
       }
-    } else
-    for (int i = 0; i < nx; ++i) {
-      p0[i] = bf * p0[i] + af * (C1 * (uy[i] - uy[i - Y]) + C2 * (uy[i + Y] - uy[i - 2 * Y]));
-      yy[i] += (m(LAM, i) + m(TWOMU, i)) * p0[i];
-      xx[i] += m(LAM, i) * p0[i];
-      zz[i] += m(LAM, i) * p0[i];
-      p1[i] = bh * p1[i] + ah * (C1 * (ux[i + Y] - ux[i]) + C2 * (ux[i + 2 * Y] - ux[i - Y]));
-      xy[i] += m(MUXY, i) * p1[i];
-      p2[i] = bh * p2[i] + ah * (C1 * (uz[i + Y] - uz[i]) + C2 * (uz[i + 2 * Y] - uz[i - Y]));
-      yz[i] += m(MUYZ, i) * p2[i];
-      if (L > 0) {
-        visco_normal(m, i, b + i, p0[i], 1);
-        visco_shear(m, i, b + i, p1[i], sxy, rxy, CMXY(0));
-        visco_shear(m, i, b + i, p2[i], syz, ryz, CMYZ(0));
-      }
     }
+    if (L > 0) visco_pml(m, b, 0, nx, p0, 1, p1, sxy, rxy, CMXY(0), p2, syz, ryz, CMYZ(0));
   }
   if (const int s = pmlz.count() > 0 ? pmlz.slot[k] : -1; s >= 0) {
     const float bf = pmlz.b_full[k], af = pmlz.a_full[k], bh = pmlz.b_half[k], ah = pmlz.a_half[k];
@@ -951,7 +983,7 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
     float* p0 = psiz[3].data() + p;
     float* p1 = psiz[4].data() + p;
     float* p2 = psiz[5].data() + p;
-    if (L == 0) {
+    {
       float* __restrict q0 = p0;
       float* __restrict q1 = p1;
       float* __restrict q2 = p2;
@@ -974,22 +1006,8 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
         q2[i] = bh * q2[i] + ah * (C1 * (V[i + Z] - V[i]) + C2 * (V[i + 2 * Z] - V[i - Z]));
         YZ[i] += m(MUYZ, i) * q2[i];
       }
-    } else
-    for (int i = 0; i < nx; ++i) {
-      p0[i] = bf * p0[i] + af * (C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]));
-      zz[i] += (m(LAM, i) + m(TWOMU, i)) * p0[i];
-      xx[i] += m(LAM, i) * p0[i];
-      yy[i] += m(LAM, i) * p0[i];
-      p1[i] = bh * p1[i] + ah * (C1 * (ux[i + Z] - ux[i]) + C2 * (ux[i + 2 * Z] - ux[i - Z]));
-      xz[i] += m(MUXZ, i) * p1[i];
-      p2[i] = bh * p2[i] + ah * (C1 * (uy[i + Z] - uy[i]) + C2 * (uy[i + 2 * Z] - uy[i - Z]));
-      yz[i] += m(MUYZ, i) * p2[i];
-      if (L > 0) {
-        visco_normal(m, i, b + i, p0[i], 2);
-        visco_shear(m, i, b + i, p1[i], sxz, rxz, CMXZ(0));
-        visco_shear(m, i, b + i, p2[i], syz, ryz, CMYZ(0));
-      }
     }
+    if (L > 0) visco_pml(m, b, 0, nx, p0, 2, p1, sxz, rxz, CMXZ(0), p2, syz, ryz, CMYZ(0));
   }
   if constexpr (Zm == 1)
     for (int i = 0; i < nx; ++i) zz[i] = 0.0f;
