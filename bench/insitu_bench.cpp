@@ -8,7 +8,7 @@
 // camera-frames per core-second, database bytes vs raw-field bytes (phi_p, phi_s as float32), the
 // process's resident memory with everything open, and memory per open stream.
 //
-// `insitu_bench --video-study` (not run by scripts/bench; minutes) measures what the video settings
+// `insitu_bench --video-study [demo|paper]` (not run by scripts/bench; minutes) measures what the video settings
 // give on the real frames of a setting: it runs the demo (every snapshot) and a stretch of
 // paper_quarter, keeps the finished frames of a sample of streams, and encodes them with several
 // GOP / quality / preset choices: bytes per frame, encode CPU time, PSNR, memory per open writer.
@@ -66,8 +66,8 @@ double cpu_seconds() {
 }
 
 // Runs a setting like panoptes run and keeps the finished frames of the streams (camera, task) with
-// camera % camera_step == 0: frames[stream][snapshot].
-std::vector<std::vector<Image>> capture_frames(const bench::InsituSetting& s, int camera_step) {
+// camera % camera_step == 0: frames[stream][snapshot]. `raw_bytes` = phi_p + phi_s of one snapshot.
+std::vector<std::vector<Image>> capture_frames(const bench::InsituSetting& s, int camera_step, double& raw_bytes) {
   std::ifstream in(s.config);
   if (!in) throw FileError(s.config, "cannot open");
   std::stringstream ss;
@@ -84,6 +84,7 @@ std::vector<std::vector<Image>> capture_frames(const bench::InsituSetting& s, in
   seismic::Solver solver(rc.solver);
   const auto& g = rc.solver.grid;
   const render::GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
+  raw_bytes = 2.0 * double(g.nx) * g.ny * g.nz * 4;
   insitu::Session session(cfg, grid, insitu::LocalBlock::whole(grid));
   const int tasks = session.task_count();
   std::map<int, std::vector<Image>> kept;
@@ -168,14 +169,20 @@ void study_row(const char* setting, const std::vector<std::vector<Image>>& strea
   std::fflush(stdout);
 }
 
-int video_study() {
+// `which`: "demo", "paper" or "" (both).
+int video_study(const std::string& which) {
   const std::string src = PANOPTES_SOURCE_DIR;
   // The whole demo (24 snapshots), every 10th of its 130 cameras: 39 streams.
-  const auto demo = capture_frames({src + "/examples/demo.toml", "", 0, 24}, 10);
+  std::vector<std::vector<Image>> demo, paper;
+  double demo_raw = 0, quarter_raw = 0;
+  if (which != "paper") demo = capture_frames({src + "/examples/demo.toml", "", 0, 24}, 10, demo_raw);
   // paper_quarter from the middle of the run: 4 of yinyang:2x2's 8 cameras, 20 snapshots, 920x896.
-  const auto paper = capture_frames({src + "/examples/paper_quarter.toml", "yinyang:2x2", 200, 20}, 2);
-  // Raw fields per camera-frame of the real run: phi_p + phi_s per snapshot / (130 x 3) frames.
-  const double demo_raw = 2.0 * 48 * 96 * 32 * 4 / 390, paper_raw = 2.0 * 256 * 512 * 160 * 4 / 390;
+  if (which != "demo")
+    paper = capture_frames({src + "/examples/paper_quarter.toml", "yinyang:2x2", 200, 20}, 2, quarter_raw);
+  // Raw fields per camera-frame of the real runs (390 streams): the demo's grid, and the FULL paper
+  // grid (256x512x160 = 64x the quarter grid's points) for the paper rows.
+  demo_raw /= 390;
+  const double paper_raw = 64 * quarter_raw / 390;
   std::printf("| setting | image | gop | crf | preset | bytes/frame | %% of raw fields | encode frames/CPU-s | PSNR dB mean / min | "
               "MB per open writer |\n|---|---|---|---|---|---|---|---|---|---|\n");
   struct V {
@@ -190,10 +197,10 @@ int video_study() {
     v.gop = x.gop;
     v.crf = x.crf;
     v.preset = x.preset;
-    study_row("demo", demo, v, demo_raw);
+    if (!demo.empty()) study_row("demo", demo, v, demo_raw);
   }
   for (const V& x : variants) {
-    if (x.gop == 24) continue;
+    if (x.gop == 24 || paper.empty()) continue;
     video::VideoSettings v;
     v.gop = x.gop;
     v.crf = x.crf;
@@ -209,7 +216,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::strcmp(argv[i], "--video-study") == 0) {
       try {
-        return video_study();
+        return video_study(i + 1 < argc ? argv[i + 1] : "");
       } catch (const std::exception& e) {
         std::fprintf(stderr, "insitu_bench: %s\n", e.what());
         return 1;
