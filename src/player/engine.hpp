@@ -58,6 +58,10 @@ struct EngineOptions {
   bool prefetch = true;
   /// Prefetch threads (0 = off, same as prefetch = false).
   int prefetch_threads = 2;
+  /// Nice increment of the prefetch threads relative to the process (0..19; Linux nice is per
+  /// thread). Higher = prefetch yields to every other process too, and a display thread waiting for
+  /// an in-flight prefetch decode then waits longer; 0 measured best under load (docs/player.md).
+  int prefetch_nice = 0;
   /// Frames ahead (in the playback direction) prefetched for the current stream, beyond the next one.
   int read_ahead = 2;
   /// Prefetch the graph neighbours (left/right/up/down/in/out) of the selection.

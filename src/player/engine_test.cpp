@@ -256,6 +256,8 @@ TEST_F(EngineTest, ReaderPoolBoundIsRespected) {
   EXPECT_LE(st.readers_open, 3);
   EXPECT_GT(st.readers_evicted, 0);
   EXPECT_THROW(Engine(db(), [&] { auto x = o; x.reader_pool_capacity = 2; return x; }()), Error);
+  EXPECT_THROW(Engine(db(), [&] { auto x = o; x.prefetch_nice = 20; return x; }()), Error);
+  EXPECT_THROW(Engine(db(), [&] { auto x = o; x.prefetch_nice = -1; return x; }()), Error);
 }
 
 TEST_F(EngineTest, FrameCacheCapIsRespected) {
