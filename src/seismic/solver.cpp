@@ -749,6 +749,7 @@ void Solver::Impl::velocity_row(int k, int j, const M& mat0) {
     float* __restrict p0 = psiy[0].data() + (std::size_t(k) * pmly.count() + s) * nx;
     float* __restrict p1 = psiy[1].data() + (std::size_t(k) * pmly.count() + s) * nx;
     float* __restrict p2 = psiy[2].data() + (std::size_t(k) * pmly.count() + s) * nx;
+#pragma omp simd
     for (int i = 0; i < nx; ++i) {
       p0[i] = bf * p0[i] + af * (C1 * (xy[i] - xy[i - Y]) + C2 * (xy[i + Y] - xy[i - 2 * Y]));
       ux[i] += m(BX, i) * p0[i];
@@ -763,6 +764,7 @@ void Solver::Impl::velocity_row(int k, int j, const M& mat0) {
     float* __restrict p0 = psiz[0].data() + (std::size_t(s) * ny + j) * nx;
     float* __restrict p1 = psiz[1].data() + (std::size_t(s) * ny + j) * nx;
     float* __restrict p2 = psiz[2].data() + (std::size_t(s) * ny + j) * nx;
+#pragma omp simd
     for (int i = 0; i < nx; ++i) {
       p0[i] = bf * p0[i] + af * (C1 * (xz[i] - xz[i - Z]) + C2 * (xz[i + Z] - xz[i - 2 * Z]));
       ux[i] += m(BX, i) * p0[i];
