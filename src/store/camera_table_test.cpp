@@ -138,6 +138,12 @@ TEST(CameraTable, SchemaVersion1ManifestsAreStillRead) {
   EXPECT_EQ(back.schema_version, 1);
   EXPECT_EQ(back.cameras, m.cameras);
   EXPECT_EQ(back.graph, m.graph);
+  // Written back, it becomes version 2 with a camera table.
+  write_manifest_atomic(dir / kManifestFileName, back);
+  const json again = json::parse(read_bytes(dir / kManifestFileName));
+  EXPECT_EQ(again.at("schema_version"), 2);
+  EXPECT_TRUE(again.contains("camera_table"));
+  EXPECT_EQ(read_manifest(dir / kManifestFileName).cameras, m.cameras);
   // A version-1 manifest cannot refer to a table.
   j["camera_table"] = {{"file", "cameras.0.bin"}, {"bytes", 1}, {"crc32", 0}, {"cameras", 5}};
   EXPECT_CONTAINS(error_of([&] { manifest_from_json(j, "f", dir.path); }), "camera_table: is not part of schema_version 1");

@@ -267,7 +267,9 @@ namespace {
 // The manifest as JSON: with `table`, the cameras and the graph are replaced by a reference to it.
 json manifest_json(const Manifest& m, const CameraTableRef* table) {
   json j;
-  j["schema_version"] = m.schema_version;
+  // Always the current version: both forms (inline cameras or a table) are valid in it, and a manifest
+  // read from a version-1 file is written back as version 2.
+  j["schema_version"] = kSchemaVersion;
   j["format"] = "panoptes movie database";
   j["title"] = m.title;
   j["status"] = std::string(to_string(m.status));
