@@ -385,8 +385,9 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   auto single_volume = [&](std::uint64_t m) {
     return m && !(m & (m - 1)) && S.rt[std::size_t(std::countr_zero(m))].kind == RtKind::volume1;
   };
-  // Marches samples kb … kend, all in one macro-cell whose live tasks are `mask`; `safe`: the cell
-  // lies inside the data with a one-cell margin, so interpolation needs no clamps.
+  // Marches samples kb … kend, all in one macro-cell whose live tasks are `mask` (or in consecutive
+  // cells of one single volume task, see the walk below); `safe`: the cells lie inside the data with
+  // a one-cell margin, so interpolation needs no clamps.
   auto run = [&](std::int64_t kb, std::int64_t kend, std::uint64_t mask, bool safe) {
     if (!have_prev && (live & S.iso_mask) && kb > 0) {
       // The sample before this run (maybe in the previous brick: within the ghost layers).
