@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -141,31 +142,34 @@ TEST(InsituSession, SnapshotsScheduleAndFinalize) {
   fs::remove_all(dir);
 }
 
+// Runs a session that SIGKILLs itself in the middle of its third snapshot (camera 2 of frame 2).
+void run_until_killed(const fs::path& dir) {
+  insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+  s.set_frame_observer([](int camera, int, int frame, const Image&) {
+    if (frame == 2 && camera == 2) ::raise(SIGKILL);
+  });
+  for (int step = 0; step < 5; ++step) {
+    const auto f = field(0.2 * step);
+    s.process(step, 0.2 * step, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }
+  s.finalize();
+}
+
 // A run SIGKILLed in the middle of its third snapshot leaves a database that opens as interrupted
 // with the two completed snapshots playable in every stream.
 TEST(InsituSession, KilledRunOpensInterrupted) {
-  const fs::path dir = fs::temp_directory_path() / ("insitu_killed_" + std::to_string(::getpid()));
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    try {
-      insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
-      s.set_frame_observer([](int camera, int, int frame, const Image&) {
-        if (frame == 2 && camera == 2) ::raise(SIGKILL);
-      });
-      for (int step = 0; step < 5; ++step) {
-        const auto f = field(0.2 * step);
-        s.process(step, 0.2 * step, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
-      }
-      s.finalize();
-    } catch (...) {
-    }
-    ::_exit(3);
+  // The run happens in a re-executed copy of this binary ("threadsafe" death test), not a plain
+  // fork: a child forked after earlier tests started OpenMP's thread pool deadlocks in its first
+  // parallel region (libgomp is not fork-safe), which hung this test when the binary ran whole.
+  // The child re-runs this body, so it finds the directory through the environment.
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  if (!std::getenv("PANOPTES_TEST_KILLED_DIR")) {
+    const fs::path d = fs::temp_directory_path() / ("insitu_killed_" + std::to_string(::getpid()));
+    ::setenv("PANOPTES_TEST_KILLED_DIR", d.c_str(), 1);
   }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status));
-  EXPECT_EQ(WTERMSIG(status), SIGKILL);
+  const fs::path dir = std::getenv("PANOPTES_TEST_KILLED_DIR");
+  fs::remove_all(dir);
+  EXPECT_EXIT(run_until_killed(dir), ::testing::KilledBySignal(SIGKILL), "");
   const auto db = store::Database::open(dir);
   EXPECT_EQ(db.status(), store::Status::interrupted);
   EXPECT_EQ(db.frame_count(), 2);
