@@ -73,10 +73,9 @@ enum class Type : std::uint32_t { f64 = 1, i32 = 2, u32 = 3, blob = 4 };
 
 std::size_t element_size(Type t) { return t == Type::f64 ? 8 : t == Type::blob ? 1 : 4; }
 
+// The table is little-endian on disk: a value's bytes are swapped on a big-endian host (both ways).
 template <class T>
-T load(const char* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
+T little_endian(T v) {
   if constexpr (std::endian::native == std::endian::big) {
     if constexpr (sizeof(T) == 8) {
       std::uint64_t u;
@@ -94,20 +93,15 @@ T load(const char* p) {
 }
 
 template <class T>
+T load(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return little_endian(v);
+}
+
+template <class T>
 void store_le(std::string& out, std::size_t at, T v) {
-  if constexpr (std::endian::native == std::endian::big) {
-    if constexpr (sizeof(T) == 8) {
-      std::uint64_t u;
-      std::memcpy(&u, &v, 8);
-      u = __builtin_bswap64(u);
-      std::memcpy(&v, &u, 8);
-    } else if constexpr (sizeof(T) == 4) {
-      std::uint32_t u;
-      std::memcpy(&u, &v, 4);
-      u = __builtin_bswap32(u);
-      std::memcpy(&v, &u, 4);
-    }
-  }
+  v = little_endian(v);
   std::memcpy(out.data() + at, &v, sizeof v);
 }
 
