@@ -821,6 +821,29 @@ void Solver::Impl::velocity_rows(int k, int j0, int j1, double t) {
 
 // One row of the stress update (plus memory variables when attenuating), then its CPML
 // corrections x, y, z; on the free-surface plane σzz is set to 0 last. Corrections of σ read only v.
+// CPML correction of one stress row for the derivatives along y or z (stride S between rows of that
+// axis): ψ0 of the axis's own velocity component n feeds the normal stresses (λ + 2μ on the axis's
+// own, λ on the two others); ψ1 and ψ2 of the other components a1, a2 feed the two shear stresses in
+// the axis's plane. Restrict-qualified so the loop vectorizes; the same expressions as the interior
+// update's, so results do not depend on which code path a row takes.
+template <int Mu1, int Mu2, class M>
+[[gnu::always_inline]] inline void pml_stress_row(const M& m, int nx, long S, float bf, float af, float bh, float ah, float* __restrict q0,
+                           float* __restrict q1, float* __restrict q2, float* __restrict normal, float* __restrict other1,
+                           float* __restrict other2, float* __restrict shear1, float* __restrict shear2,
+                           const float* __restrict n, const float* __restrict a1, const float* __restrict a2) {
+#pragma omp simd
+  for (int i = 0; i < nx; ++i) {
+    q0[i] = bf * q0[i] + af * (C1 * (n[i] - n[i - S]) + C2 * (n[i + S] - n[i - 2 * S]));
+    normal[i] += (m(LAM, i) + m(TWOMU, i)) * q0[i];
+    other1[i] += m(LAM, i) * q0[i];
+    other2[i] += m(LAM, i) * q0[i];
+    q1[i] = bh * q1[i] + ah * (C1 * (a1[i + S] - a1[i]) + C2 * (a1[i + 2 * S] - a1[i - S]));
+    shear1[i] += m(Mu1, i) * q1[i];
+    q2[i] = bh * q2[i] + ah * (C1 * (a2[i + S] - a2[i]) + C2 * (a2[i + 2 * S] - a2[i - S]));
+    shear2[i] += m(Mu2, i) * q2[i];
+  }
+}
+
 template <int Zm, class M>
 void Solver::Impl::stress_row(int k, int j, const M& mat0) {
   const std::size_t b = idx(0, j, k);
@@ -953,30 +976,7 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
     float* p0 = psiy[3].data() + p;
     float* p1 = psiy[4].data() + p;
     float* p2 = psiy[5].data() + p;
-    {
-      float* __restrict q0 = p0;
-      float* __restrict q1 = p1;
-      float* __restrict q2 = p2;
-      float* __restrict X = xx;
-      float* __restrict YY = yy;
-      float* __restrict ZZ = zz;
-      float* __restrict XY = xy;
-      float* __restrict YZ = yz;
-      const float* __restrict U = ux;
-      const float* __restrict V = uy;
-      const float* __restrict W = uz;
-#pragma omp simd
-      for (int i = 0; i < nx; ++i) {
-        q0[i] = bf * q0[i] + af * (C1 * (V[i] - V[i - Y]) + C2 * (V[i + Y] - V[i - 2 * Y]));
-        YY[i] += (m(LAM, i) + m(TWOMU, i)) * q0[i];
-        X[i] += m(LAM, i) * q0[i];
-        ZZ[i] += m(LAM, i) * q0[i];
-        q1[i] = bh * q1[i] + ah * (C1 * (U[i + Y] - U[i]) + C2 * (U[i + 2 * Y] - U[i - Y]));
-        XY[i] += m(MUXY, i) * q1[i];
-        q2[i] = bh * q2[i] + ah * (C1 * (W[i + Y] - W[i]) + C2 * (W[i + 2 * Y] - W[i - Y]));
-        YZ[i] += m(MUYZ, i) * q2[i];
-      }
-    }
+    pml_stress_row<MUXY, MUYZ>(m, nx, Y, bf, af, bh, ah, p0, p1, p2, yy, xx, zz, xy, yz, uy, ux, uz);
     if (L > 0) visco_pml(m, b, 0, nx, p0, 1, p1, sxy, rxy, CMXY(0), p2, syz, ryz, CMYZ(0));
   }
   if (const int s = pmlz.count() > 0 ? pmlz.slot[k] : -1; s >= 0) {
@@ -985,30 +985,7 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
     float* p0 = psiz[3].data() + p;
     float* p1 = psiz[4].data() + p;
     float* p2 = psiz[5].data() + p;
-    {
-      float* __restrict q0 = p0;
-      float* __restrict q1 = p1;
-      float* __restrict q2 = p2;
-      float* __restrict X = xx;
-      float* __restrict YY = yy;
-      float* __restrict ZZ = zz;
-      float* __restrict XZ = xz;
-      float* __restrict YZ = yz;
-      const float* __restrict U = ux;
-      const float* __restrict V = uy;
-      const float* __restrict W = uz;
-#pragma omp simd
-      for (int i = 0; i < nx; ++i) {
-        q0[i] = bf * q0[i] + af * (C1 * (W[i] - W[i - Z]) + C2 * (W[i + Z] - W[i - 2 * Z]));
-        ZZ[i] += (m(LAM, i) + m(TWOMU, i)) * q0[i];
-        X[i] += m(LAM, i) * q0[i];
-        YY[i] += m(LAM, i) * q0[i];
-        q1[i] = bh * q1[i] + ah * (C1 * (U[i + Z] - U[i]) + C2 * (U[i + 2 * Z] - U[i - Z]));
-        XZ[i] += m(MUXZ, i) * q1[i];
-        q2[i] = bh * q2[i] + ah * (C1 * (V[i + Z] - V[i]) + C2 * (V[i + 2 * Z] - V[i - Z]));
-        YZ[i] += m(MUYZ, i) * q2[i];
-      }
-    }
+    pml_stress_row<MUXZ, MUYZ>(m, nx, Z, bf, af, bh, ah, p0, p1, p2, zz, xx, yy, xz, yz, uz, ux, uy);
     if (L > 0) visco_pml(m, b, 0, nx, p0, 2, p1, sxz, rxz, CMXZ(0), p2, syz, ryz, CMYZ(0));
   }
   if constexpr (Zm == 1)
