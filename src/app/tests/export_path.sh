@@ -8,7 +8,7 @@ cd "$work"
 
 "$panoptes" synth-db db --cameras 4 --tasks 2 --frames 12 --size 64x64 >/dev/null
 printf 't=0.1 key=Right\nt=0.3 key=Tab\nt=0.5 key=Right\n' > s.txt
-"$panoptes" export-path db --script s.txt --out path.mp4 | grep -q "wrote path.mp4: 16 frames"
+"$panoptes" export-path db --script s.txt --out path.mp4 | grep "wrote path.mp4: 16 frames" >/dev/null
 frames=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,width,height \
          -of csv=p=0 path.mp4)
 [ "$frames" = "64,64,16" ] || { echo "ffprobe says: $frames"; exit 1; }

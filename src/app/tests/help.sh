@@ -2,8 +2,8 @@
 # Every subcommand answers --help with exit 0, and a bad subcommand fails with a message.
 set -euo pipefail
 panoptes=$1
-"$panoptes" --help | grep -q "Panoptes"
-"$panoptes" --version | grep -q "panoptes"
+"$panoptes" --help | grep "Panoptes" >/dev/null
+"$panoptes" --version | grep "panoptes" >/dev/null
 for sub in $("$panoptes" --help | awk '/^SUBCOMMANDS:/{f=1;next} f&&NF{print $1}'); do
   "$panoptes" "$sub" --help >/dev/null || { echo "'$sub --help' failed"; exit 1; }
 done

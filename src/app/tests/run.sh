@@ -54,8 +54,8 @@ TOML
 check_complete() {
   local out
   out=$("$bin" info --json "$1")
-  echo "$out" | grep -Eq '"status": *"complete"' || { echo "FAIL: $1 not complete: $out"; exit 1; }
-  echo "$out" | grep -Eq '"frames": *4' || { echo "FAIL: $1 does not have 4 frames: $out"; exit 1; }
+  echo "$out" | grep -E '"status": *"complete"' >/dev/null || { echo "FAIL: $1 not complete: $out"; exit 1; }
+  echo "$out" | grep -E '"frames": *4' >/dev/null || { echo "FAIL: $1 does not have 4 frames: $out"; exit 1; }
 }
 
 "$bin" run tiny.toml > run1.log 2>&1 || { cat run1.log; echo "FAIL: run"; exit 1; }
