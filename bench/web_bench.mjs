@@ -1,0 +1,62 @@
+// The web player's switch latency in headless Chromium (see web_bench.sh.in): per run, a fresh page
+// plays the database at its frame rate; after 1.5 s of playback, 40 switches (right, right, Tab,
+// up, ...; one every 330 ms, i.e. every ~10 frames at 30 fps) are pressed. Latency = key press to
+// the rAF callback that drew the new stream's frame (the player's own record). Bytes per switch =
+// bytes fetched during the switching phase / switches (includes the playback's own read-ahead).
+import { createRequire } from "node:module";
+import os from "node:os";
+
+const [url, chromium, nodeModules, dbPath, repsArg] = process.argv.slice(2);
+const require = createRequire(nodeModules + "/");
+const puppeteer = require("puppeteer-core");
+const reps = Number(repsArg || 3);
+const keys = ["ArrowRight", "ArrowRight", "Tab", "ArrowUp", "ArrowLeft", "Tab", "ArrowDown", "ArrowRight"];
+
+const median = (a) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.floor((s.length - 1) / 2)] : NaN; };
+const pct = (a, p) => { const s = [...a].sort((x, y) => x - y); return s[Math.min(s.length - 1, Math.ceil((p / 100) * s.length) - 1)]; };
+
+async function run(browser, prefetch) {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1280, height: 900 });
+  const t0 = Date.now();
+  await page.goto(url + `?play=1&prefetch=${prefetch ? 1 : 0}`);
+  await page.waitForFunction(() => window.panoptes && window.panoptes.firstFrameMs() !== null, { timeout: 30000 });
+  const firstFrame = await page.evaluate(() => window.panoptes.firstFrameMs());  // since navigation start
+  await new Promise((r) => setTimeout(r, 1500));
+  const before = await page.evaluate(() => window.panoptes.traffic());
+  for (let i = 0; i < 40; i++) {
+    await page.keyboard.press(keys[i % keys.length]);
+    await new Promise((r) => setTimeout(r, 330));
+  }
+  const after = await page.evaluate(() => window.panoptes.traffic());
+  const switches = await page.evaluate(() => window.panoptes.switches());
+  await page.close();
+  const ms = switches.map((s) => s.ms);
+  return {
+    n: switches.length, p50: median(ms), p99: pct(ms, 99), max: Math.max(...ms),
+    hits: switches.filter((s) => s.hit).length / Math.max(1, switches.length),
+    firstFrame, bytesPerSwitch: (after.bytes - before.bytes) / Math.max(1, switches.length),
+    requestsPerSwitch: (after.requests - before.requests) / Math.max(1, switches.length),
+  };
+}
+
+const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox", "--disable-dev-shm-usage"] });
+const db = await (await fetch(url + "api/database.json")).json();
+const rows = [];
+for (const prefetch of [true, false]) {
+  const runs = [];
+  for (let r = 0; r < reps; r++) runs.push(await run(browser, prefetch));
+  const m = (k) => median(runs.map((x) => x[k]));
+  const range = (k, d = 1) => `${Math.min(...runs.map((x) => x[k])).toFixed(d)}–${Math.max(...runs.map((x) => x[k])).toFixed(d)}`;
+  rows.push(`| ${prefetch ? "on" : "off"} | ${runs[0].n} | ${m("p50").toFixed(1)} | ${m("p99").toFixed(1)} (${range("p99")}) | ${m("max").toFixed(1)} | ` +
+            `${(100 * m("hits")).toFixed(0)} % | ${m("firstFrame").toFixed(0)} | ${(m("bytesPerSwitch") / 1024).toFixed(1)} | ${m("requestsPerSwitch").toFixed(1)} |`);
+}
+const version = await browser.version();
+await browser.close();
+console.log(`Database \`${dbPath}\`: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames of ` +
+            `${db.image.width}×${db.image.height} at ${db.fps} fps (gop ${db.gop}); ${version} headless, ${reps} runs per row ` +
+            `(medians; p99 range over runs); load average at the end ${os.loadavg().map((x) => x.toFixed(1)).join(" ")}.`);
+console.log("");
+console.log("| prefetch | switches/run | p50 ms | p99 ms | max ms | switches prefetched | first frame ms | kB fetched/switch | requests/switch |");
+console.log("|---|---|---|---|---|---|---|---|---|");
+for (const r of rows) console.log(r);

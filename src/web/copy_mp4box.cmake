@@ -1,0 +1,10 @@
+# Copies mp4box.js's ES-module build (dist/*.mjs; the files import each other) and its licence.
+file(GLOB modules ${SRC}/dist/*.mjs)
+if(NOT modules)
+  message(FATAL_ERROR "mp4box.js not found under ${SRC}/dist (did npm ci run?)")
+endif()
+file(COPY ${modules} DESTINATION ${DST})
+file(GLOB licence ${SRC}/LICENSE*)
+if(licence)
+  file(COPY ${licence} DESTINATION ${DST})
+endif()

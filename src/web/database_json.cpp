@@ -1,0 +1,63 @@
+#include "web/database_json.hpp"
+
+namespace panoptes::web {
+
+nlohmann::json database_json(const store::Database& db) {
+  const store::Manifest& m = db.manifest();
+  using nlohmann::json;
+  json j;
+  j["title"] = m.title;
+  j["status"] = std::string(store::to_string(db.status()));
+  j["frames"] = db.frame_count();
+  j["fps"] = m.video.fps;
+  j["gop"] = m.video.gop;
+  j["image"] = {{"width", m.image.width}, {"height", m.image.height}};
+  json times = json::array();
+  for (int i = 0; i < db.frame_count(); ++i) times.push_back(m.frame_time(i));
+  j["times"] = std::move(times);
+  j["movie_pattern"] = m.movie_pattern;
+  j["rig"] = m.rig.kind;
+  j["domain_units"] = m.domain.units;
+
+  json axes = json::array();
+  for (const auto& a : m.axes) axes.push_back({{"name", a.name}, {"values", a.values}, {"units", a.units}});
+  j["axes"] = std::move(axes);
+  json tasks = json::array();
+  for (const auto& t : m.tasks) {
+    json positions = json::array();
+    for (const auto& p : t.axes) positions.push_back({{"axis", p.axis}, {"index", p.index}});
+    tasks.push_back({{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)}});
+  }
+  j["tasks"] = std::move(tasks);
+
+  const int n = m.camera_count();
+  std::vector<double> lat(n), lon(n), pos(3 * std::size_t(n)), look(3 * std::size_t(n)), up(3 * std::size_t(n));
+  std::vector<int> shell(n);
+  for (int i = 0; i < n; ++i) {
+    const auto& c = m.cameras[i];
+    lat[i] = c.labels.lat_deg;
+    lon[i] = c.labels.lon_deg;
+    shell[i] = c.labels.shell;
+    const Vec3* v[3] = {&c.position, &c.look_at, &c.up};
+    std::vector<double>* out[3] = {&pos, &look, &up};
+    for (int k = 0; k < 3; ++k) {
+      (*out[k])[3 * i] = v[k]->x;
+      (*out[k])[3 * i + 1] = v[k]->y;
+      (*out[k])[3 * i + 2] = v[k]->z;
+    }
+  }
+  j["cameras"] = {{"count", n}, {"lat_deg", lat}, {"lon_deg", lon}, {"shell", shell},
+                  {"position", pos}, {"look_at", look}, {"up", up}};
+  json graph = json::array();
+  for (const auto& g : m.graph.neighbours) graph.push_back({g.left, g.right, g.up, g.down, g.in, g.out});
+  j["graph"] = std::move(graph);
+  return j;
+}
+
+nlohmann::json fragment_index_json(const FragmentIndex& index) {
+  nlohmann::json fragments = nlohmann::json::array();
+  for (const auto& f : index.fragments) fragments.push_back({f.offset, f.size, f.first_frame, f.frames});
+  return {{"file_size", index.file_size}, {"init_size", index.init_size}, {"fragments", std::move(fragments)}};
+}
+
+}  // namespace panoptes::web

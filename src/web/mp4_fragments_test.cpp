@@ -1,0 +1,70 @@
+#include "web/mp4_fragments.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "core/error.hpp"
+#include "store/database.hpp"
+#include "store/synthetic.hpp"
+#include "store/test_support.hpp"
+
+namespace panoptes::web {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path make_db(const fs::path& dir, int frames, int gop) {
+  store::SyntheticOptions o;
+  o.cameras = 2;
+  o.tasks = 1;
+  o.frames = frames;
+  o.width = 64;
+  o.height = 48;
+  o.video.gop = gop;
+  o.threads = 1;
+  store::write_synthetic_database(dir, o);
+  return dir / "movies" / "c1" / "t0.mp4";
+}
+
+TEST(Mp4Fragments, OneFragmentPerGopCoversEveryFrame) {
+  store::testing::TempDir tmp("web-frag");
+  const fs::path movie = make_db(tmp.path / "db", 7, 3);
+  const FragmentIndex index = index_fragments(movie);
+  EXPECT_EQ(index.file_size, fs::file_size(movie));
+  EXPECT_GT(index.init_size, 0u);
+  ASSERT_EQ(index.fragments.size(), 3u);  // keyframes at 0, 3, 6
+  EXPECT_EQ(index.frame_count(), 7);
+  int expected_first = 0;
+  std::uint64_t expected_offset = index.init_size;
+  for (const auto& f : index.fragments) {
+    EXPECT_EQ(f.first_frame, expected_first);
+    EXPECT_EQ(f.offset, expected_offset);  // fragments follow each other with nothing between
+    expected_first += f.frames;
+    expected_offset += f.size;
+  }
+  EXPECT_EQ(index.fragments[2].frames, 1);
+  EXPECT_LE(expected_offset, index.file_size);  // a finished movie ends with an mfra box
+}
+
+TEST(Mp4Fragments, TruncatedMovieKeepsItsCompleteFragments) {
+  store::testing::TempDir tmp("web-frag");
+  const fs::path movie = make_db(tmp.path / "db", 4, 1);
+  const FragmentIndex whole = index_fragments(movie);
+  ASSERT_EQ(whole.fragments.size(), 4u);
+  fs::resize_file(movie, whole.fragments[3].offset + whole.fragments[3].size / 2);
+  const FragmentIndex cut = index_fragments(movie);
+  EXPECT_EQ(cut.fragments.size(), 3u);
+  EXPECT_EQ(cut.frame_count(), 3);
+}
+
+TEST(Mp4Fragments, RefusesFilesThatAreNotMovies) {
+  store::testing::TempDir tmp("web-frag");
+  const fs::path junk = tmp.path / "junk.mp4";
+  std::ofstream(junk) << "this is not a movie, just some text long enough to look like boxes";
+  EXPECT_THROW(index_fragments(junk), FileError);
+  EXPECT_THROW(index_fragments(tmp.path / "missing.mp4"), FileError);
+}
+
+}  // namespace
+}  // namespace panoptes::web

@@ -1,0 +1,44 @@
+#include "web/safe_path.hpp"
+
+#include <system_error>
+
+#include "core/error.hpp"
+
+namespace panoptes::web {
+
+namespace fs = std::filesystem;
+
+SafeRoot::SafeRoot(const fs::path& dir) {
+  std::error_code ec;
+  root_ = fs::canonical(dir, ec);
+  if (ec || !fs::is_directory(root_)) throw FileError(dir.string(), "not a directory");
+}
+
+std::optional<fs::path> SafeRoot::resolve(std::string_view relative, std::string* why) const {
+  auto refuse = [&](const std::string& reason) -> std::optional<fs::path> {
+    if (why) *why = reason;
+    return std::nullopt;
+  };
+  if (relative.empty()) return refuse("empty path");
+  if (relative.find('\0') != std::string_view::npos || relative.find('\\') != std::string_view::npos)
+    return refuse("NUL or backslash in the path");
+  fs::path path = root_;
+  std::size_t start = 0;
+  while (start <= relative.size()) {
+    const std::size_t slash = std::min(relative.find('/', start), relative.size());
+    const std::string_view part = relative.substr(start, slash - start);
+    // Hidden names too: the lock file, temporary manifests and dot-dirs are nobody's business.
+    if (part.empty() || part.front() == '.') return refuse("empty, '.', '..' or hidden path component");
+    path /= fs::path(std::string(part));
+    start = slash + 1;
+  }
+  std::error_code ec;
+  const fs::path real = fs::weakly_canonical(path, ec);
+  if (ec) return refuse("cannot resolve the path");
+  const auto rel = real.lexically_relative(root_);
+  if (rel.empty() || *rel.begin() == "..") return refuse("resolves outside the served directory");
+  if (!fs::is_regular_file(real, ec)) return refuse("no such file");
+  return real;
+}
+
+}  // namespace panoptes::web

@@ -1,0 +1,229 @@
+#include "web/server.hpp"
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <atomic>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "store/synthetic.hpp"
+#include "store/test_support.hpp"
+
+namespace panoptes::web {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A database, a player directory and a secret file beside them that must never be served.
+struct Fixture {
+  store::testing::TempDir tmp{"web-server"};
+  fs::path db = tmp.path / "db", player = tmp.path / "player", secret = tmp.path / "secret.txt";
+  Fixture() {
+    store::SyntheticOptions o;
+    o.cameras = 3;
+    o.tasks = 2;
+    o.frames = 5;
+    o.width = 64;
+    o.height = 48;
+    o.video.gop = 2;
+    o.threads = 1;
+    store::write_synthetic_database(db, o);
+    fs::create_directories(player);
+    std::ofstream(player / "index.html") << "<!doctype html><title>player</title>";
+    std::ofstream(secret) << "TOP-SECRET-CONTENT";
+    // Links out of the database (a directory and a file) and one that stays inside.
+    fs::create_directory_symlink(tmp.path, db / "movies" / "outside");
+    fs::create_symlink(secret, db / "movies" / "c0" / "secret.mp4");
+    fs::create_symlink(db / "movies" / "c0" / "t0.mp4", db / "movies" / "inside.mp4");
+  }
+};
+
+/// A server on a free port, running in a thread for the test's lifetime.
+struct Running {
+  Server server;
+  std::thread thread;
+  explicit Running(ServerOptions o) : server(std::move(o)) {
+    thread = std::thread([this] { server.run(); });
+    httplib::Client probe("127.0.0.1", server.port());
+    for (int i = 0; i < 200 && !probe.Get("/api/database.json"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ~Running() {
+    server.stop();
+    thread.join();
+  }
+};
+
+ServerOptions options(const Fixture& f, std::string token = {}) {
+  ServerOptions o;
+  o.database = f.db;
+  o.player_dir = f.player;
+  o.port = 0;
+  o.token = std::move(token);
+  return o;
+}
+
+TEST(Server, ServesDatabaseJsonIndexAndByteRanges) {
+  Fixture f;
+  std::vector<std::string> log;
+  std::mutex log_mutex;
+  auto o = options(f);
+  o.log = [&](const std::string& line) {
+    std::lock_guard lock(log_mutex);
+    log.push_back(line);
+  };
+  Running r(o);
+  httplib::Client c("127.0.0.1", r.server.port());
+  auto res = c.Get("/api/database.json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  const auto db = nlohmann::json::parse(res->body);
+  EXPECT_EQ(db["frames"], 5);
+  EXPECT_EQ(db["cameras"]["count"], 3);
+  EXPECT_EQ(db["tasks"].size(), 2u);
+  EXPECT_EQ(db["graph"].size(), 3u);
+  EXPECT_EQ(db["cameras"]["position"].size(), 9u);
+
+  res = c.Get("/api/index/2/1.json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  const auto index = nlohmann::json::parse(res->body);
+  ASSERT_EQ(index["fragments"].size(), 3u);  // gop 2, 5 frames
+  EXPECT_EQ(index["fragments"][2][2], 4);    // first frame of the last fragment
+
+  // The second fragment by a byte range: exactly those bytes, 206.
+  const std::uint64_t offset = index["fragments"][1][0], size = index["fragments"][1][1];
+  res = c.Get("/db/movies/c2/t1.mp4",
+              {{"Range", "bytes=" + std::to_string(offset) + "-" + std::to_string(offset + size - 1)}});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 206);
+  EXPECT_EQ(res->body, read_file(f.db / "movies/c2/t1.mp4").substr(offset, size));
+  res = c.Get("/db/movies/c2/t1.mp4");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_EQ(res->body.size(), fs::file_size(f.db / "movies/c2/t1.mp4"));
+  // A link that stays inside the database is fine.
+  res = c.Get("/db/movies/inside.mp4");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+
+  res = c.Get("/");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_NE(res->body.find("player"), std::string::npos);
+
+  // Out of range stream, missing movie, corrupt movie.
+  EXPECT_EQ(c.Get("/api/index/3/0.json")->status, 404);
+  fs::remove(f.db / "movies/c1/t0.mp4");
+  EXPECT_EQ(c.Get("/api/index/1/0.json")->status, 404);
+  std::ofstream(f.db / "movies/c1/t1.mp4", std::ios::trunc) << "garbage garbage garbage garbage";
+  EXPECT_EQ(c.Get("/api/index/1/1.json")->status, 422);
+
+  std::lock_guard lock(log_mutex);
+  bool logged_range = false;
+  for (const auto& line : log) logged_range |= line.find("GET /db/movies/c2/t1.mp4 206 bytes=") != std::string::npos;
+  EXPECT_TRUE(logged_range) << "one log line per request, with the range";
+}
+
+TEST(Server, NoPathOutsideTheDatabaseCanBeReached) {
+  Fixture f;
+  Running r(options(f));
+  httplib::Client c("127.0.0.1", r.server.port());
+  c.set_url_encode(false);  // send the paths exactly as written
+  const char* attacks[] = {
+      "/db/../secret.txt",
+      "/db/movies/../../secret.txt",
+      "/db/%2e%2e/secret.txt",
+      "/db/%2E%2E/secret.txt",
+      "/db/%2e%2e%2fsecret.txt",
+      "/db/movies/c0/..%2f..%2f..%2fsecret.txt",
+      "/db/.%2e/secret.txt",
+      "/db//etc/passwd",
+      "/db/%2fetc%2fpasswd",
+      "/db/movies/outside/secret.txt",  // directory link out of the database
+      "/db/movies/c0/secret.mp4",       // file link out of the database
+      "/db/.panoptes.lock",
+      "/../secret.txt",
+      "/%2e%2e/secret.txt",
+      "/..%2fsecret.txt",
+      "/db/movies\\..\\..\\secret.txt",
+      "/db/movies/c0/t0.mp4%00.txt",
+  };
+  for (const char* path : attacks) {
+    auto res = c.Get(path);
+    if (!res) continue;  // the library refused to send or parse it: also fine
+    EXPECT_NE(res->status, 200) << path;
+    EXPECT_NE(res->status, 206) << path;
+    EXPECT_EQ(res->body.find("TOP-SECRET"), std::string::npos) << path;
+  }
+  // The same server still serves what it should.
+  EXPECT_EQ(c.Get("/db/movies/c0/t0.mp4")->status, 200);
+}
+
+TEST(Server, TokenIsRequiredWhenGiven) {
+  Fixture f;
+  Running r(options(f, "s3cret-t0ken"));
+  httplib::Client c("127.0.0.1", r.server.port());
+  EXPECT_EQ(c.Get("/api/database.json")->status, 401);
+  EXPECT_EQ(c.Get("/db/movies/c0/t0.mp4")->status, 401);
+  EXPECT_EQ(c.Get("/api/database.json?token=wrong-t0ken!")->status, 401);
+  EXPECT_EQ(c.Get("/api/database.json?token=s3cret-t0ke")->status, 401);
+  EXPECT_EQ(c.Get("/api/database.json", {{"Authorization", "Bearer wrong"}})->status, 401);
+  EXPECT_EQ(c.Get("/api/database.json", {{"Cookie", "panoptes_token=wrong"}})->status, 401);
+
+  auto res = c.Get("/?token=s3cret-t0ken");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_NE(res->get_header_value("Set-Cookie").find("panoptes_token=s3cret-t0ken"), std::string::npos);
+  EXPECT_EQ(c.Get("/api/database.json", {{"Authorization", "Bearer s3cret-t0ken"}})->status, 200);
+  EXPECT_EQ(c.Get("/db/movies/c0/t0.mp4", {{"Cookie", "x=1; panoptes_token=s3cret-t0ken"}})->status, 200);
+}
+
+TEST(Server, ManyConcurrentClientsGetTheirRanges) {
+  Fixture f;
+  Running r(options(f));
+  const std::string movie = read_file(f.db / "movies/c1/t1.mp4");
+  std::atomic<int> good{0}, bad{0};
+  std::vector<std::thread> clients;
+  for (int k = 0; k < 16; ++k) {
+    clients.emplace_back([&, k] {
+      httplib::Client c("127.0.0.1", r.server.port());
+      for (int i = 0; i < 10; ++i) {
+        const std::size_t a = (k * 131 + i * 17) % (movie.size() - 64), b = a + 63;
+        auto res = c.Get("/db/movies/c1/t1.mp4", {{"Range", "bytes=" + std::to_string(a) + "-" + std::to_string(b)}});
+        (res && res->status == 206 && res->body == movie.substr(a, 64) ? good : bad)++;
+      }
+    });
+  }
+  for (auto& t : clients) t.join();
+  EXPECT_EQ(good, 160);
+  EXPECT_EQ(bad, 0);
+}
+
+TEST(Server, RefusesBadDirectoriesAndBusyPorts) {
+  Fixture f;
+  auto o = options(f);
+  o.database = f.tmp.path / "nope";
+  EXPECT_THROW(Server{o}, Error);
+  o = options(f);
+  o.player_dir = f.db;  // no index.html
+  EXPECT_THROW(Server{o}, FileError);
+  Running r(options(f));
+  o = options(f);
+  o.port = r.server.port();
+  EXPECT_THROW(Server{o}, Error);
+}
+
+}  // namespace
+}  // namespace panoptes::web

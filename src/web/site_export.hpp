@@ -1,0 +1,31 @@
+#pragma once
+// `panoptes export-web`: the web player as a static site that any static web server can host.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+
+namespace panoptes::web {
+
+/// What export_site does with the database's files.
+enum class DatabaseCopy {
+  copy,  ///< copy the manifest, camera table and movies into OUT/db (self-contained site)
+  link,  ///< OUT/db is a symbolic link to the database (no copy; the server must follow links)
+};
+
+/// Summary of an export.
+struct SiteExport {
+  std::int64_t streams = 0;         ///< streams in the database
+  std::int64_t indexed = 0;         ///< streams whose fragment index was written
+  std::int64_t bytes_copied = 0;    ///< movie and manifest bytes copied (0 when linked)
+};
+
+/// Writes OUT/index.html and the player's files, OUT/api/database.json, OUT/api/index/C/T.json per
+/// stream (what `panoptes serve` computes per request), and the database under OUT/db. Missing or
+/// unreadable movies get no index (the player shows its placeholder for them). Refuses an OUT that
+/// exists and is not empty unless overwrite (then only the files it writes are replaced).
+/// progress(done, total) is called now and then.
+SiteExport export_site(const std::filesystem::path& database, const std::filesystem::path& out,
+                       const std::filesystem::path& player_dir, DatabaseCopy mode, bool overwrite,
+                       const std::function<void(std::int64_t, std::int64_t)>& progress = {});
+
+}  // namespace panoptes::web

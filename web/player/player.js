@@ -1,0 +1,395 @@
+// The Panoptes web player: the same navigation as the desktop player (docs/player.md, docs/ui.md)
+// over `panoptes serve` or a static export. Decoding: WebCodecs + mp4box.js (movies.js). Prefetch:
+// after every change of selection the queue is replaced by, in this order, the current stream's
+// next frame, every neighbour at the next frame, the current stream's read-ahead, every neighbour at
+// the current frame — the engine's order — so a switch finds its frame decoded.
+import { FrameCache, Stream, traffic } from "./movies.js";
+import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
+import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
+
+const params = new URLSearchParams(location.search);
+const base = new URL(".", location.href).href.split("?")[0];
+const options = {
+  prefetch: params.get("prefetch") !== "0",
+  autoplay: params.get("play") !== "0",
+  cacheFrames: Number(params.get("cache") || 240),
+  workers: Number(params.get("workers") || 3),
+  readAhead: 2,
+};
+
+const canvas = document.getElementById("view");
+const ctx = canvas.getContext("2d");
+const hud = document.getElementById("hud");
+const statusLine = document.getElementById("status");
+const minimap = document.getElementById("minimap");
+const mapCtx = minimap.getContext("2d");
+
+const cache = new FrameCache(options.cacheFrames);
+const streams = new Map();  // "c/t" → Stream, LRU
+const MAX_STREAMS = 48;
+const drag = new DragRotation();
+
+const S = {
+  db: null, camera: 0, task: 0, axis: 0,
+  playing: options.autoplay, loop: true, speed: 1,
+  anchorFrame: 0, anchorTime: 0,
+  zoom: 1, panX: 0, panY: 0,
+  shown: null,        // {camera, task, frame, status} last drawn
+  pending: null,      // switch waiting to be shown: {t0, command, from}
+  switches: [],       // {command, from, to, ms, hit}
+  firstFrameMs: null,
+  message: "",
+};
+
+function stream(camera, task) {
+  const key = `${camera}/${task}`;
+  let s = streams.get(key);
+  if (s) { streams.delete(key); streams.set(key, s); return s; }
+  s = new Stream(base, S.db, camera, task);
+  streams.set(key, s);
+  while (streams.size > MAX_STREAMS) {
+    const [k, old] = streams.entries().next().value;
+    streams.delete(k);
+    old.close();
+  }
+  return s;
+}
+
+// ---- clock: time stays continuous through switches ---------------------------------------------
+function currentFrame(now = performance.now()) {
+  const n = S.db.frames;
+  if (!S.playing) return S.anchorFrame;
+  let f = S.anchorFrame + Math.floor(((now - S.anchorTime) / 1000) * S.db.fps * S.speed);
+  if (f >= n) {
+    if (S.loop) f %= n;
+    else { f = n - 1; S.playing = false; S.anchorFrame = f; }
+  }
+  return f;
+}
+function setFrame(f) {
+  S.anchorFrame = Math.max(0, Math.min(S.db.frames - 1, f));
+  S.anchorTime = performance.now();
+}
+function setPlaying(p) {
+  const f = currentFrame();
+  S.playing = p;
+  setFrame(f);
+}
+
+// ---- navigation ---------------------------------------------------------------------------------
+const COLUMNS = ["left", "right", "up", "down", "in", "out"];
+function graphNeighbour(camera, direction) {
+  const row = S.db.graph[camera];
+  return row ? row[COLUMNS.indexOf(direction)] : -1;
+}
+/// The task at the same positions as `task` on every axis but `axis`, moved by delta there; -1 if none.
+function stepTaskOnAxis(task, axisName, delta) {
+  const pos = (t) => Object.fromEntries(S.db.tasks[t].axes.map((a) => [a.axis, a.index]));
+  const from = pos(task);
+  if (!(axisName in from)) return -1;
+  for (let t = 0; t < S.db.tasks.length; t++) {
+    const p = pos(t);
+    if (p[axisName] !== from[axisName] + delta) continue;
+    if (Object.keys(from).every((k) => k === axisName || p[k] === from[k]) && Object.keys(p).length === Object.keys(from).length)
+      return t;
+  }
+  return -1;
+}
+function neighbourSelections(camera, task) {
+  const out = [];
+  for (const dir of COLUMNS) {
+    const c = graphNeighbour(camera, dir);
+    if (c >= 0) out.push([c, task]);
+  }
+  const T = S.db.tasks.length;
+  if (T > 1) out.push([camera, (task + 1) % T], [camera, (task + T - 1) % T]);
+  for (const axis of S.db.axes)
+    for (const d of [1, -1]) {
+      const t = stepTaskOnAxis(task, axis.name, d);
+      if (t >= 0) out.push([camera, t]);
+    }
+  const seen = new Set();
+  return out.filter(([c, t]) => !(c === camera && t === task) && !seen.has(`${c}/${t}`) && seen.add(`${c}/${t}`));
+}
+
+function select(camera, task, command) {
+  if (camera < 0 || task < 0 || camera >= S.db.cameras.count || task >= S.db.tasks.length) return false;
+  if (camera === S.camera && task === S.task) return false;
+  S.pending = { t0: performance.now(), command, from: [S.camera, S.task] };
+  S.camera = camera;
+  S.task = task;
+  schedulePrefetch(true);
+  return true;
+}
+
+// ---- prefetch -----------------------------------------------------------------------------------
+let queue = [];
+let lastScheduled = "";
+let activeWorkers = 0;
+function schedulePrefetch(force = false) {
+  if (!options.prefetch) return;
+  const f = currentFrame(), n = S.db.frames;
+  const next = S.playing ? (f + 1) % n : f;
+  const key = `${S.camera}/${S.task}/${f}`;
+  if (!force && key === lastScheduled) return;
+  lastScheduled = key;
+  const nb = neighbourSelections(S.camera, S.task);
+  const jobs = [[S.camera, S.task, next]];
+  for (const [c, t] of nb) jobs.push([c, t, next]);
+  if (S.playing) for (let k = 2; k <= options.readAhead + 1; k++) jobs.push([S.camera, S.task, (f + k) % n]);
+  for (const [c, t] of nb) jobs.push([c, t, f]);
+  queue = jobs.filter(([c, t, fr]) => !cache.has(`${c}/${t}/${fr}`));  // replaced, not appended
+  while (activeWorkers < options.workers && queue.length) runWorker();
+}
+async function runWorker() {
+  activeWorkers++;
+  while (queue.length) {
+    const [c, t, f] = queue.shift();
+    if (cache.has(`${c}/${t}/${f}`)) continue;
+    await stream(c, t).ensure(f, cache);
+  }
+  activeWorkers--;
+}
+
+// ---- drawing ------------------------------------------------------------------------------------
+function drawPlaceholder(camera, task, status, message) {
+  const w = canvas.width, h = canvas.height;
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.fillStyle = "#4a0d0d";
+  ctx.fillRect(0, 0, w, h);
+  const b = Math.max(3, Math.round(Math.min(w, h) / 60));
+  ctx.strokeStyle = "#f2c500";
+  ctx.lineWidth = b;
+  ctx.strokeRect(b / 2, b / 2, w - b, h - b);
+  ctx.fillStyle = "#f2c500";
+  ctx.textAlign = "center";
+  ctx.textBaseline = "middle";
+  ctx.font = `bold ${Math.round(Math.min(w, h) / 9)}px sans-serif`;
+  ctx.fillText(`STREAM ${status.toUpperCase()}`, w / 2, h / 2 - h / 10);
+  ctx.font = `${Math.round(Math.min(w, h) / 18)}px sans-serif`;
+  ctx.fillText(`camera ${camera} · task ${task}`, w / 2, h / 2 + h / 12);
+  S.message = message;
+}
+function drawFrame(vf) {
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.fillStyle = "#000";
+  if (S.zoom !== 1) ctx.fillRect(0, 0, canvas.width, canvas.height);
+  ctx.setTransform(S.zoom, 0, 0, S.zoom, S.panX, S.panY);
+  ctx.drawImage(vf, 0, 0, canvas.width, canvas.height);
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+}
+
+let demanded = "";
+function tick() {
+  requestAnimationFrame(tick);
+  if (!S.db) return;
+  const frame = currentFrame();
+  const st = stream(S.camera, S.task);
+  const key = `${S.camera}/${S.task}/${frame}`;
+  const same = S.shown && S.shown.camera === S.camera && S.shown.task === S.task && S.shown.frame === frame;
+  let drawn = false, hit = false, status = "ok";
+  if (!same || S.shown.status === "waiting") {
+    const vf = cache.get(key);
+    if (vf) {
+      drawFrame(vf);
+      drawn = true;
+      hit = demanded !== key;
+      S.message = "";
+    } else if (st.status === "missing" || st.status === "unreadable") {
+      status = st.status;
+      drawPlaceholder(S.camera, S.task, status, st.message);
+      drawn = true;
+    } else if (st.status === "ok" && st.fragmentOf(frame) < 0) {
+      status = "unreadable";
+      drawPlaceholder(S.camera, S.task, status, `${st.url}: truncated before frame ${frame}`);
+      drawn = true;
+    } else if (demanded !== key) {
+      demanded = key;  // decode on demand, ahead of the prefetch queue
+      st.ensure(frame, cache);
+    }
+  }
+  if (drawn) {
+    const now = performance.now();
+    S.shown = { camera: S.camera, task: S.task, frame, status };
+    if (S.firstFrameMs === null) S.firstFrameMs = now;
+    if (S.pending) {
+      S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit });
+      S.pending = null;
+    }
+    drawMinimap();
+  } else if (!same && S.shown) {
+    S.shown = { ...S.shown, status: S.shown.status === "ok" ? "ok" : S.shown.status };
+  }
+  schedulePrefetch();
+  updateHud(frame);
+}
+
+function updateHud(frame) {
+  const db = S.db, c = S.camera, task = db.tasks[S.task];
+  const last = S.switches[S.switches.length - 1];
+  const axes = task.axes.map((a) => `${a.axis}=${db.axes.find((x) => x.name === a.axis)?.values[a.index]}`).join(" ");
+  const active = db.axes[S.axis] ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
+  hud.textContent =
+    `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "▶" : "⏸"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
+    `camera ${c}  lat ${db.cameras.lat_deg[c].toFixed(1)}°  lon ${db.cameras.lon_deg[c].toFixed(1)}°  shell ${db.cameras.shell[c]}\n` +
+    `task ${S.task} "${task.name}" ${axes}  ${active}\n` +
+    `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (prefetched)" : " (decoded on demand)") : "—"}` +
+    `  zoom ${S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
+  statusLine.textContent = S.message;
+}
+
+// ---- mini-map: cameras by longitude (x) and latitude (y); click picks the nearest -------------
+function mapXY(i) {
+  const w = minimap.width, h = minimap.height;
+  return [((S.db.cameras.lon_deg[i] + 180) / 360) * w, ((90 - S.db.cameras.lat_deg[i]) / 180) * h];
+}
+function drawMinimap() {
+  const w = minimap.width, h = minimap.height, n = S.db.cameras.count;
+  mapCtx.fillStyle = "rgba(10,14,22,0.85)";
+  mapCtx.fillRect(0, 0, w, h);
+  mapCtx.strokeStyle = "#334";
+  mapCtx.beginPath();
+  mapCtx.moveTo(0, h / 2); mapCtx.lineTo(w, h / 2); mapCtx.moveTo(w / 2, 0); mapCtx.lineTo(w / 2, h);
+  mapCtx.stroke();
+  const shell = S.db.cameras.shell[S.camera];
+  const nb = new Set(COLUMNS.map((d) => graphNeighbour(S.camera, d)));
+  const radius = n > 2000 ? 1 : n > 300 ? 2 : 3;
+  for (let i = 0; i < n; i++) {
+    const [x, y] = mapXY(i);
+    mapCtx.fillStyle = S.db.cameras.shell[i] !== shell ? "#445" : nb.has(i) ? "#6cf" : "#9aa";
+    mapCtx.fillRect(x - radius / 2, y - radius / 2, radius, radius);
+  }
+  const [x, y] = mapXY(S.camera);
+  mapCtx.strokeStyle = "#ff4";
+  mapCtx.lineWidth = 2;
+  mapCtx.beginPath();
+  mapCtx.arc(x, y, 6, 0, 2 * Math.PI);
+  mapCtx.stroke();
+}
+minimap.addEventListener("click", (e) => {
+  const r = minimap.getBoundingClientRect();
+  const px = ((e.clientX - r.left) / r.width) * minimap.width, py = ((e.clientY - r.top) / r.height) * minimap.height;
+  let best = -1, bestD = Infinity;
+  for (let i = 0; i < S.db.cameras.count; i++) {
+    const [x, y] = mapXY(i);
+    const d = (x - px) ** 2 + (y - py) ** 2;
+    if (d < bestD) { bestD = d; best = i; }
+  }
+  if (best >= 0) select(best, S.task, "minimap");
+});
+
+// ---- keys, wheel, drag --------------------------------------------------------------------------
+function zoomAt(factor, px, py) {
+  const z = Math.max(1, Math.min(16, S.zoom * factor));
+  const f = z / S.zoom;
+  S.panX = px - (px - S.panX) * f;
+  S.panY = py - (py - S.panY) * f;
+  S.zoom = z;
+  if (z === 1) { S.panX = 0; S.panY = 0; }
+  S.shown = null;  // redraw
+}
+const actions = {
+  ArrowLeft: () => select(graphNeighbour(S.camera, "left"), S.task, "left"),
+  ArrowRight: () => select(graphNeighbour(S.camera, "right"), S.task, "right"),
+  ArrowUp: () => select(graphNeighbour(S.camera, "up"), S.task, "up"),
+  ArrowDown: () => select(graphNeighbour(S.camera, "down"), S.task, "down"),
+  z: () => select(graphNeighbour(S.camera, "in"), S.task, "in"),
+  x: () => select(graphNeighbour(S.camera, "out"), S.task, "out"),
+  Tab: (e) => select(S.camera, (S.task + (e.shiftKey ? S.db.tasks.length - 1 : 1)) % S.db.tasks.length, e.shiftKey ? "previous task" : "next task"),
+  PageUp: () => S.db.axes[S.axis] && select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, 1), "axis +1"),
+  PageDown: () => S.db.axes[S.axis] && select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, -1), "axis -1"),
+  a: () => { if (S.db.axes.length) S.axis = (S.axis + 1) % S.db.axes.length; },
+  " ": () => setPlaying(!S.playing),
+  ".": () => { S.playing = false; setFrame((currentFrame() + 1) % S.db.frames); },
+  ",": () => { S.playing = false; setFrame((currentFrame() + S.db.frames - 1) % S.db.frames); },
+  Home: () => setFrame(0),
+  End: () => setFrame(S.db.frames - 1),
+  l: () => { S.loop = !S.loop; },
+  ">": () => { const f = currentFrame(); S.speed = Math.min(8, S.speed * 2); setFrame(f); },
+  "<": () => { const f = currentFrame(); S.speed = Math.max(0.25, S.speed / 2); setFrame(f); },
+  "+": () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
+  "=": () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
+  "-": () => zoomAt(0.8, canvas.width / 2, canvas.height / 2),
+  0: () => zoomAt(1 / S.zoom, 0, 0),
+  "]": () => actions.PageUp(),
+  "[": () => actions.PageDown(),
+  h: () => document.getElementById("help").classList.toggle("hidden"),
+};
+for (let k = 1; k <= 9; k++) actions[String(k)] = () => select(S.camera, k - 1, `task ${k}`);
+document.addEventListener("keydown", (e) => {
+  if (!S.db) return;
+  const action = actions[e.key] ?? actions[e.key.toLowerCase()];
+  if (!action || e.ctrlKey || e.metaKey || e.altKey) return;
+  e.preventDefault();
+  action(e);
+});
+canvas.addEventListener("wheel", (e) => {
+  e.preventDefault();
+  const r = canvas.getBoundingClientRect();
+  zoomAt(e.deltaY < 0 ? 1.15 : 1 / 1.15, ((e.clientX - r.left) / r.width) * canvas.width, ((e.clientY - r.top) / r.height) * canvas.height);
+}, { passive: false });
+
+let dragLast = null;
+const dirs = () => S._dirs ?? (S._dirs = cameraDirections(S.db.cameras));
+function cameraVec(col, c) { return [0, 1, 2].map((k) => S.db.cameras[col][3 * c + k]); }
+canvas.addEventListener("pointerdown", (e) => {
+  if (e.button !== 0 || !S.db) return;
+  canvas.setPointerCapture(e.pointerId);
+  drag.begin(cameraVec("position", S.camera), cameraVec("up", S.camera), cameraVec("look_at", S.camera));
+  dragLast = [e.clientX, e.clientY];
+});
+canvas.addEventListener("pointermove", (e) => {
+  if (!drag.active || !dragLast) return;
+  drag.move(e.clientX - dragLast[0], e.clientY - dragLast[1], canvas.getBoundingClientRect().height);
+  dragLast = [e.clientX, e.clientY];
+  const c = nearestCamera(dirs(), S.db.cameras.shell, drag.dir, S.db.cameras.shell[S.camera]);
+  if (c >= 0) select(c, S.task, "drag");
+});
+const endDrag = () => { drag.end(); dragLast = null; };
+canvas.addEventListener("pointerup", endDrag);
+canvas.addEventListener("pointercancel", endDrag);
+
+// ---- start --------------------------------------------------------------------------------------
+async function main() {
+  if (!("VideoDecoder" in window)) {
+    statusLine.textContent = "This browser has no WebCodecs VideoDecoder (Chromium 94+, Firefox 130+, Safari 16.4+).";
+    return;
+  }
+  const res = await fetch(base + "api/database.json", { cache: "no-store" });
+  if (!res.ok) {
+    statusLine.textContent = `cannot load the database: HTTP ${res.status} ${res.status === 401 ? "(open the URL with ?token=...)" : ""}`;
+    return;
+  }
+  const db = await res.json();
+  canvas.width = db.image.width;
+  canvas.height = db.image.height;
+  document.title = `${db.title || "Panoptes"} — Panoptes web player`;
+  document.getElementById("title").textContent =
+    `${db.title}: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames (${db.status})`;
+  S.camera = Math.min(Number(params.get("camera") || 0), db.cameras.count - 1);
+  S.task = Math.min(Number(params.get("task") || 0), db.tasks.length - 1);
+  S.anchorFrame = Math.min(Number(params.get("frame") || 0), db.frames - 1);
+  S.anchorTime = performance.now();
+  S.db = db;
+  requestAnimationFrame(tick);
+}
+
+/// For tests and the benchmark (headless Chromium through puppeteer).
+window.panoptes = {
+  state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, playing: S.playing, zoom: S.zoom }),
+  shown: () => S.shown,
+  switches: () => S.switches,
+  traffic: () => ({ ...traffic }),
+  firstFrameMs: () => S.firstFrameMs,
+  options,
+  /// The stamp in the canvas pixels (zoom 1 only), or null.
+  readStamp: () => {
+    const w = canvas.width, h = canvas.height, b = stampBlock(w, h);
+    const img = ctx.getImageData(0, 0, STAMP_COLUMNS * b, STAMP_ROWS * b);
+    return readStamp(img.data, img.width, w, h);
+  },
+  select: (camera, task) => select(camera, task, "api"),
+  cameraDirections: () => Array.from(dirs()),
+};
+
+main().catch((e) => { statusLine.textContent = `error: ${e.message}`; });

@@ -1,0 +1,215 @@
+// Drives the web player in headless Chromium (see browser_test.sh). Every check reads the frame
+// stamp back from the canvas pixels, so it fails when the player shows the wrong (camera, task, frame).
+import { createRequire } from "node:module";
+import assert from "node:assert/strict";
+
+const [serveUrl, staticUrl, chromium, nodeModules] = process.argv.slice(2);
+const require = createRequire(nodeModules + "/");
+const puppeteer = require("puppeteer-core");
+
+const browser = await puppeteer.launch({
+  executablePath: chromium,
+  headless: true,
+  args: ["--no-sandbox", "--disable-dev-shm-usage", "--autoplay-policy=no-user-gesture-required"],
+});
+let failures = 0;
+async function check(name, fn) {
+  const t0 = Date.now();
+  try {
+    await fn();
+    console.log(`ok   ${name} (${Date.now() - t0} ms)`);
+  } catch (e) {
+    failures++;
+    console.log(`FAIL ${name}: ${e.message}`);
+  }
+}
+
+async function open(url) {
+  const page = await browser.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(e.message));
+  page.on("console", (m) => m.type() === "error" && errors.push(m.text()));
+  await page.goto(url);
+  await page.waitForFunction(() => window.panoptes && window.panoptes.shown(), { timeout: 20000 });
+  return { page, errors };
+}
+
+/// Waits until the canvas shows (camera, task, frame) and its pixels carry that stamp.
+async function expectShown(page, camera, task, frame, what) {
+  try {
+    await page.waitForFunction(
+      (c, t, f) => {
+        const s = window.panoptes.shown();
+        return s && s.camera === c && s.task === t && (f === null || s.frame === f);
+      },
+      { timeout: 10000 }, camera, task, frame);
+  } catch {
+    const s = await page.evaluate(() => window.panoptes.shown());
+    throw new Error(`${what}: expected (${camera}, ${task}, ${frame}) on screen, shows ${JSON.stringify(s)}`);
+  }
+  const { shown, stamp } = await page.evaluate(() => ({ shown: window.panoptes.shown(), stamp: window.panoptes.readStamp() }));
+  assert.deepEqual(stamp, { camera: shown.camera, task: shown.task, frame: shown.frame }, `${what}: stamp in the canvas pixels`);
+  return shown;
+}
+
+const db = await (await fetch(serveUrl + "api/database.json", { headers: { Authorization: "Bearer t0k3n" } })).json();
+const [L, R, U, D] = [0, 1, 2, 3];
+const graph = db.graph;
+
+await check("keys: every command shows the expected stamp", async () => {
+  const { page, errors } = await open(serveUrl + "&play=0");
+  await expectShown(page, 0, 0, 0, "start");
+  let c = 0;
+  for (const [key, col] of [["ArrowRight", R], ["ArrowRight", R], ["ArrowLeft", L], ["ArrowUp", U], ["ArrowDown", D]]) {
+    if (graph[c][col] < 0) continue;
+    c = graph[c][col];
+    await page.keyboard.press(key);
+    await expectShown(page, c, 0, 0, key);
+  }
+  await page.keyboard.press("Tab");
+  await expectShown(page, c, 1, 0, "Tab");
+  await page.keyboard.down("Shift");
+  await page.keyboard.press("Tab");
+  await page.keyboard.up("Shift");
+  await expectShown(page, c, 0, 0, "Shift+Tab");
+  await page.keyboard.press("PageUp");  // isovalue axis +1 = task 1
+  await expectShown(page, c, 1, 0, "PageUp");
+  await page.keyboard.press("PageUp");
+  await expectShown(page, c, 2, 0, "PageUp");
+  await page.keyboard.press("PageDown");
+  await expectShown(page, c, 1, 0, "PageDown");
+  for (let f = 1; f <= 5; f++) {  // through a fragment boundary (gop 4): delta frames decode too
+    await page.keyboard.press(".");
+    await expectShown(page, c, 1, f, ". step");
+  }
+  await page.keyboard.press(",");
+  await expectShown(page, c, 1, 4, ", step");
+  await page.keyboard.press("End");
+  await expectShown(page, c, 1, db.frames - 1, "End");
+  await page.keyboard.press("Home");
+  await expectShown(page, c, 1, 0, "Home");
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+await check("playback: frames advance and switches during playback show the right stamp", async () => {
+  const { page } = await open(serveUrl + "&play=1");
+  await expectShown(page, 0, 0, null, "start");
+  const f0 = (await page.evaluate(() => window.panoptes.shown())).frame;
+  await page.waitForFunction((f) => window.panoptes.shown().frame !== f, { timeout: 5000 }, f0);
+  let c = 0;
+  for (let i = 0; i < 4; i++) {
+    c = graph[c][R];
+    await page.keyboard.press("ArrowRight");
+    await expectShown(page, c, 0, null, "ArrowRight while playing");
+    await new Promise((r) => setTimeout(r, 150));
+  }
+  await page.keyboard.press("Tab");
+  await expectShown(page, c, 1, null, "Tab while playing");
+  const switches = await page.evaluate(() => window.panoptes.switches());
+  assert.equal(switches.length, 5);
+  await page.keyboard.press(" ");  // pause: the frame stays
+  const paused = (await page.evaluate(() => window.panoptes.state())).frame;
+  await new Promise((r) => setTimeout(r, 300));
+  assert.equal((await page.evaluate(() => window.panoptes.state())).frame, paused, "Space pauses");
+  await page.close();
+});
+
+await check("drag snaps to the camera nearest the dragged direction", async () => {
+  const { page } = await open(serveUrl + "&play=0");
+  await expectShown(page, 0, 0, 0, "start");
+  const box = await (await page.$("#view")).boundingBox();
+  const dx = box.height / 4;  // 45 degrees of orbit
+  // Expected (independent of the page's code): rotate the camera's direction about its up vector by
+  // -dx * 180 / height degrees, then the camera with the largest dot product.
+  const at = (col, i) => [0, 1, 2].map((k) => db.cameras[col][3 * i + k]);
+  const norm = (v) => { const n = Math.hypot(...v); return v.map((x) => x / n); };
+  const d = norm(at("position", 0).map((x, k) => x - at("look_at", 0)[k]));
+  let up = at("up", 0);
+  const du = d.reduce((s, x, k) => s + x * up[k], 0);
+  up = norm(up.map((x, k) => x - du * d[k]));
+  const a = (-dx * Math.PI) / box.height;
+  const cr = [up[1] * d[2] - up[2] * d[1], up[2] * d[0] - up[0] * d[2], up[0] * d[1] - up[1] * d[0]];
+  const ud = up.reduce((s, x, k) => s + x * d[k], 0);
+  const nd = d.map((x, k) => x * Math.cos(a) + cr[k] * Math.sin(a) + up[k] * ud * (1 - Math.cos(a)));
+  let best = -1, bestDot = -2;
+  for (let i = 0; i < db.cameras.count; i++) {
+    const v = norm(at("position", i).map((x, k) => x - at("look_at", i)[k]));
+    const dot = v.reduce((s, x, k) => s + x * nd[k], 0);
+    if (dot > bestDot) { bestDot = dot; best = i; }
+  }
+  assert.notEqual(best, 0, "the test drag must reach another camera");
+  const y = box.y + box.height / 2, x0 = box.x + box.width / 2 - dx / 2;
+  await page.mouse.move(x0, y);
+  await page.mouse.down();
+  await page.mouse.move(x0 + dx, y, { steps: 12 });
+  await page.mouse.up();
+  await expectShown(page, best, 0, 0, "drag");
+  await page.close();
+});
+
+await check("mini-map click, wheel zoom", async () => {
+  const { page } = await open(serveUrl + "&play=0");
+  await expectShown(page, 0, 0, 0, "start");
+  const target = 3;
+  const box = await (await page.$("#minimap")).boundingBox();
+  const x = box.x + ((db.cameras.lon_deg[target] + 180) / 360) * box.width;
+  const y = box.y + ((90 - db.cameras.lat_deg[target]) / 180) * box.height;
+  await page.mouse.click(x, y);
+  await expectShown(page, target, 0, 0, "mini-map click");
+  const view = await (await page.$("#view")).boundingBox();
+  await page.mouse.move(view.x + view.width / 2, view.y + view.height / 2);
+  await page.mouse.wheel({ deltaY: -200 });
+  await page.waitForFunction(() => window.panoptes.state().zoom > 1, { timeout: 3000 });
+  await page.keyboard.press("0");
+  await page.waitForFunction(() => window.panoptes.state().zoom === 1, { timeout: 3000 });
+  await page.keyboard.press(".");
+  await expectShown(page, target, 0, 1, "after zoom reset");
+  await page.close();
+});
+
+await check("missing and corrupt movies show a placeholder and playback goes on", async () => {
+  const { page } = await open(serveUrl + "&play=0&camera=5&task=0");
+  await expectShown(page, 5, 0, 0, "start");
+  await page.keyboard.press("Tab");  // (5, 1) is missing
+  await page.waitForFunction(() => window.panoptes.shown().task === 1, { timeout: 10000 });
+  let s = await page.evaluate(() => ({ shown: window.panoptes.shown(), stamp: window.panoptes.readStamp(), msg: document.getElementById("status").textContent }));
+  assert.equal(s.shown.status, "missing");
+  assert.equal(s.stamp, null);
+  assert.match(s.msg, /c5\/t1\.mp4/);
+  await page.keyboard.press(" ");  // play: the frame moves on under the placeholder
+  await page.waitForFunction(() => window.panoptes.shown().frame >= 3, { timeout: 5000 });
+  await page.keyboard.press("Tab");  // (5, 2) plays again
+  await expectShown(page, 5, 2, null, "after the missing stream");
+  await page.evaluate(() => window.panoptes.select(4, 0));  // corrupt
+  await page.waitForFunction(() => window.panoptes.shown().camera === 4, { timeout: 10000 });
+  s = await page.evaluate(() => window.panoptes.shown());
+  assert.equal(s.status, "unreadable");
+  const f = s.frame;
+  await page.waitForFunction((f0) => window.panoptes.shown().frame !== f0, { timeout: 5000 }, f);
+  await page.close();
+});
+
+await check("without the token nothing is served", async () => {
+  const context = await browser.createBrowserContext();
+  const page = await context.newPage();
+  const res = await page.goto(serveUrl.replace(/\?token=.*/, ""));
+  assert.equal(res.status(), 401);
+  await context.close();
+});
+
+await check("export-web on a static server (no byte ranges) plays the same stamps", async () => {
+  const { page } = await open(staticUrl + "?play=0");
+  await expectShown(page, 0, 0, 0, "start");
+  await page.keyboard.press("ArrowRight");
+  await expectShown(page, graph[0][R], 0, 0, "ArrowRight");
+  await page.keyboard.press("Tab");
+  await expectShown(page, graph[0][R], 1, 0, "Tab");
+  await page.close();
+});
+
+await browser.close();
+if (failures) {
+  console.log(`${failures} browser check(s) failed`);
+  process.exit(1);
+}

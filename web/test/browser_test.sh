@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Browser tests of the web player: headless Chromium (Debian's) driven by puppeteer-core against
+# `panoptes serve` on a stamped synthetic database with one missing and one corrupt movie, then the
+# same player exported by `panoptes export-web` behind a plain static server (python3 http.server,
+# which ignores byte ranges).
+#   browser_test.sh PANOPTES NODE_MODULES CHROMIUM
+set -euo pipefail
+panoptes=$1 node_modules=$2 chromium=$3
+here=$(cd "$(dirname "$0")" && pwd)
+tmp=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+
+"$panoptes" synth-db "$tmp/db" --cameras 8 --tasks 3 --frames 24 --size 160x120 --gop 4 >/dev/null
+rm "$tmp/db/movies/c5/t1.mp4"                                   # missing
+head -c 3000 /dev/urandom > "$tmp/db/movies/c4/t0.mp4"          # corrupt
+
+"$panoptes" serve "$tmp/db" --port 0 --token t0k3n > "$tmp/serve.log" 2>&1 &
+pids+=($!)
+url=""
+for _ in $(seq 100); do
+  url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$tmp/serve.log")
+  [ -n "$url" ] && break
+  sleep 0.1
+done
+[ -n "$url" ] || { echo "serve did not start:"; cat "$tmp/serve.log"; exit 1; }
+
+"$panoptes" export-web "$tmp/db" "$tmp/site" >/dev/null
+port=$((20000 + RANDOM % 20000))
+(cd "$tmp/site" && exec /usr/bin/python3 -m http.server "$port" --bind 127.0.0.1) > "$tmp/static.log" 2>&1 &
+pids+=($!)
+
+export NODE_PATH=$node_modules
+if ! node "$here/browser_test.mjs" "$url" "http://127.0.0.1:$port/" "$chromium" "$node_modules"; then
+  echo "--- serve log (last 30 lines)"; tail -30 "$tmp/serve.log"
+  exit 1
+fi
+# The server logged the refused request of the test's token-less context.
+grep -q " 401 refused: missing or wrong token" "$tmp/serve.log" || { echo "no 401 log line"; exit 1; }
