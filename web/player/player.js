@@ -310,7 +310,7 @@ const actions = {
   "+": () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
   "=": () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
   "-": () => zoomAt(0.8, canvas.width / 2, canvas.height / 2),
-  0: () => zoomAt(1 / S.zoom, 0, 0),
+  0: () => { S.zoom = 1; S.panX = S.panY = 0; S.shown = null; },
   "]": () => actions.PageUp(),
   "[": () => actions.PageDown(),
   h: () => document.getElementById("help").classList.toggle("hidden"),
@@ -363,6 +363,14 @@ async function main() {
   const db = await res.json();
   canvas.width = db.image.width;
   canvas.height = db.image.height;
+  // Frames are shown as large as the window allows (small renders are common: the demo's are 256x224).
+  const fit = () => {
+    const s = Math.max(0.1, Math.min((innerWidth - 20) / db.image.width, (innerHeight - 110) / db.image.height));
+    canvas.style.width = `${Math.floor(db.image.width * s)}px`;
+    canvas.style.height = `${Math.floor(db.image.height * s)}px`;
+  };
+  fit();
+  addEventListener("resize", fit);
   document.title = `${db.title || "Panoptes"} — Panoptes web player`;
   document.getElementById("title").textContent =
     `${db.title}: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames (${db.status})`;
@@ -390,6 +398,7 @@ window.panoptes = {
   },
   select: (camera, task) => select(camera, task, "api"),
   cameraDirections: () => Array.from(dirs()),
+  dragDirection: () => drag.dir,
 };
 
 main().catch((e) => { statusLine.textContent = `error: ${e.message}`; });

@@ -3,7 +3,9 @@
 import { createRequire } from "node:module";
 import assert from "node:assert/strict";
 
-const [serveUrl, staticUrl, chromium, nodeModules] = process.argv.slice(2);
+const [serveArg, staticUrl, chromium, nodeModules] = process.argv.slice(2);
+const serveBase = serveArg.replace(/\?.*/, "");  // the URL printed by serve, without ?token=
+const serveUrl = serveArg;
 const require = createRequire(nodeModules + "/");
 const puppeteer = require("puppeteer-core");
 
@@ -20,7 +22,7 @@ async function check(name, fn) {
     console.log(`ok   ${name} (${Date.now() - t0} ms)`);
   } catch (e) {
     failures++;
-    console.log(`FAIL ${name}: ${e.message}`);
+    console.log(`FAIL ${name}: ${e.message.split("\n").slice(0, 12).join(" | ")}`);
   }
 }
 
@@ -28,7 +30,8 @@ async function open(url) {
   const page = await browser.newPage();
   const errors = [];
   page.on("pageerror", (e) => errors.push(e.message));
-  page.on("console", (m) => m.type() === "error" && errors.push(m.text()));
+  // Fetches of the missing and corrupt movies' indexes fail by design (404/422): not an error here.
+  page.on("console", (m) => m.type() === "error" && !/status of 40[4]|status of 422/.test(m.text()) && errors.push(m.text()));
   await page.goto(url);
   await page.waitForFunction(() => window.panoptes && window.panoptes.shown(), { timeout: 20000 });
   return { page, errors };
@@ -52,7 +55,7 @@ async function expectShown(page, camera, task, frame, what) {
   return shown;
 }
 
-const db = await (await fetch(serveUrl + "api/database.json", { headers: { Authorization: "Bearer t0k3n" } })).json();
+const db = await (await fetch(serveBase + "api/database.json", { headers: { Authorization: "Bearer t0k3n" } })).json();
 const [L, R, U, D] = [0, 1, 2, 3];
 const graph = db.graph;
 
@@ -98,7 +101,7 @@ await check("playback: frames advance and switches during playback show the righ
   const f0 = (await page.evaluate(() => window.panoptes.shown())).frame;
   await page.waitForFunction((f) => window.panoptes.shown().frame !== f, { timeout: 5000 }, f0);
   let c = 0;
-  for (let i = 0; i < 4; i++) {
+  for (let i = 0; i < 3; i++) {  // 0 → 1 → 2 → 3 (camera 4's movie is the corrupt one)
     c = graph[c][R];
     await page.keyboard.press("ArrowRight");
     await expectShown(page, c, 0, null, "ArrowRight while playing");
@@ -107,7 +110,7 @@ await check("playback: frames advance and switches during playback show the righ
   await page.keyboard.press("Tab");
   await expectShown(page, c, 1, null, "Tab while playing");
   const switches = await page.evaluate(() => window.panoptes.switches());
-  assert.equal(switches.length, 5);
+  assert.equal(switches.length, 4);
   await page.keyboard.press(" ");  // pause: the frame stays
   const paused = (await page.evaluate(() => window.panoptes.state())).frame;
   await new Promise((r) => setTimeout(r, 300));
@@ -193,7 +196,7 @@ await check("missing and corrupt movies show a placeholder and playback goes on"
 await check("without the token nothing is served", async () => {
   const context = await browser.createBrowserContext();
   const page = await context.newPage();
-  const res = await page.goto(serveUrl.replace(/\?token=.*/, ""));
+  const res = await page.goto(serveBase);
   assert.equal(res.status(), 401);
   await context.close();
 });

@@ -5,7 +5,7 @@
 # which ignores byte ranges).
 #   browser_test.sh PANOPTES NODE_MODULES CHROMIUM
 set -euo pipefail
-panoptes=$1 node_modules=$2 chromium=$3
+panoptes=$(realpath "$1") node_modules=$(realpath "$2") chromium=$3
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
 pids=()
