@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Browser tests of the web player: headless Chromium (Debian's) driven by puppeteer-core against
 # `panoptes serve` on a stamped synthetic database with one missing and one corrupt movie, then the
-# same player exported by `panoptes export-web` behind a plain static server (python3 http.server,
-# which ignores byte ranges).
+# same player exported by `panoptes export-web` behind a plain static file server that ignores byte
+# ranges (started by browser_test.mjs).
 #   browser_test.sh PANOPTES NODE_MODULES CHROMIUM
 set -euo pipefail
 panoptes=$(realpath "$1") node_modules=$(realpath "$2") chromium=$3
@@ -31,12 +31,9 @@ done
 [ -n "$url" ] || { echo "serve did not start:"; cat "$tmp/serve.log"; exit 1; }
 
 "$panoptes" export-web "$tmp/db" "$tmp/site" >/dev/null
-port=$((20000 + RANDOM % 20000))
-(cd "$tmp/site" && exec /usr/bin/python3 -m http.server "$port" --bind 127.0.0.1) > "$tmp/static.log" 2>&1 &
-pids+=($!)
 
 export NODE_PATH=$node_modules
-if ! node "$here/browser_test.mjs" "$url" "http://127.0.0.1:$port/" "$chromium" "$node_modules"; then
+if ! node "$here/browser_test.mjs" "$url" "$tmp/site" "$chromium" "$node_modules"; then
   echo "--- serve log (last 30 lines)"; tail -30 "$tmp/serve.log"
   exit 1
 fi
