@@ -141,25 +141,36 @@ export class Stream {
     return f.length && frame >= f[lo][2] && frame < f[lo][2] + f[lo][3] ? lo : -1;
   }
 
-  /// Decodes the fragment holding `frame` into the cache (every frame of it); resolves when done.
-  async ensure(frame, cache) {
+  /// Decodes the fragment holding `frame`, and the following ones up to `batchFrames` frames, into
+  /// the cache: one range request and one decoder flush for the lot (with intra-only movies a
+  /// fragment is one frame, and a request per frame costs more than the decode). Resolves when done.
+  async ensure(frame, cache, batchFrames = 4) {
     await this.open();
     if (this.status !== "ok") return;
     const n = this.fragmentOf(frame);
     if (n < 0) return;  // beyond a truncated movie's end: the player shows its placeholder
     if (!this.inflight.has(n)) {
-      const p = (this.chain = this.chain.then(() => this._decodeFragment(n, cache)));
-      this.inflight.set(n, p);
-      p.finally(() => this.inflight.delete(n));
+      const f = this.index.fragments;
+      let m = n + 1;
+      while (m < f.length && f[m][2] + f[m][3] - f[n][2] <= batchFrames && !this.inflight.has(m) &&
+             !cache.has(`${this.camera}/${this.task}/${f[m][2]}`)) m++;
+      const p = (this.chain = this.chain.then(() => this._decodeFragments(n, m, cache)));
+      for (let k = n; k < m; k++) {
+        this.inflight.set(k, p);
+      }
+      p.finally(() => { for (let k = n; k < m; k++) if (this.inflight.get(k) === p) this.inflight.delete(k); });
     }
     return this.inflight.get(n);
   }
 
-  async _decodeFragment(n, cache) {
-    const [offset, size, first] = this.index.fragments[n];
-    if (cache.has(`${this.camera}/${this.task}/${first}`)) return;  // decoded meanwhile
+  /// Fragments [n, m): contiguous in the file, so one range; init + those fragments is itself a valid
+  /// fragmented MP4 for mp4box.js (offsets are relative to each moof).
+  async _decodeFragments(n, m, cache) {
+    const f = this.index.fragments;
+    const first = f[n][2];
+    if (cache.has(`${this.camera}/${this.task}/${first}`) && m === n + 1) return;  // decoded meanwhile
     try {
-      const bytes = await fetchBytes(this.url, [offset, offset + size]);
+      const bytes = await fetchBytes(this.url, [f[n][0], f[m - 1][0] + f[m - 1][1]]);
       const { samples } = await demux(this.init, bytes);
       if (!this.decoder || this.decoder.state === "closed") {
         this.decoder = new VideoDecoder({
@@ -175,7 +186,7 @@ export class Stream {
       if (this.decodeError) throw this.decodeError;
     } catch (e) {
       this.status = "unreadable";
-      this.message = `${this.url}: fragment ${n}: ${e.message || e}`;
+      this.message = `${this.url}: fragments ${n}..${m - 1}: ${e.message || e}`;
       if (this.decoder && this.decoder.state !== "closed") this.decoder.close();
     }
   }

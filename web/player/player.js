@@ -115,6 +115,8 @@ function neighbourSelections(camera, task) {
 function select(camera, task, command) {
   if (camera < 0 || task < 0 || camera >= S.db.cameras.count || task >= S.db.tasks.length) return false;
   if (camera === S.camera && task === S.task) return false;
+  // A switch not yet on screen when the next one comes is recorded as superseded (never shown).
+  if (S.pending) S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: null, hit: false, superseded: true });
   S.pending = { t0: performance.now(), command, from: [S.camera, S.task] };
   S.camera = camera;
   S.task = task;
@@ -187,8 +189,8 @@ function tick() {
   const st = stream(S.camera, S.task);
   const key = `${S.camera}/${S.task}/${frame}`;
   const same = S.shown && S.shown.camera === S.camera && S.shown.task === S.task && S.shown.frame === frame;
-  let drawn = false, hit = false, status = "ok";
-  if (!same || S.shown.status === "waiting") {
+  let drawn = false, hit = false, status = "ok", shownFrame = frame;
+  if (!same) {
     const vf = cache.get(key);
     if (vf) {
       drawFrame(vf);
@@ -203,22 +205,37 @@ function tick() {
       status = "unreadable";
       drawPlaceholder(S.camera, S.task, status, `${st.url}: truncated before frame ${frame}`);
       drawn = true;
-    } else if (demanded !== key) {
-      demanded = key;  // decode on demand, ahead of the prefetch queue
-      st.ensure(frame, cache);
+    } else {
+      if (demanded !== key) {
+        demanded = key;  // decode on demand, ahead of the prefetch queue
+        st.ensure(frame, cache);
+      }
+      // The engine waits for the frame it needs; here the clock runs on meanwhile, so when a frame of
+      // this stream decoded on demand arrives late, show it rather than keep the old stream on screen.
+      if (S.playing) {
+        for (let back = 1; back <= 3; back++) {
+          const g = (frame - back + S.db.frames) % S.db.frames;
+          if (S.shown && S.shown.camera === S.camera && S.shown.task === S.task && S.shown.frame === g) break;
+          const late = cache.get(`${S.camera}/${S.task}/${g}`);
+          if (late) {
+            drawFrame(late);
+            drawn = true;
+            shownFrame = g;
+            break;
+          }
+        }
+      }
     }
   }
   if (drawn) {
     const now = performance.now();
-    S.shown = { camera: S.camera, task: S.task, frame, status };
+    S.shown = { camera: S.camera, task: S.task, frame: shownFrame, status };
     if (S.firstFrameMs === null) S.firstFrameMs = now;
     if (S.pending) {
       S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit });
       S.pending = null;
     }
     drawMinimap();
-  } else if (!same && S.shown) {
-    S.shown = { ...S.shown, status: S.shown.status === "ok" ? "ok" : S.shown.status };
   }
   schedulePrefetch();
   updateHud(frame);
@@ -226,11 +243,11 @@ function tick() {
 
 function updateHud(frame) {
   const db = S.db, c = S.camera, task = db.tasks[S.task];
-  const last = S.switches[S.switches.length - 1];
+  const last = S.switches.findLast((w) => w.ms !== null);
   const axes = task.axes.map((a) => `${a.axis}=${db.axes.find((x) => x.name === a.axis)?.values[a.index]}`).join(" ");
   const active = db.axes[S.axis] ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
   hud.textContent =
-    `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "▶" : "⏸"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
+    `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
     `camera ${c}  lat ${db.cameras.lat_deg[c].toFixed(1)}°  lon ${db.cameras.lon_deg[c].toFixed(1)}°  shell ${db.cameras.shell[c]}\n` +
     `task ${S.task} "${task.name}" ${axes}  ${active}\n` +
     `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (prefetched)" : " (decoded on demand)") : "—"}` +
