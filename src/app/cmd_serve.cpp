@@ -2,6 +2,7 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <cctype>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -9,6 +10,7 @@
 #include <thread>
 
 #include "app/command.hpp"
+#include "core/error.hpp"
 #include "web/server.hpp"
 
 namespace {
@@ -24,6 +26,10 @@ struct Args {
 
 void run(const Args& a) {
   using namespace panoptes;
+  // The token goes into a URL and a cookie as it is: keep it to characters that need no escaping.
+  for (char ch : a.token)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.' && ch != '~')
+      throw Error("--token \"" + a.token + "\": expected letters, digits and - _ . ~ only");
   web::ServerOptions o;
   o.database = a.db;
   o.player_dir = web::find_player_dir();

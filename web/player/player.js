@@ -397,6 +397,23 @@ async function main() {
   S.anchorTime = performance.now();
   S.db = db;
   requestAnimationFrame(tick);
+  // A database still being written grows: re-read its manifest every 2 s and re-open the streams
+  // (their fragment indexes) when the frame count moved on.
+  const refresh = setInterval(async () => {
+    if (S.db.status !== "running") return clearInterval(refresh);
+    try {
+      const next = await (await fetch(base + "api/database.json", { cache: "no-store" })).json();
+      S.db.status = next.status;
+      if (next.frames !== S.db.frames) {
+        S.db.frames = next.frames;
+        S.db.times = next.times;
+        for (const s of streams.values()) s.close();
+        streams.clear();
+        document.getElementById("title").textContent =
+          `${next.title}: ${next.cameras.count} cameras × ${next.tasks.length} tasks, ${next.frames} frames (${next.status})`;
+      }
+    } catch { /* the server may be restarting: try again next time */ }
+  }, 2000);
 }
 
 /// For tests and the benchmark (headless Chromium through puppeteer).

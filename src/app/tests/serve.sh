@@ -12,6 +12,9 @@ trap '[ -n "$server" ] && kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
 echo "TOP-SECRET" > "$tmp/secret.txt"
 ln -s "$tmp/secret.txt" "$tmp/db/movies/leak.mp4"
 
+if "$panoptes" serve "$tmp/db" --token 'a;b' 2>"$tmp/err"; then echo "accepted a token with ';'"; exit 1; fi
+grep "^panoptes: error: --token" "$tmp/err" >/dev/null
+
 # Not a database: one error line, non-zero exit.
 if "$panoptes" serve "$tmp" --port 0 2>"$tmp/err"; then echo "served a directory without a database"; exit 1; fi
 grep "^panoptes: error: .*panoptes.json" "$tmp/err" >/dev/null || { cat "$tmp/err"; exit 1; }
