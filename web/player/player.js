@@ -13,7 +13,8 @@ const options = {
   prefetch: params.get("prefetch") !== "0",
   autoplay: params.get("play") !== "0",
   cacheFrames: Number(params.get("cache") || 240),
-  workers: Number(params.get("workers") || 3),
+  workers: Number(params.get("workers") || 4),
+  batch: Number(params.get("batch") || 8),  // frames fetched and decoded per range request
   readAhead: 2,
 };
 
@@ -148,7 +149,7 @@ async function runWorker() {
   while (queue.length) {
     const [c, t, f] = queue.shift();
     if (cache.has(`${c}/${t}/${f}`)) continue;
-    await stream(c, t).ensure(f, cache);
+    await stream(c, t).ensure(f, cache, options.batch);
   }
   activeWorkers--;
 }
@@ -208,7 +209,7 @@ function tick() {
     } else {
       if (demanded !== key) {
         demanded = key;  // decode on demand, ahead of the prefetch queue
-        st.ensure(frame, cache);
+        st.ensure(frame, cache, options.batch);
       }
       // The engine waits for the frame it needs; here the clock runs on meanwhile, so when a frame of
       // this stream decoded on demand arrives late, show it rather than keep the old stream on screen.
