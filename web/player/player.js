@@ -221,6 +221,7 @@ function tick() {
           if (late) {
             drawFrame(late);
             drawn = true;
+            hit = demanded !== `${S.camera}/${S.task}/${g}`;  // prefetched, one or more frames ago
             shownFrame = g;
             break;
           }
