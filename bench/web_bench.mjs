@@ -60,6 +60,6 @@ console.log(`Database \`${dbPath}\`: ${db.cameras.count} cameras × ${db.tasks.l
             `${db.image.width}×${db.image.height} at ${db.fps} fps (gop ${db.gop}); ${version} headless, ${reps} runs per row ` +
             `(medians; p99 range over runs); ${os.cpus()[0].model}, ${os.cpus().length} cores, load average at the end ${os.loadavg().map((x) => x.toFixed(1)).join(" ")}.`);
 console.log("");
-console.log("| prefetch | switches/run | not shown before the next switch | p50 ms | p99 ms | max ms | switches prefetched | first frame ms | kB fetched/switch | requests/switch |");
+console.log("| prefetch | switches/run | not shown before the next switch | p50 ms | p99 ms | max ms | shown on the next frame | first frame ms | kB fetched/switch | requests/switch |");
 console.log("|---|---|---|---|---|---|---|---|---|---|");
 for (const r of rows) console.log(r);

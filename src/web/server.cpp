@@ -202,6 +202,9 @@ Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(o
   auto& o = impl_->options;
   const std::size_t threads = std::size_t(std::max(1, o.threads));
   impl_->http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  // A player makes hundreds of small range requests on its (at most 6) connections: keep them open
+  // instead of httplib's default of closing a connection after 5 requests.
+  impl_->http.set_keep_alive_max_count(1000);
   impl_->routes();
   // httplib's default sets SO_REUSEPORT, which lets a second server bind the same port and silently
   // take half of the connections; SO_REUSEADDR alone still allows a quick restart.

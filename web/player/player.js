@@ -190,13 +190,15 @@ function tick() {
   const st = stream(S.camera, S.task);
   const key = `${S.camera}/${S.task}/${frame}`;
   const same = S.shown && S.shown.camera === S.camera && S.shown.task === S.task && S.shown.frame === frame;
-  let drawn = false, hit = false, status = "ok", shownFrame = frame;
+  let drawn = false, status = "ok", shownFrame = frame;
+  // A switch counts as a hit when the first display frame after the key shows the new stream.
+  const firstTickAfterSwitch = S.pending !== null && !S.pending.seen;
+  if (S.pending) S.pending.seen = true;
   if (!same) {
     const vf = cache.get(key);
     if (vf) {
       drawFrame(vf);
       drawn = true;
-      hit = demanded !== key;
       S.message = "";
     } else if (st.status === "missing" || st.status === "unreadable") {
       status = st.status;
@@ -221,7 +223,6 @@ function tick() {
           if (late) {
             drawFrame(late);
             drawn = true;
-            hit = demanded !== `${S.camera}/${S.task}/${g}`;  // prefetched, one or more frames ago
             shownFrame = g;
             break;
           }
@@ -234,7 +235,7 @@ function tick() {
     S.shown = { camera: S.camera, task: S.task, frame: shownFrame, status };
     if (S.firstFrameMs === null) S.firstFrameMs = now;
     if (S.pending) {
-      S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit });
+      S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit: firstTickAfterSwitch });
       S.pending = null;
     }
     drawMinimap();
@@ -252,7 +253,7 @@ function updateHud(frame) {
     `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
     `camera ${c}  lat ${db.cameras.lat_deg[c].toFixed(1)}°  lon ${db.cameras.lon_deg[c].toFixed(1)}°  shell ${db.cameras.shell[c]}\n` +
     `task ${S.task} "${task.name}" ${axes}  ${active}\n` +
-    `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (prefetched)" : " (decoded on demand)") : "—"}` +
+    `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (next frame)" : " (waited for a decode)") : "—"}` +
     `  zoom ${S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
   statusLine.textContent = S.message;
 }
