@@ -15,6 +15,7 @@ const options = {
   cacheFrames: Number(params.get("cache") || 240),
   workers: Number(params.get("workers") || 4),
   batch: Number(params.get("batch") || 8),  // frames fetched and decoded per range request
+  nbBatch: Number(params.get("nbbatch") || 8),  // the same for a neighbour's prefetch
   readAhead: 2,
 };
 
@@ -137,19 +138,22 @@ function schedulePrefetch(force = false) {
   if (!force && key === lastScheduled) return;
   lastScheduled = key;
   const nb = neighbourSelections(S.camera, S.task);
-  const jobs = [[S.camera, S.task, next]];
-  for (const [c, t] of nb) jobs.push([c, t, next]);
-  if (S.playing) for (let k = 2; k <= options.readAhead + 1; k++) jobs.push([S.camera, S.task, (f + k) % n]);
-  for (const [c, t] of nb) jobs.push([c, t, f]);
+  // The current stream is decoded in batches of options.batch frames; a neighbour only needs its next
+  // frame or two until the user switches, so it gets batches of nbBatch (less decoding per tick).
+  const B = options.batch, nbB = options.nbBatch;
+  const jobs = [[S.camera, S.task, next, B]];
+  for (const [c, t] of nb) jobs.push([c, t, next, nbB]);
+  if (S.playing) for (let k = 2; k <= options.readAhead + 1; k++) jobs.push([S.camera, S.task, (f + k) % n, B]);
+  for (const [c, t] of nb) jobs.push([c, t, f, nbB]);
   queue = jobs.filter(([c, t, fr]) => !cache.has(`${c}/${t}/${fr}`));  // replaced, not appended
   while (activeWorkers < options.workers && queue.length) runWorker();
 }
 async function runWorker() {
   activeWorkers++;
   while (queue.length) {
-    const [c, t, f] = queue.shift();
+    const [c, t, f, batch] = queue.shift();
     if (cache.has(`${c}/${t}/${f}`)) continue;
-    await stream(c, t).ensure(f, cache, options.batch);
+    await stream(c, t).ensure(f, cache, batch);
   }
   activeWorkers--;
 }
