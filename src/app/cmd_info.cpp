@@ -110,8 +110,9 @@ void run(const Args& a) {
       nlohmann::json problems = nlohmann::json::array();
       for (const auto& p : report.problems)
         problems.push_back({{"camera", p.camera}, {"task", p.task},
-                            {"kind", std::string(store::to_string(p.kind))}, {"message", p.message}});
-      j["check"] = {{"checked", report.checked}, {"movie_bytes", report.bytes}, {"decoded_last_frame", a.decode},
+                            {"kind", std::string(store::to_string(p.kind))}, {"message", p.message},
+                            {"damaged_frames", p.damaged_frames}});
+      j["check"] = {{"checked", report.checked}, {"movie_bytes", report.bytes}, {"decoded_all_frames", a.decode},
                     {"problems", problems}};
     }
     std::printf("%s\n", j.dump(2).c_str());
@@ -146,7 +147,7 @@ void run(const Args& a) {
       std::printf("checked    no movie (--no-check)\n");
     } else {
       std::printf("checked    %lld of %lld movies%s: %s\n", (long long)report.checked, (long long)db.stream_count(),
-                  a.decode ? " (last frame decoded)" : "",
+                  a.decode ? " (every frame decoded)" : "",
                   report.problems.empty() ? "all readable"
                                           : (std::to_string(report.problems.size()) + " with problems").c_str());
       const std::size_t shown = std::min(report.problems.size(), std::size_t(std::max(0, a.max_problems)));
@@ -166,11 +167,11 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto* sub = root.add_subcommand(
       "info",
       "Summarize a movie database (status, cameras, tasks, axes, frames, sizes) and check every movie. Exit "
-      "status: 0 all good, 2 some movies missing/unreadable/truncated, 1 not a database");
+      "status: 0 all good, 2 some movies missing/unreadable/truncated/damaged, 1 not a database");
   sub->add_option("DB", args->db, "Database directory (holding panoptes.json)")->required();
   sub->add_flag("--json", args->json, "Print the summary as JSON");
   sub->add_flag("--no-check", args->no_check, "Read the manifest only; do not open the movies");
-  sub->add_flag("--decode", args->decode, "Also decode each movie's last recorded frame (slower)");
+  sub->add_flag("--decode", args->decode, "Also decode every recorded frame of every movie and list the damaged ones (slower)");
   sub->add_option("--threads", args->threads, "Threads for the movie check (0 = all cores)")->capture_default_str();
   sub->add_option("--max-problems", args->max_problems, "Problems listed in the text output")->capture_default_str();
   sub->callback([args] { run(*args); });

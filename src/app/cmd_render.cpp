@@ -20,6 +20,7 @@
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
 
@@ -264,7 +265,8 @@ void run(const Args& a, const std::string& command_line) {
     // Cameras in batches: render each camera (multi-threaded inside), then encode the batch's
     // frames in parallel — each goes to its own stream, and one x264 encoder uses one thread.
     const int batch = 8;
-    for (int c0 = 0; c0 < rig.size(); c0 += batch) {
+    int c0 = 0;
+    for (; c0 < rig.size() && !stop_requested(); c0 += batch) {
       const int c1 = std::min(rig.size(), c0 + batch);
       for (int c = c0; c < c1; ++c) {
         render::render_brick(cams[std::size_t(c)], fields, specs, partials, opt);
@@ -287,8 +289,15 @@ void run(const Args& a, const std::string& command_line) {
       done += n;
       progress(tty, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    writer.set_time(int(f), double(f));
-    writer.checkpoint();
+    if (c0 >= rig.size()) {  // a snapshot cut short by a signal is abandoned: the manifest keeps the last one
+      writer.set_time(int(f), double(f));
+      writer.checkpoint();
+    }
+    if (const int sig = stop_requested()) {
+      if (tty) std::fprintf(stderr, "\n");
+      throw Interrupted(sig, a.out + ": stopped by " + signal_name(sig) + "; " + std::to_string(writer.complete_frames()) +
+                                 " complete snapshot(s) kept, the database is marked interrupted");
+    }
   }
   writer.finalize();
   if (tty) std::fprintf(stderr, "\n");
@@ -328,6 +337,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--title", args->title, "Title stored in the manifest");
   sub->add_option("--crf", args->crf, "x264 quality 0..51 (default: the video default)");
   sub->callback([args] {
+    install_stop_handlers();
     std::string cl = "panoptes render";
     for (const auto& i : args->inputs) cl += " " + i;
     cl += " --rig " + args->rig;

@@ -18,6 +18,7 @@
 #include "app/command.hpp"
 #include "app/mpi_scope.hpp"
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 #include "insitu/session.hpp"
 #include "seismic/config_toml.hpp"
 #include "seismic/solver.hpp"
@@ -78,6 +79,9 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   insitu::SessionConfig cfg = insitu::parse_combined_config(text, source, seismic_sections, seis_text);
   const seismic::RunConfig rc = seismic::parse_run_config(seis_text, source, base_dir);
   rc.solver.validate();
+  if (rc.solver.steps <= 0)
+    throw FileError(source, "[time] steps = " + std::to_string(rc.solver.steps) +
+                                ": a run needs at least one step (a database without frames would be written)");
   if (!options.out.empty()) cfg.output_dir = options.out;
   if (options.overwrite) cfg.overwrite = true;
   cfg.validate();
@@ -131,7 +135,16 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   double sim = 0;
+  install_stop_handlers();
+  int stop_signal = 0;
   for (int s = 0; s < steps; ++s) {
+    // SIGINT/SIGTERM: every rank must leave at the same step (the solver and the session are
+    // collective), so the request is agreed on once per step (an 8-byte allreduce).
+    stop_signal = stop_requested();
+#ifdef PANOPTES_HAVE_MPI
+    if (solver.ranks() > 1) MPI_Allreduce(MPI_IN_PLACE, &stop_signal, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+#endif
+    if (stop_signal) break;
     auto ts = Clock::now();
     solver.step();
     sim += std::chrono::duration<double>(Clock::now() - ts).count();
@@ -151,6 +164,14 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
                    tty ? "\r" : "", st.snapshots, expected, s + 1, steps, el, eta, sim, st.time.render + st.time.copy,
                    st.time.composite, st.time.encode, tty ? "  " : "\n");
     }
+  }
+  if (stop_signal) {
+    // The session's destructor flushes every movie and marks the database interrupted (removing the
+    // lock); every snapshot taken so far was checkpointed and stays readable.
+    if (root && tty && !options.quiet) std::fprintf(stderr, "\n");
+    throw Interrupted(stop_signal, cfg.output_dir + ": stopped by " + signal_name(stop_signal) + " after " +
+                                       std::to_string(session.snapshots()) +
+                                       " snapshot(s); the database is marked interrupted and every snapshot taken is readable");
   }
   session.finalize();
   const insitu::SessionStats st = session.reduced_stats();

@@ -10,6 +10,7 @@
 
 #include "app/command.hpp"
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 #include "store/synthetic.hpp"
 
 namespace {
@@ -81,6 +82,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->capture_default_str();
   sub->add_option("--title", args->title, "Title stored in the manifest")->capture_default_str();
   sub->callback([args] {
+    panoptes::install_stop_handlers();
     // The effective settings, so the provenance reproduces the database.
     const std::string command_line = "panoptes synth-db " + args->out + " --cameras " + std::to_string(args->cameras) + " --tasks " +
                    std::to_string(args->tasks) + " --frames " + std::to_string(args->frames) + " --size " + args->size;

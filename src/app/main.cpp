@@ -4,6 +4,7 @@
 
 #include "app/command.hpp"
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 
 namespace panoptes::app {
 namespace {
@@ -38,6 +39,9 @@ int main(int argc, char** argv) {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return root.exit(e);
+  } catch (const panoptes::Interrupted& e) {
+    std::fprintf(stderr, "panoptes: interrupted: %s\n", e.what());
+    return 128 + e.signal();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panoptes: error: %s\n", e.what());
     return 1;

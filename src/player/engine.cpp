@@ -42,6 +42,7 @@ std::string_view to_string(FrameStatus status) {
     case FrameStatus::ok: return "ok";
     case FrameStatus::missing: return "missing";
     case FrameStatus::unreadable: return "unreadable";
+    case FrameStatus::damaged: return "damaged";
   }
   return "unknown";
 }
@@ -117,6 +118,7 @@ struct Engine::Impl {
   int cameras = 0, tasks = 0, frames = 0;
   std::vector<double> times;  // frame times, refreshed with frames
   store::Status db_status = store::Status::complete;
+  double last_refresh = 0;  // playback-clock time of the last automatic refresh
   double fps = 30;
   std::vector<Vec3> directions;  // unit vectors look_at → position, for nearest_camera
   std::vector<int> shells;
@@ -217,6 +219,9 @@ struct Engine::Impl {
     const double t0 = steady_seconds();
     try {
       reader->read(s.frame, *frame);
+    } catch (const video::DamagedFrameError& e) {
+      pool.release(s.camera, s.task, std::move(reader));
+      return {FrameStatus::damaged, e.what(), nullptr};
     } catch (const std::exception& e) {
       pool.discard(std::move(reader));
       return {FrameStatus::unreadable, e.what(), nullptr};
@@ -426,7 +431,10 @@ struct Engine::Impl {
     if (!placeholder || placeholder_stream != stream || placeholder_status != status) {
       const int w = db.manifest().image.width, h = db.manifest().image.height;
       placeholder = std::make_shared<video::YuvFrame>(make_placeholder(
-          w, h, status == FrameStatus::missing ? "STREAM MISSING" : "STREAM UNREADABLE",
+          w, h,
+          status == FrameStatus::missing   ? "STREAM MISSING"
+          : status == FrameStatus::damaged ? "FRAME DAMAGED"
+                                           : "STREAM UNREADABLE",
           "CAMERA " + std::to_string(s.camera) + " TASK " + std::to_string(s.task)));
       placeholder_stream = stream;
       placeholder_status = status;
@@ -551,7 +559,23 @@ int Engine::refresh() {
   }
   return m.frames;
 }
-void Engine::tick() { impl_->tick(); }
+void Engine::tick() {
+  Impl& m = *impl_;
+  // A database still being written grows: take over its new frames now and then (on the playback
+  // clock, so headless runs refresh at the same frames on every machine).
+  if (m.db_status == store::Status::running && m.options.refresh_seconds > 0) {
+    const double t = m.now();
+    if (t - m.last_refresh >= m.options.refresh_seconds) {
+      m.last_refresh = t;
+      try {
+        refresh();
+      } catch (const Error&) {
+        // A manifest caught mid-replace or a writer gone wrong: keep playing what we have.
+      }
+    }
+  }
+  m.tick();
+}
 bool Engine::playing() const { return impl_->is_playing; }
 
 void Engine::set_playing(bool playing) {

@@ -72,6 +72,9 @@ struct EngineOptions {
   bool start_playing = true;
   /// Playback loops at the ends (L toggles).
   bool loop = true;
+  /// While the database is `running` (a live writer), tick() calls refresh() every this many seconds
+  /// of the playback clock, so new frames appear; 0 = never.
+  double refresh_seconds = 1.0;
   /// Initial selection.
   int camera = 0, task = 0, frame = 0;
   /// Playback time source; empty = steady_time_source().
@@ -94,6 +97,7 @@ enum class FrameStatus {
   ok,          ///< decoded from the movie
   missing,     ///< the movie file does not exist
   unreadable,  ///< the movie exists but cannot be opened/decoded, or is truncated before this frame
+  damaged,     ///< the decoder had to conceal damage in this frame (or a frame it predicts from)
 };
 std::string_view to_string(FrameStatus status);
 

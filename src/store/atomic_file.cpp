@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "store/safe_file.hpp"
 
 namespace panoptes::store {
 
@@ -29,11 +30,20 @@ void write_all(int fd, std::string_view data, const std::string& path) {
 }  // namespace
 
 void write_file_atomic(const std::filesystem::path& path, std::string_view data, std::string_view what) {
+  // Everything relative to the directory's descriptor: the temp file is created exclusively without
+  // following links (a link planted at a guessed temp name cannot redirect the write), and rename
+  // replaces a link at the target name instead of writing through it.
+  const auto [dir, name] = split_parent(path);
+  FileHandle dfd;
+  try {
+    dfd = open_directory(dir);
+  } catch (const FileError& e) {
+    throw FileError(path.string(), "cannot create the " + std::string(what) + ": " + e.what());
+  }
   // A unique temp name per writer: two processes writing at once must not share a temp file.
-  const std::filesystem::path tmp =
-      path.string() + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(std::random_device{}());
-  const std::string tmp_name = tmp.string();
-  const int fd = ::open(tmp_name.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const std::string tmp = name + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(std::random_device{}());
+  const std::string tmp_name = (dir / tmp).string();
+  const int fd = ::openat(dfd.get(), tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd < 0)
     throw FileError(tmp_name, "cannot create the " + std::string(what) + ": " + std::strerror(errno));
   bool closed = false;
@@ -44,21 +54,16 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view data,
     if (::close(fd) != 0) throw FileError(tmp_name, std::string("cannot close: ") + std::strerror(errno));
   } catch (...) {
     if (!closed) ::close(fd);
-    ::unlink(tmp_name.c_str());
+    ::unlinkat(dfd.get(), tmp.c_str(), 0);
     throw;
   }
-  if (::rename(tmp_name.c_str(), path.c_str()) != 0) {
+  if (::renameat(dfd.get(), tmp.c_str(), dfd.get(), name.c_str()) != 0) {
     const int err = errno;
-    ::unlink(tmp_name.c_str());
+    ::unlinkat(dfd.get(), tmp.c_str(), 0);
     throw FileError(path.string(), "cannot replace the " + std::string(what) + ": " + std::strerror(err));
   }
   // Make the rename itself durable (best effort: some file systems refuse fsync on directories).
-  const std::string dir = path.has_parent_path() ? path.parent_path().string() : ".";
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  ::fsync(dfd.get());
 }
 
 }  // namespace panoptes::store

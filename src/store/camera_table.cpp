@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "store/atomic_file.hpp"
+#include "store/safe_file.hpp"
 
 namespace panoptes::store {
 
@@ -301,15 +302,19 @@ void decode_camera_table(std::string_view bytes, const CameraTableRef& expected,
          " (table and manifest do not belong together)");
   const std::uint32_t header_crc = load<std::uint32_t>(base + kCrcOffset);
   const std::uint32_t crc = crc32(base + kCrcStart, size - kCrcStart);
-  if (crc != header_crc || crc != expected.crc32)
-    fail("camera table checksum mismatch: CRC-32 of the contents is " + camera_table_file_name(crc).substr(8, 8) +
-         ", header records " + camera_table_file_name(header_crc).substr(8, 8) + ", manifest records " +
-         camera_table_file_name(expected.crc32).substr(8, 8) + " (corrupt file)");
+  const auto hex = [](std::uint32_t v) { return camera_table_file_name(v).substr(8, 8); };
+  if (crc != header_crc)
+    fail("camera table checksum mismatch: the CRC-32 of its contents is " + hex(crc) + ", its header records " +
+         hex(header_crc) + " (corrupt file)");
+  if (crc != expected.crc32)
+    fail("camera table checksum " + hex(crc) + " (its contents and header agree) differs from the " + hex(expected.crc32) +
+         " the manifest records (table and manifest do not belong together)");
   const auto count = load<std::uint64_t>(base + 24);
   if (count != std::uint64_t(expected.cameras))
     fail("camera table holds " + std::to_string(count) + " cameras, the manifest records " +
          std::to_string(expected.cameras));
-  if (count > std::uint64_t(INT32_MAX)) fail("camera count " + std::to_string(count) + " is too large");
+  if (count > std::uint64_t(kMaxCameras))
+    fail("camera count " + std::to_string(count) + " is more than the limit of " + std::to_string(kMaxCameras));
   const auto ncols = load<std::uint32_t>(base + 32);
   if (std::uint64_t(ncols) * kColumnSize > size - kHeaderSize)
     fail("camera table column count " + std::to_string(ncols) + " does not fit the file");
@@ -469,42 +474,19 @@ CameraTableRef write_camera_table(const fs::path& dir, const Manifest& manifest)
 }
 
 void read_camera_table(const fs::path& dir, const CameraTableRef& ref, Manifest& manifest) {
-  const fs::path path = dir / ref.file;
-  const std::string name = path.string();
-  std::error_code ec;
-  if (fs::is_symlink(path, ec)) {
-    const fs::path root = fs::canonical(dir.empty() ? fs::path(".") : dir, ec);
-    const fs::path target = fs::weakly_canonical(path, ec);
-    const auto rel = target.lexically_relative(root);
-    if (ec || rel.empty() || *rel.begin() == "..")
-      throw FileError(name, "resolves to " + target.string() + ", outside the database directory; refused");
-  }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    const int err = errno;
-    if (err == ENOENT) throw FileError(name, "camera table missing (the manifest refers to it)");
-    throw FileError(name, std::string("cannot read the camera table: ") + std::strerror(err));
-  }
+  const std::string name = (dir / ref.file).string();
+  // No link, FIFO or device; not larger than the manifest says (checked again by decode, which names
+  // both sizes): a hostile table cannot make the reader load more than the manifest admits.
+  const FileHandle dfd = open_directory(dir);
+  const std::uint64_t limit = std::min<std::uint64_t>(ref.bytes, kMaxCameraTableBytes);
   std::string bytes;
   try {
-    struct stat st{};
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) throw FileError(name, "camera table is not a regular file");
-    // Sized from the manifest (checked against the file below): one read, no reallocation.
-    bytes.resize(std::size_t(std::max<off_t>(st.st_size, 0)));
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-      const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) throw FileError(name, std::string("cannot read the camera table: ") + std::strerror(errno));
-      if (n == 0) break;
-      done += std::size_t(n);
-    }
-    bytes.resize(done);
-  } catch (...) {
-    ::close(fd);
+    bytes = read_regular_file(dfd.get(), ref.file, limit, "camera table", dir);
+  } catch (const FileError& e) {
+    if (std::string(e.what()).find(" missing") != std::string::npos)
+      throw FileError(name, "camera table missing (the manifest refers to it)");
     throw;
   }
-  ::close(fd);
   decode_camera_table(bytes, ref, name, manifest);
 }
 

@@ -22,6 +22,9 @@ inline constexpr std::string_view kCameraTableMagic{"PNPTCAMS", 8};
 /// Binary layout version this build writes and reads.
 inline constexpr std::uint32_t kCameraTableVersion = 1;
 
+/// Largest camera table a reader loads (kMaxCameras rows of every column fit in a quarter of it).
+inline constexpr std::uint64_t kMaxCameraTableBytes = std::uint64_t(1) << 30;
+
 /// CRC-32 (ISO-HDLC / zlib polynomial 0xEDB88320, reflected, init and final xor 0xFFFFFFFF) of
 /// `size` bytes, continuing from `crc` (0 to start). crc32("123456789") = 0xCBF43926.
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);

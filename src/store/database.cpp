@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <ctime>
@@ -20,7 +21,9 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "store/bounded_json.hpp"
 #include "store/camera_table.hpp"
+#include "store/safe_file.hpp"
 #include "video/movie_writer.hpp"
 
 namespace panoptes::store {
@@ -101,6 +104,7 @@ struct DatabaseWriter::Impl {
   std::vector<Stream> streams;      // owned × tasks, row-major by owned camera
   std::mutex mutex;                 // guards manifest.image padding updates and directory creation
   int lock_fd = -1;
+  FileHandle dir_fd;  // the database directory: every name inside is opened relative to it
   bool finalized = false;
   CameraTableRef table;  // the camera table written by create() (manifest writer only)
 
@@ -151,7 +155,7 @@ struct DatabaseWriter::Impl {
 
   void release_lock() {
     if (lock_fd >= 0) {
-      ::unlink((dir / kLockFileName).c_str());
+      ::unlinkat(dir_fd.get(), kLockFileName, 0);
       ::close(lock_fd);  // drops the flock
       lock_fd = -1;
     }
@@ -159,8 +163,9 @@ struct DatabaseWriter::Impl {
 
   void take_lock() {
     const fs::path path = dir / kLockFileName;
-    lock_fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (lock_fd < 0) throw FileError(path.string(), std::string("cannot create the writer lock: ") + std::strerror(errno));
+    // Never through a link (`ln -s ~/f DB/.panoptes.lock` must not truncate ~/f), never a FIFO or
+    // device; the file is truncated only once we hold the lock.
+    lock_fd = open_for_writing(dir_fd.get(), kLockFileName, false, "writer lock", dir).release();
     if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
       const int err = errno;
       if (err == EWOULDBLOCK) {
@@ -236,6 +241,7 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   if (!options.writes_manifest) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist (create it on the root writer first)");
+    impl->dir_fd = open_directory(dir);
     return DatabaseWriter(std::move(impl));
   }
 
@@ -243,11 +249,13 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw FileError(dir.string(), "exists and is not a directory");
   fs::create_directories(dir, ec);
   if (ec) throw FileError(dir.string(), "cannot create the database directory: " + ec.message());
+  impl->dir_fd = open_directory(dir);
   impl->take_lock();  // before looking at an old database, so two creators cannot both proceed
 
   const fs::path manifest_path = dir / kManifestFileName;
   std::string old_table;
-  if (fs::exists(manifest_path, ec)) {
+  struct stat manifest_stat{};
+  if (::fstatat(impl->dir_fd.get(), kManifestFileName, &manifest_stat, AT_SYMLINK_NOFOLLOW) == 0) {
     if (!options.overwrite) {
       impl->release_lock();
       throw FileError(dir.string(), "already holds a Panoptes database (panoptes.json); refusing to overwrite it "
@@ -258,8 +266,9 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     std::vector<std::string> patterns{impl->manifest.movie_pattern};
     try {
       // The JSON only: the old camera table does not matter here (and may be damaged).
-      std::ifstream in(manifest_path, std::ios::binary);
-      const nlohmann::json old = nlohmann::json::parse(in);
+      const nlohmann::json old = parse_bounded_json(
+          read_regular_file(impl->dir_fd.get(), kManifestFileName, kMaxManifestBytes, "manifest", dir),
+          manifest_path.string(), {}, "manifest");
       const std::string pattern = old.at("movie_pattern").get<std::string>();
       validate_movie_pattern(pattern);
       patterns.push_back(pattern);
@@ -283,7 +292,7 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
         throw FileError(tree.string(), "cannot remove the old movies: " + ec.message());
       }
     }
-    fs::remove(manifest_path, ec);
+    ::unlinkat(impl->dir_fd.get(), kManifestFileName, 0);  // a link is removed, never followed
   }
   try {
     impl->table = write_camera_table(dir, impl->manifest);
@@ -292,7 +301,7 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     impl->release_lock();
     throw;
   }
-  if (!old_table.empty() && old_table != impl->table.file) fs::remove(dir / old_table, ec);
+  if (!old_table.empty() && old_table != impl->table.file) ::unlinkat(impl->dir_fd.get(), old_table.c_str(), 0);
   return DatabaseWriter(std::move(impl));
 }
 
@@ -329,15 +338,21 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
   if (frame.channels != 3 && frame.channels != 4)
     throw Error(impl_->dir.string() + ": frame has " + std::to_string(frame.channels) + " channels, expected 3 or 4");
   if (!s.writer) {
-    const fs::path path = impl_->dir / impl_->manifest.stream_relative_path(camera, task);
+    const std::string relative = impl_->manifest.stream_relative_path(camera, task);
+    const fs::path path = impl_->dir / relative;
+    // Every directory and the movie are opened relative to the database directory without following
+    // links: a planted `movies -> /elsewhere` is refused, not written through.
+    const auto slash = relative.rfind('/');
+    FileHandle movie_dir;
     {
       std::lock_guard lock(impl_->mutex);
-      std::error_code ec;
-      fs::create_directories(path.parent_path(), ec);
-      if (ec && !fs::is_directory(path.parent_path()))
-        throw FileError(path.parent_path().string(), "cannot create the movie directory: " + ec.message());
+      movie_dir = open_subdirectory(impl_->dir_fd.get(), slash == std::string::npos ? "" : relative.substr(0, slash),
+                                    true, impl_->dir);
     }
-    auto writer = std::make_unique<video::MovieWriter>(path.string(), im.width, im.height, impl_->manifest.video);
+    FileHandle file = open_for_writing(movie_dir.get(), relative.substr(slash == std::string::npos ? 0 : slash + 1),
+                                       true, "movie", path.parent_path());
+    auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), im.width, im.height,
+                                                       impl_->manifest.video);
     if (writer->padded_width() != im.padded_width || writer->padded_height() != im.padded_height) {
       std::lock_guard lock(impl_->mutex);
       impl_->manifest.image.padded_width = writer->padded_width();
@@ -404,8 +419,13 @@ const fs::path& DatabaseWriter::dir() const { return impl_->dir; }
 // ---- reader ----------------------------------------------------------------------------------
 
 bool writer_is_alive(const fs::path& dir) {
-  const fs::path path = dir / kLockFileName;
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // No link, FIFO or device is opened (a FIFO planted at the lock would block a plain open forever).
+  int fd = -1;
+  try {
+    fd = open_regular_file(open_directory(dir).get(), kLockFileName, 4096, "writer lock", dir, true).release();
+  } catch (const Error&) {
+    return false;  // not a lock any writer made: no live writer
+  }
   if (fd < 0) return false;  // no lock file: the writer finished or never started
   bool alive;
   if (::flock(fd, LOCK_SH | LOCK_NB) == 0) {
@@ -433,6 +453,7 @@ std::string_view to_string(StreamProblem::Kind kind) {
     case StreamProblem::Kind::unreadable: return "unreadable";
     case StreamProblem::Kind::truncated: return "truncated";
     case StreamProblem::Kind::unsafe: return "unsafe";
+    case StreamProblem::Kind::damaged: return "damaged";
   }
   return "unknown";
 }
@@ -523,7 +544,7 @@ std::unique_ptr<video::MovieReader> Database::stream(int camera, int task) const
   return reader;
 }
 
-StreamReport Database::validate_streams(int threads, bool decode_last,
+StreamReport Database::validate_streams(int threads, bool decode_all,
                                         const std::function<void(std::int64_t, std::int64_t)>& progress) const {
   const std::int64_t total = stream_count();
   const int tasks = task_count();
@@ -548,11 +569,29 @@ StreamReport Database::validate_streams(int threads, bool decode_last,
       const auto size = fs::file_size(resolved, ec);
       if (!ec) bytes += std::int64_t(size);
       auto reader = stream(camera, task);
-      if (decode_last && frame_count() > 0) {
-        video::YuvFrame frame;
-        reader->read(frame_count() - 1, frame);
-      }
       problem.message.clear();
+      if (decode_all) {
+        video::YuvFrame frame;
+        std::string first_error;
+        for (int f = 0; f < frame_count(); ++f) {
+          try {
+            reader->read(f, frame);
+          } catch (const Error& e) {  // damaged (concealed) or not decodable at all
+            if (first_error.empty()) first_error = e.what();
+            problem.damaged_frames.push_back(f);
+          }
+        }
+        if (!problem.damaged_frames.empty()) {
+          std::string list;
+          for (std::size_t k = 0; k < problem.damaged_frames.size() && k < 20; ++k)
+            list += (k ? ", " : "") + std::to_string(problem.damaged_frames[k]);
+          if (problem.damaged_frames.size() > 20) list += ", ...";
+          problem.kind = StreamProblem::Kind::damaged;
+          problem.message = stream_path(camera, task).string() + ": " + std::to_string(problem.damaged_frames.size()) +
+                            " of " + std::to_string(frame_count()) + " frames damaged (" + list + "); first: " +
+                            first_error;
+        }
+      }
     } catch (const StreamFileError& e) {
       problem.message = e.what();
       problem.kind = e.kind;

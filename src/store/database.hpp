@@ -109,10 +109,11 @@ class DatabaseWriter {
 
 /// A problem found by Database::validate_streams.
 struct StreamProblem {
-  enum class Kind { missing, unreadable, truncated, unsafe };
+  enum class Kind { missing, unreadable, truncated, unsafe, damaged };
   int camera = 0, task = 0;
   Kind kind = Kind::missing;
   std::string message;  ///< one line, names the file
+  std::vector<int> damaged_frames;  ///< Kind::damaged: the frames that did not decode cleanly
 };
 
 std::string_view to_string(StreamProblem::Kind kind);
@@ -156,9 +157,10 @@ class Database {
 
   /// Deep check: opens every stream's movie (in parallel with `threads` threads, 0 = hardware) and
   /// reports missing, unsafe, unreadable and truncated (fewer than frame_count() frames) ones. With
-  /// decode_last, also decodes each stream's last checkpointed frame. `progress(done, total)` is
-  /// called from one thread now and then, if given.
-  StreamReport validate_streams(int threads = 0, bool decode_last = false,
+  /// decode_all, also decodes every checkpointed frame of every movie (in order: one decode per
+  /// frame) and reports the movies with damaged frames (Kind::damaged, listing them).
+  /// `progress(done, total)` is called from one thread now and then, if given.
+  StreamReport validate_streams(int threads = 0, bool decode_all = false,
                                 const std::function<void(std::int64_t, std::int64_t)>& progress = {}) const;
 
  private:

@@ -16,6 +16,8 @@
 
 #include "core/error.hpp"
 #include "store/atomic_file.hpp"
+#include "store/bounded_json.hpp"
+#include "store/safe_file.hpp"
 #include "store/camera_table.hpp"
 
 namespace panoptes::store {
@@ -131,6 +133,16 @@ void Manifest::validate() const {
          std::to_string(kOldestSchemaVersion) + " to " + std::to_string(kSchemaVersion) + ")");
   if (image.width <= 0 || image.height <= 0)
     fail("image size " + std::to_string(image.width) + "x" + std::to_string(image.height) + " must be positive");
+  if (image.width > kMaxImageSide || image.height > kMaxImageSide ||
+      std::int64_t(image.width) * image.height > kMaxImagePixels)
+    fail("image size " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+         " is larger than H.264 allows (at most " + std::to_string(kMaxImageSide) + " per side and " +
+         std::to_string(kMaxImagePixels) + " pixels, e.g. 8192x4352)");
+  if (image.padded_width > kMaxImageSide + 1 || image.padded_height > kMaxImageSide + 1)
+    fail("padded image size " + std::to_string(image.padded_width) + "x" + std::to_string(image.padded_height) +
+         " is larger than " + std::to_string(kMaxImageSide) + " per side");
+  if (std::int64_t(cameras.size()) > kMaxCameras)
+    fail(std::to_string(cameras.size()) + " cameras, more than the limit of " + std::to_string(kMaxCameras));
   if (image.padded_width != 0 || image.padded_height != 0)
     if (image.padded_width < image.width || image.padded_height < image.height)
       fail("padded image size " + std::to_string(image.padded_width) + "x" + std::to_string(image.padded_height) +
@@ -437,7 +449,9 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
     ref.cameras = r.integer(r.field(*t, "cameras", "camera_table"), "camera_table.cameras");
     if (bytes < 0) r.fail("camera_table.bytes", std::to_string(bytes) + " is negative");
     if (crc < 0 || crc > INT64_C(0xFFFFFFFF)) r.fail("camera_table.crc32", std::to_string(crc) + " is not a 32-bit value");
-    if (ref.cameras < 0 || ref.cameras > INT32_MAX) r.fail("camera_table.cameras", std::to_string(ref.cameras) + " out of range");
+    if (ref.cameras < 0 || ref.cameras > kMaxCameras)
+      r.fail("camera_table.cameras", std::to_string(ref.cameras) + " is out of range (0.." + std::to_string(kMaxCameras) +
+                                         " cameras; readers keep each camera in memory)");
     ref.bytes = std::uint64_t(bytes);
     ref.crc32 = std::uint32_t(crc);
     if (const json* nav = r.optional(*t, "navigation", "camera_table")) {
@@ -448,6 +462,8 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
     table = ref;
   } else {
     const json& cams = r.array(r.field(j, "cameras", ""), "cameras");
+    if (std::int64_t(cams.size()) > kMaxCameras)
+      r.fail("cameras", std::to_string(cams.size()) + " cameras, more than the limit of " + std::to_string(kMaxCameras));
     m.cameras.resize(cams.size());
     for (std::size_t i = 0; i < cams.size(); ++i) {
       const json& c = cams[i];
@@ -545,25 +561,16 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
 
 namespace {
 
-// Reads and parses a manifest file's JSON. Throws FileError.
+// Reads and parses a manifest file's JSON: never through a link, never from a FIFO or device, at most
+// kMaxManifestBytes, bounded nesting (see safe_file.hpp, bounded_json.hpp). Throws FileError.
 json read_manifest_json(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw FileError(name, "no manifest here (not a Panoptes database)");
-    throw FileError(name, std::string("cannot read the manifest: ") + std::strerror(errno));
-  }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  try {
-    return json::parse(buffer.str());
-  } catch (const json::parse_error& e) {
-    // e.what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..."; keep the useful tail.
-    std::string what = e.what();
-    const auto pos = what.find("parse error");
-    throw FileError(name, "malformed manifest (not valid JSON): " + (pos == std::string::npos ? what : what.substr(pos)));
-  }
+  const auto [dir, file] = split_parent(path);
+  const FileHandle dfd = open_directory(dir);
+  const FileHandle fd = open_regular_file(dfd.get(), file, kMaxManifestBytes, "manifest", dir, true);
+  if (!fd) throw FileError(name, "no manifest here (not a Panoptes database)");
+  const std::string text = read_regular_file(dfd.get(), file, kMaxManifestBytes, "manifest", dir);
+  return parse_bounded_json(text, name, {}, "manifest");
 }
 
 }  // namespace

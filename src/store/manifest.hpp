@@ -25,6 +25,16 @@ inline constexpr int kSchemaVersion = 2;
 inline constexpr int kOldestSchemaVersion = 1;
 /// File name of the manifest inside the database directory.
 inline constexpr const char* kManifestFileName = "panoptes.json";
+/// Largest panoptes.json a reader accepts (a schema-1 manifest with 10^6 inline cameras has 232 MB;
+/// schema 2 keeps cameras in the binary table): bounds what a hostile manifest can make a reader load.
+inline constexpr std::uint64_t kMaxManifestBytes = std::uint64_t(256) << 20;
+/// Largest number of cameras a database may hold (2097152): readers keep ~200 bytes per camera in
+/// memory, so a table of shared columns claiming 2*10^7 cameras is refused instead of taking 4 GB.
+inline constexpr std::int64_t kMaxCameras = std::int64_t(1) << 21;
+/// Largest frame a database may hold: H.264 level 6.2 allows 139264 macroblocks (35.6 Mpixel, e.g.
+/// 8192x4352); each side at most kMaxImageSide.
+inline constexpr std::int64_t kMaxImagePixels = std::int64_t(139264) * 256;
+inline constexpr int kMaxImageSide = 16384;
 /// Default movie file-name pattern, relative to the database directory.
 inline constexpr const char* kDefaultMoviePattern = "movies/c{camera}/t{task}.mp4";
 

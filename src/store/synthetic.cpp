@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 #include "core/frame_stamp.hpp"
 #include "store/database.hpp"
 
@@ -126,6 +127,10 @@ void write_synthetic_database(const std::filesystem::path& dir, const SyntheticO
   auto work = [&] {
     Image img(o.width, o.height, 4);
     for (std::int64_t s; (s = next.fetch_add(1)) < total;) {
+      if (stop_requested()) {  // SIGINT/SIGTERM: abandon the remaining streams (see core/stop_request.hpp)
+        next = total;
+        break;
+      }
       const int camera = int(s / o.tasks), task = int(s % o.tasks);
       try {
         for (int f = 0; f < o.frames; ++f) {
@@ -148,11 +153,14 @@ void write_synthetic_database(const std::filesystem::path& dir, const SyntheticO
       progress(done.load(), total);
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       std::lock_guard lock(error_mutex);
-      if (error) break;
+      if (error || stop_requested()) break;
     }
   }
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);  // the writer's destructor marks the database interrupted
+  if (const int sig = stop_requested())
+    throw Interrupted(sig, dir.string() + ": stopped by " + signal_name(sig) + " after " + std::to_string(done.load()) +
+                               " of " + std::to_string(total) + " streams; the database is marked interrupted");
   if (progress) progress(total, total);
   writer.finalize();
 }

@@ -63,6 +63,10 @@ struct MovieReader::Impl {
   int current_frame = -1;  // frame held in `frame`, -1 if none
   std::int64_t packets_sent = 0;
   bool draining = false;
+  // Set when the decoder reported damage since the last seek (a packet it refused, a frame it had to
+  // conceal): every later frame up to the next keyframe may predict from concealed pixels.
+  bool tainted = false;
+  bool current_damaged = false;  // the frame in `frame` is (or predicts from) concealed data
 
   ~Impl() {
     avcodec_free_context(&dec);
@@ -138,11 +142,13 @@ struct MovieReader::Impl {
   }
 
   void build_index() {
-    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    // O_NONBLOCK: a FIFO in place of a movie must not block the open (it is refused just below).
+    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
     struct stat sb {};
     if (::fstat(fd, &sb) != 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
     if (S_ISDIR(sb.st_mode)) throw FileError(path, "is a directory, not a movie");
+    if (!S_ISREG(sb.st_mode)) throw FileError(path, "is not a regular file (a FIFO, device or socket); refused");
     file_size = sb.st_size;
     if (file_size == 0) throw FileError(path, "not a readable movie (the file is empty)");
     view_size = readable_prefix();
@@ -306,7 +312,9 @@ struct MovieReader::Impl {
     const int ret = avcodec_send_packet(dec, pkt);
     av_packet_unref(pkt);
     ++packets_sent;
-    // A damaged packet is not fatal by itself: the frame it carried simply never comes out.
+    // A damaged packet is not fatal by itself: the frame it carried never comes out (or comes out
+    // concealed), and the frames predicted from it are flagged (see `tainted`).
+    if (ret == AVERROR_INVALIDDATA) tainted = true;
     if (ret < 0 && ret != AVERROR_INVALIDDATA)
       throw Error("movie " + path + ": decoder refused packet " + std::to_string(k) + ": " + av_error_string(ret));
   }
@@ -316,6 +324,7 @@ struct MovieReader::Impl {
     next_packet = start_packet;
     current_frame = -1;
     draining = false;
+    tainted = false;
   }
 
   // Leaves frame `index` in `frame`.
@@ -334,6 +343,12 @@ struct MovieReader::Impl {
         if (ret == 0) {
           const std::int64_t pts = frame->pts != AV_NOPTS_VALUE ? frame->pts : frame->best_effort_timestamp;
           const int f = frame_of_pts(pts);
+          // A keyframe decoded cleanly ends the damage; concealment or a corrupt flag starts it.
+          if (frame->key_frame && frame->decode_error_flags == 0 &&
+              !(frame->flags & AV_FRAME_FLAG_CORRUPT))
+            tainted = false;
+          if (frame->decode_error_flags != 0 || (frame->flags & AV_FRAME_FLAG_CORRUPT)) tainted = true;
+          current_damaged = tainted;
           if (f < 0) {  // not a frame of the index (e.g. from a dropped, truncated packet)
             current_frame = -1;
             continue;
@@ -356,7 +371,10 @@ struct MovieReader::Impl {
           continue;
         }
         if (ret == AVERROR_EOF) break;
-        if (ret == AVERROR_INVALIDDATA) continue;
+        if (ret == AVERROR_INVALIDDATA) {
+          tainted = true;
+          continue;
+        }
         throw Error("movie " + path + ": decoding failed: " + av_error_string(ret));
       }
     } catch (...) {
@@ -435,6 +453,10 @@ std::int64_t MovieReader::packets_decoded() const { return impl_->packets_sent; 
 
 void MovieReader::read(int index, YuvFrame& out) {
   impl_->decode(index);
+  if (impl_->current_damaged)
+    throw DamagedFrameError("movie " + impl_->path + ": frame " + std::to_string(index) +
+                            " is damaged (the decoder had to conceal missing or corrupt data in it or in a frame it "
+                            "predicts from)");
   impl_->export_yuv(out);
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/image.hpp"
 
 namespace panoptes::video {
@@ -15,6 +16,13 @@ struct YuvFrame {
   int width = 0, height = 0;
   int index = -1;  ///< frame number in the movie
   std::vector<std::uint8_t> y, u, v;
+};
+
+/// A frame whose data is damaged: the decoder concealed errors in it, or in a frame it is predicted
+/// from. Readers show such a frame as damaged, never as good (and never another frame in its place).
+class DamagedFrameError : public Error {
+ public:
+  using Error::Error;
 };
 
 /// An open movie. Not thread-safe: use one reader per thread.
@@ -43,7 +51,8 @@ class MovieReader {
   const std::string& path() const;
 
   /// Decodes exactly frame `index` (seeks to the keyframe at or before it, decodes forward; consecutive
-  /// indices decode without seeking). Throws Error if index is out of range or the frame is unreadable.
+  /// indices decode without seeking). Throws Error if index is out of range or the frame is unreadable,
+  /// DamagedFrameError if the decoder had to conceal damage in it or in a frame it predicts from.
   void read(int index, YuvFrame& out);
   Image read_rgba(int index);
   /// Packets sent to the decoder since open (a measure of decoding work: reading frames i, i+1, ...

@@ -437,6 +437,47 @@ TEST_F(MovieTest, MovieWithoutVideoIsAFileError) {
   }
 }
 
+// Corrupted P-frame data (issue #15): the decoder conceals it and used to hand the concealed picture
+// out as good, sometimes with another frame's content. Every frame is now either exactly the frame
+// asked for, or DamagedFrameError/Error; and the damage is reported, not hidden.
+TEST_F(MovieTest, ConcealedFramesAreReportedNeverShownAsGood) {
+  VideoSettings s;
+  s.gop = 30;
+  const std::string path = file("damaged.mp4");
+  write_movie(path, 96, 64, 30, s);
+  // Flip bytes inside the mdat (the coded pictures), well after the keyframe.
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const auto mdat = bytes.find("mdat");
+  ASSERT_NE(mdat, std::string::npos);
+  const std::size_t start = mdat + (bytes.size() - mdat) / 2;
+  for (std::size_t i = start; i < start + 24 && i < bytes.size(); ++i) bytes[i] = char(bytes[i] ^ 0x5a);
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << bytes;
+  }
+  int good = 0, damaged = 0;
+  for (int pass = 0; pass < 2; ++pass) {  // in order, then backwards (seeks)
+    MovieReader r(path);
+    ASSERT_EQ(r.frame_count(), 30);
+    for (int k = 0; k < r.frame_count(); ++k) {
+      const int i = pass == 0 ? k : r.frame_count() - 1 - k;
+      try {
+        const Image img = r.read_rgba(i);
+        EXPECT_EQ(read_test_frame_number(img), i) << "frame " << i << " shown with the wrong content";
+        ++good;
+      } catch (const Error& e) {
+        ++damaged;
+      }
+    }
+  }
+  EXPECT_GT(damaged, 0) << "the damage went unreported";
+  EXPECT_GT(good, 0) << "frames before the damage must stay readable";
+}
+
 TEST_F(MovieTest, OutOfRangeReadIsAnError) {
   const std::string path = file("range.mp4");
   write_movie(path, 64, 48, 3);

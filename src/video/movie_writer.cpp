@@ -8,7 +8,11 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -52,6 +56,8 @@ void strip_sei(AVPacket* pkt) {
 
 struct MovieWriter::Impl {
   std::string path;
+  int fd = -1;             // with a caller's descriptor: written through a custom AVIOContext
+  std::int64_t fd_pos = 0;
   int width = 0, height = 0, padded_width = 0, padded_height = 0;
   VideoSettings settings;
 
@@ -87,12 +93,53 @@ struct MovieWriter::Impl {
   void release() {
     release_encoder();
     if (fmt) {
-      if (fmt->pb) avio_closep(&fmt->pb);
+      if (fmt->pb && fd >= 0) {
+        avio_flush(fmt->pb);
+        av_freep(&fmt->pb->buffer);
+        avio_context_free(&fmt->pb);
+      } else if (fmt->pb) {
+        avio_closep(&fmt->pb);
+      }
       avformat_free_context(fmt);
       fmt = nullptr;
     }
     av_packet_free(&pkt);
+    if (fd >= 0) ::close(fd);
+    fd = -1;
     open = false;
+  }
+
+  static int fd_write(void* opaque, std::uint8_t* buf, int n) {
+    auto* m = static_cast<Impl*>(opaque);
+    int done = 0;
+    while (done < n) {
+      const ssize_t w = ::pwrite(m->fd, buf + done, std::size_t(n - done), m->fd_pos);
+      if (w < 0 && errno == EINTR) continue;
+      if (w < 0) return AVERROR(errno);
+      done += int(w);
+      m->fd_pos += w;
+    }
+    return n;
+  }
+
+  static std::int64_t fd_seek(void* opaque, std::int64_t offset, int whence) {
+    auto* m = static_cast<Impl*>(opaque);
+    switch (whence & ~AVSEEK_FORCE) {
+      case AVSEEK_SIZE: {
+        struct stat st{};
+        return ::fstat(m->fd, &st) == 0 ? std::int64_t(st.st_size) : AVERROR(errno);
+      }
+      case SEEK_SET: m->fd_pos = offset; break;
+      case SEEK_CUR: m->fd_pos += offset; break;
+      case SEEK_END: {
+        struct stat st{};
+        if (::fstat(m->fd, &st) != 0) return AVERROR(errno);
+        m->fd_pos = st.st_size + offset;
+        break;
+      }
+      default: return AVERROR(EINVAL);
+    }
+    return m->fd_pos;
   }
 
   [[noreturn]] void fail_write(const std::string& what, int err) {
@@ -166,8 +213,19 @@ struct MovieWriter::Impl {
   void start() {
     int ret = avformat_alloc_output_context2(&fmt, nullptr, "mp4", path.c_str());
     if (ret < 0 || !fmt) throw Error("movie " + path + ": cannot allocate the MP4 muxer: " + av_error_string(ret));
-    ret = avio_open(&fmt->pb, path.c_str(), AVIO_FLAG_WRITE);
-    if (ret < 0) throw FileError(path, "cannot create the movie: " + av_error_string(ret));
+    if (fd >= 0) {
+      constexpr int kIoBuffer = 1 << 16;
+      auto* buf = static_cast<std::uint8_t*>(av_malloc(kIoBuffer));
+      fmt->pb = buf ? avio_alloc_context(buf, kIoBuffer, 1, this, nullptr, &fd_write, &fd_seek) : nullptr;
+      if (!fmt->pb) {
+        av_free(buf);
+        throw Error("movie " + path + ": out of memory");
+      }
+      fmt->flags |= AVFMT_FLAG_CUSTOM_IO;
+    } else {
+      ret = avio_open(&fmt->pb, path.c_str(), AVIO_FLAG_WRITE);
+      if (ret < 0) throw FileError(path, "cannot create the movie: " + av_error_string(ret));
+    }
     open_encoder();
     stream = avformat_new_stream(fmt, nullptr);
     if (!stream) throw Error("movie " + path + ": out of memory");
@@ -242,7 +300,11 @@ struct MovieWriter::Impl {
 };
 
 MovieWriter::MovieWriter(const std::string& path, int width, int height, const VideoSettings& settings)
+    : MovieWriter(-1, path, width, height, settings) {}
+
+MovieWriter::MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings)
     : impl_(std::make_unique<Impl>()) {
+  impl_->fd = fd;  // owned from here on, also if a check below throws
   settings.validate();
   if (width < 1 || height < 1 || width > 16384 || height > 16384)
     throw Error("movie " + path + ": frame size " + std::to_string(width) + "x" + std::to_string(height) +
@@ -342,8 +404,13 @@ void MovieWriter::close() {
       if (ret < 0) m.fail_write("cannot finish the movie", ret);
       avio_flush(m.fmt->pb);
       m.check_io("cannot finish the movie");
-      ret = avio_closep(&m.fmt->pb);
-      if (ret < 0) m.fail_write("cannot close the movie", ret);
+      if (m.fd >= 0) {
+        // Custom I/O on the store's descriptor: everything is written (flushed above); release()
+        // frees the context and closes the descriptor.
+      } else {
+        ret = avio_closep(&m.fmt->pb);
+        if (ret < 0) m.fail_write("cannot close the movie", ret);
+      }
     }
   } catch (...) {
     m.release();

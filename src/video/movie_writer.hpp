@@ -19,6 +19,10 @@ class MovieWriter {
  public:
   /// Creates (or truncates) the file. Throws FileError if it cannot be created, Error on bad settings.
   MovieWriter(const std::string& path, int width, int height, const VideoSettings& settings = {});
+  /// Writes to `fd`, an empty regular file opened for writing (taken over: closed by the writer, also
+  /// when the constructor throws); `path` only names it in messages. The store opens its movies this
+  /// way, relative to the database directory and without following links.
+  MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings = {});
   ~MovieWriter();  ///< Closes the movie if still open; never throws.
   MovieWriter(const MovieWriter&) = delete;
   MovieWriter& operator=(const MovieWriter&) = delete;

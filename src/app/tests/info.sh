@@ -18,7 +18,7 @@ done
 
 json=$("$panoptes" info "$tmp/db" --json --decode)
 for want in '"status": "complete"' '"cameras": 4' '"tasks": 3' '"streams": 12' '"frames": 5' \
-            '"checked": 12' '"problems": []' '"decoded_last_frame": true' '"bytes_on_disk": '; do
+            '"checked": 12' '"problems": []' '"decoded_all_frames": true' '"bytes_on_disk": '; do
   grep -qF "$want" <<<"$json" || fail "missing '$want' in JSON:
 $json"
 done
