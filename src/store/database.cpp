@@ -599,6 +599,9 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
       problem.message = e.what();  // a decode failure of the last frame
       problem.kind = StreamProblem::Kind::unreadable;
     }
+    // A database stopped before its first checkpoint records no frame: a movie not created yet is
+    // not a problem then (nothing it should hold is missing).
+    if (problem.kind == StreamProblem::Kind::missing && frame_count() == 0) problem.message.clear();
     if (!problem.message.empty()) {
       std::lock_guard lock(mutex);
       report.problems.push_back(std::move(problem));

@@ -19,7 +19,7 @@ ny = 20
 nz = 16
 h = 100.0
 [time]
-steps = 400
+steps = 160
 [medium]
 type = "homogeneous"
 rho = 2500.0
@@ -41,7 +41,7 @@ height = 32
 [rig]
 spec = "fibonacci:3"
 [schedule]
-every_steps = 4
+every_steps = 6
 [[task]]
 name = "p"
 field = "phi_p"
@@ -72,7 +72,7 @@ for i in $(seq 1 10); do
   set +e
   out=$("$bin" info "k$i" --decode --json 2>&1); rc=$?
   set -e
-  [ "$rc" -eq 0 ] || fail "kill $i after ${delay_ms} ms: info --decode exit $rc: $out"
+  [ "$rc" -eq 0 ] || fail "kill $i after ${delay_ms} ms: info --decode exit $rc: $(grep -E '"(message|status|frames)"' <<<"$out")"
   grep -E '"status": "(interrupted|complete)"' <<<"$out" >/dev/null || fail "kill $i: status: $out"
 done
 
@@ -80,7 +80,7 @@ for sig in INT TERM; do
   "$bin" run tiny.toml --out "s$sig" -q >/dev/null 2>"s$sig.err" &
   pid=$!; pids+=("$pid")
   # Wait for the first checkpoint, then signal.
-  for _ in $(seq 1 100); do
+  for _ in $(seq 1 400); do
     grep -E '"frames_written": *[1-9]' "s$sig/panoptes.json" >/dev/null 2>&1 && break
     sleep 0.05
   done
