@@ -448,6 +448,82 @@ TEST(LiveDb, RefreshTakesOverNewCheckpoints) {
   EXPECT_EQ(e.status(), store::Status::complete);
 }
 
+TEST(LiveDb, TickRefreshesARunningDatabase) {
+  TempDir dir("player-live-tick");
+  const auto m = testing::ring_manifest(2, 1);
+  auto w = store::DatabaseWriter::create(dir.path, m, true);
+  const auto write = [&](int from, int to) {
+    for (int f = from; f < to; ++f)
+      for (int c = 0; c < 2; ++c) w.append(c, 0, testing::stamped_frame(c, 0, f, 64, 64));
+    w.checkpoint();
+  };
+  write(0, 3);
+  VirtualClock clock;
+  EngineOptions o;
+  o.time_source = clock.source();
+  o.start_playing = false;
+  o.refresh_seconds = 1.0;
+  Engine e(dir.path, o);
+  clock.set(0.5);
+  e.tick();
+  write(3, 5);
+  clock.set(0.9);
+  e.tick();
+  EXPECT_EQ(e.frame_count(), 3) << "refreshed before refresh_seconds passed";
+  clock.set(1.6);
+  e.tick();
+  EXPECT_EQ(e.frame_count(), 5) << "the new frames of a running database did not appear";
+  w.finalize();
+  clock.set(3.0);
+  e.tick();
+  EXPECT_EQ(e.status(), store::Status::complete);
+}
+
+TEST(DamagedMovie, ConcealedFramesShowAPlaceholderNeverAnotherFrame) {
+  TempDir dir("player-damaged");
+  auto m = testing::ring_manifest(1, 1);
+  m.video.gop = 30;
+  {
+    auto w = store::DatabaseWriter::create(dir.path, m, true);
+    for (int f = 0; f < 30; ++f) w.append(0, 0, testing::stamped_frame(0, 0, f, 64, 64));
+    w.finalize();
+  }
+  // Zero a run of bytes in the middle of the coded pictures: the decoder notices and conceals.
+  const auto path = dir.path / "movies/c0/t0.mp4";
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const auto mdat = bytes.find("mdat");
+  ASSERT_NE(mdat, std::string::npos);
+  const std::size_t at = mdat + (bytes.size() - mdat) / 2;
+  for (std::size_t i = at; i < at + 24 && i < bytes.size(); ++i) bytes[i] = 0;
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << bytes;
+  }
+  VirtualClock clock;
+  EngineOptions o;
+  o.time_source = clock.source();
+  o.start_playing = false;
+  Engine e(dir.path, o);
+  int damaged = 0;
+  for (int f = 0; f < e.frame_count(); ++f) {
+    e.seek(f);
+    const ShownFrame s = e.current_frame();
+    if (s.status == FrameStatus::ok) {
+      EXPECT_EQ(read_frame_stamp(video::MovieReader::to_rgba(*s.frame)), (FrameStamp{0, 0, std::uint32_t(f)}))
+          << "frame " << f << " shown with another frame's content";
+    } else {
+      EXPECT_EQ(s.status, FrameStatus::damaged) << s.message;
+      EXPECT_NE(s.message.find("damaged"), std::string::npos) << s.message;
+      ++damaged;
+    }
+  }
+  EXPECT_GT(damaged, 0) << "the concealed frames were shown as ok";
+}
+
 TEST(EngineErrors, ClearErrorsForBadInput) {
   EXPECT_THROW(Engine("/nonexistent/db"), FileError);
   TempDir dir("player-empty");

@@ -19,6 +19,7 @@ extern "C" {
 
 #include "core/error.hpp"
 #include "video/ffmpeg_util.hpp"
+#include "video/packet_checksum.hpp"
 
 namespace panoptes::video {
 
@@ -67,6 +68,9 @@ struct MovieReader::Impl {
   // conceal): every later frame up to the next keyframe may predict from concealed pixels.
   bool tainted = false;
   bool current_damaged = false;  // the frame in `frame` is (or predicts from) concealed data
+  bool packet_bad = false;       // the packet just sent failed its checksum or the decoder refused it
+  int nal_length_size = 0;       // MP4 (avcC) H.264: bytes of each NAL length field; 0 = not checked
+  bool checksummed = false;      // the movie's packets carry checksums (packet_checksum.hpp)
 
   ~Impl() {
     avcodec_free_context(&dec);
@@ -283,6 +287,16 @@ struct MovieReader::Impl {
 
     crop_width = coded_width;
     crop_height = coded_height;
+
+    // Packets written by MovieWriter carry a checksum; if the first keyframe has one, every packet must.
+    const AVCodecParameters* par = st->codecpar;
+    if (par->codec_id == AV_CODEC_ID_H264 && par->extradata_size >= 7 && par->extradata[0] == 1 && !packets.empty()) {
+      nal_length_size = (par->extradata[4] & 3) + 1;
+      const PacketInfo& first = packets.front();
+      std::vector<std::uint8_t> bytes(std::size_t(first.size));
+      if (::pread(fd, bytes.data(), bytes.size(), first.pos) == ssize_t(bytes.size()))
+        checksummed = verify_packet_checksum(bytes.data(), first.size, nal_length_size) == PacketChecksum::good;
+    }
   }
 
   void send_packet(int k) {
@@ -302,6 +316,10 @@ struct MovieReader::Impl {
       done += n;
     }
     std::memset(storage->data + pi.size, 0, AV_INPUT_BUFFER_PADDING_SIZE);
+    // Accumulates until a frame comes out: a bad packet whose picture never appears still taints
+    // the next picture (it may predict from the lost one).
+    if (checksummed && verify_packet_checksum(storage->data, pi.size, nal_length_size) != PacketChecksum::good)
+      packet_bad = true;
     pkt->buf = av_buffer_ref(storage);
     if (!pkt->buf) throw Error("out of memory");
     pkt->data = storage->data;
@@ -314,13 +332,14 @@ struct MovieReader::Impl {
     ++packets_sent;
     // A damaged packet is not fatal by itself: the frame it carried never comes out (or comes out
     // concealed), and the frames predicted from it are flagged (see `tainted`).
-    if (ret == AVERROR_INVALIDDATA) tainted = true;
+    if (ret == AVERROR_INVALIDDATA) packet_bad = true;
     if (ret < 0 && ret != AVERROR_INVALIDDATA)
       throw Error("movie " + path + ": decoder refused packet " + std::to_string(k) + ": " + av_error_string(ret));
   }
 
   void seek_to(int start_packet) {
     avcodec_flush_buffers(dec);
+    packet_bad = false;
     next_packet = start_packet;
     current_frame = -1;
     draining = false;
@@ -343,11 +362,11 @@ struct MovieReader::Impl {
         if (ret == 0) {
           const std::int64_t pts = frame->pts != AV_NOPTS_VALUE ? frame->pts : frame->best_effort_timestamp;
           const int f = frame_of_pts(pts);
-          // A keyframe decoded cleanly ends the damage; concealment or a corrupt flag starts it.
-          if (frame->key_frame && frame->decode_error_flags == 0 &&
-              !(frame->flags & AV_FRAME_FLAG_CORRUPT))
-            tainted = false;
-          if (frame->decode_error_flags != 0 || (frame->flags & AV_FRAME_FLAG_CORRUPT)) tainted = true;
+          // A clean keyframe ends the damage; a bad packet, concealment or a corrupt flag starts it
+          // (no decoder delay: the frame out is the packet just sent).
+          const bool bad = packet_bad || frame->decode_error_flags != 0 || (frame->flags & AV_FRAME_FLAG_CORRUPT);
+          packet_bad = false;
+          tainted = frame->key_frame ? bad : (tainted || bad);
           current_damaged = tainted;
           if (f < 0) {  // not a frame of the index (e.g. from a dropped, truncated packet)
             current_frame = -1;
@@ -372,7 +391,7 @@ struct MovieReader::Impl {
         }
         if (ret == AVERROR_EOF) break;
         if (ret == AVERROR_INVALIDDATA) {
-          tainted = true;
+          tainted = true;  // a picture the decoder gave up on: later ones may predict from it
           continue;
         }
         throw Error("movie " + path + ": decoding failed: " + av_error_string(ret));
@@ -384,7 +403,7 @@ struct MovieReader::Impl {
     }
     next_packet = -1;
     current_frame = -1;
-    throw Error("movie " + path + ": frame " + std::to_string(index) + " cannot be decoded (damaged data)");
+    throw DamagedFrameError("movie " + path + ": frame " + std::to_string(index) + " cannot be decoded (damaged data)");
   }
 
   void export_yuv(YuvFrame& out) {

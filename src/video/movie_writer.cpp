@@ -19,6 +19,7 @@ extern "C" {
 
 #include "core/error.hpp"
 #include "video/ffmpeg_util.hpp"
+#include "video/packet_checksum.hpp"
 
 namespace panoptes::video {
 
@@ -263,6 +264,11 @@ struct MovieWriter::Impl {
         if (ret < 0) throw Error("movie " + path + ": out of memory");
         strip_sei(pkt);
       }
+      // Every packet carries the CRC-32 of its pictures (packet_checksum.hpp): readers then tell a
+      // damaged picture from a good one even when the damage decodes without a decoder error.
+      if (av_packet_make_writable(pkt) < 0)
+        throw Error("movie " + path + ": out of memory");
+      append_packet_checksum(pkt);
       av_packet_rescale_ts(pkt, enc->time_base, stream->time_base);
       pkt->stream_index = stream->index;
       ret = av_write_frame(fmt, pkt);
