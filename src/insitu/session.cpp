@@ -16,6 +16,7 @@
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
 
@@ -720,6 +721,16 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   if (m.finalized) throw Error("snapshot: the session is finalized");
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
+  // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
+  // does): every rank stops before this snapshot; the writer's destructor marks the database
+  // interrupted with the snapshots taken so far.
+  int stop = stop_requested();
+#ifdef PANOPTES_HAVE_MPI
+  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, m.comm);
+#endif
+  if (stop)
+    throw Interrupted(stop, m.cfg.output_dir + ": stopped by " + signal_name(stop) + " before snapshot " +
+                                std::to_string(m.snapshots) + "; the database is marked interrupted");
   auto t0 = Clock::now();
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/stop_request.hpp"
 #include "insitu/session.hpp"
 #include "render/synthetic_fields.hpp"
 #include "store/database.hpp"
@@ -180,6 +181,32 @@ TEST(InsituSession, KilledRunOpensInterrupted) {
       const Image img = r->read_rgba(1);
       EXPECT_EQ(img.width, 32);
     }
+  fs::remove_all(dir);
+}
+
+// A stop request (SIGINT/SIGTERM with the handlers installed) stops the session before its next
+// snapshot; the database is stored as interrupted with the snapshots taken, and its lock is gone.
+TEST(InsituSession, StopRequestLeavesTheDatabaseInterrupted) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_stop_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+    const auto f = field(0.0);
+    s.snapshot(0.0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+    request_stop(SIGTERM);
+    try {
+      s.snapshot(0.2, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+      ADD_FAILURE() << "no Interrupted";
+    } catch (const Interrupted& e) {
+      EXPECT_EQ(e.signal(), SIGTERM);
+      EXPECT_NE(std::string(e.what()).find("SIGTERM"), std::string::npos) << e.what();
+    }
+    clear_stop_request();
+  }
+  const auto db = store::Database::open(dir);
+  EXPECT_EQ(db.stored_status(), store::Status::interrupted);
+  EXPECT_EQ(db.frame_count(), 1);
+  EXPECT_FALSE(fs::exists(dir / store::kLockFileName));
   fs::remove_all(dir);
 }
 
