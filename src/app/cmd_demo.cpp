@@ -6,17 +6,9 @@
 #include <string>
 
 #include "app/command.hpp"
+#include "app/seismic_run.hpp"
 
 namespace panoptes::app {
-
-struct SeismicRunOptions {
-  std::string out;
-  bool overwrite = false;
-  bool quiet = false;
-  std::string command_line;
-};
-void run_seismic_insitu(const std::string& text, const std::string& source, const std::string& base_dir,
-                        const SeismicRunOptions& options);
 
 namespace {
 

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <climits>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -15,14 +17,19 @@
 #include <string>
 #include <vector>
 
+#include <omp.h>
+
 #include "app/command.hpp"
 #include "app/volume_file.hpp"
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/file_read.hpp"
+#include "core/memory.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
+#include "video/writer_memory.hpp"
 
 namespace {
 
@@ -41,6 +48,7 @@ struct Args {
   bool no_outline = false;
   std::string title;
   int crf = -1;
+  bool force = false;
 };
 
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option) {
@@ -159,9 +167,17 @@ void run(const Args& a, const std::string& command_line) {
   if (!std::regex_match(a.size, m, size_re))
     throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 920x896");
   const int width = std::stoi(m[1]), height = std::stoi(m[2]);
-  if (width < 2 || height < 2) throw Error("--size \"" + a.size + "\": expected at least 2x2 pixels");
+  if (width < 2 || height < 2 || width > 16384 || height > 16384)
+    throw Error("--size \"" + a.size + "\": expected 2..16384 pixels per side");
   const std::vector<std::string> files = expand_inputs(a.inputs);
   if (files.empty()) throw Error("no input volume given");
+  const MemoryLimit available = available_memory();
+  if (!a.force) {
+    // Reading a volume holds its bytes and its float values at once: refuse before, not with bad_alloc.
+    MemoryEstimate read;
+    read.add("volume file", double(regular_file_size(files[0], UINT64_MAX, "volume file")) * 2);
+    check_memory(read, available, 1, "reading " + files[0], "pass --force");
+  }
 
   // The first volume fixes the grid of the whole series.
   app::Volume first = app::read_volume(files[0]);
@@ -232,6 +248,20 @@ void run(const Args& a, const std::string& command_line) {
     man.tasks.push_back(tasks[i].entry);
   }
 
+  const long long streams = checked_product(rig.size(), (long long)tasks.size(), "cameras x tasks (movies)", INT_MAX);
+  if (const long long files_limit = open_file_limit(); files_limit >= 0 && streams > files_limit - 64)
+    throw Error(std::to_string(rig.size()) + " cameras x " + std::to_string(tasks.size()) + " tasks = " +
+                std::to_string(streams) + " movies open at once, but the open-file limit (ulimit -n) is " +
+                std::to_string(files_limit) + "; use fewer cameras or tasks, or raise the limit");
+  if (!a.force) {
+    const double px = double(width) * height, points = double(grid.dims[0]) * grid.dims[1] * grid.dims[2];
+    MemoryEstimate e;
+    e.add("volumes", points * 4 * (files.size() > 1 ? 2 : 1) + points);  // first + current, macro-cells
+    e.add("images", double(tasks.size()) * px * (20 + 8 * 3) + omp_get_max_threads() * video::live_encoder_bytes(px));
+    e.add("open movie writers", double(streams) * video::open_writer_bytes(px, man.video.gop));
+    e.add("rig and manifest", rig.size() * 1500.0);
+    check_memory(e, available, 1, "this render", "pass --force");
+  }
   store::DatabaseWriter writer = store::DatabaseWriter::create(a.out, man, a.overwrite);
   const bool tty = ::isatty(STDERR_FILENO);
   const long long total = (long long)files.size() * rig.size() * (long long)tasks.size();
@@ -336,6 +366,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_flag("--no-outline", args->no_outline, "Do not draw the domain's outline box");
   sub->add_option("--title", args->title, "Title stored in the manifest");
   sub->add_option("--crf", args->crf, "x264 quality 0..51 (default: the video default)");
+  sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
   sub->callback([args] {
     install_stop_handlers();
     std::string cl = "panoptes render";

@@ -5,7 +5,9 @@
 // insitu::parse_session_config. Everything is checked before the first step.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,30 +19,25 @@
 
 #include "app/command.hpp"
 #include "app/mpi_scope.hpp"
+#include "app/seismic_run.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/file_read.hpp"
+#include "core/memory.hpp"
+#include "insitu/resources.hpp"
+#include "seismic/resources.hpp"
 #include "insitu/session.hpp"
 #include "seismic/config_toml.hpp"
 #include "seismic/solver.hpp"
 #include "store/database.hpp"
+
+#include <omp.h>
 
 #ifdef PANOPTES_HAVE_MPI
 #include <mpi.h>
 #endif
 
 namespace panoptes::app {
-
-/// Options of a seismic in-situ run (shared with `panoptes demo`).
-struct SeismicRunOptions {
-  std::string out;  ///< overrides [output] dir when not empty
-  bool overwrite = false;
-  bool quiet = false;
-  std::string command_line;
-};
-
-/// Runs the solver with in-situ visualization from TOML text. Defined here, used by cmd_demo.cpp too.
-void run_seismic_insitu(const std::string& text, const std::string& source, const std::string& base_dir,
-                        const SeismicRunOptions& options);
 
 namespace {
 
@@ -67,6 +64,44 @@ std::string human_bytes(double b) {
 
 insitu::FieldInput input_of(const char* name, const seismic::FieldView& v) {
   return {name, v.data, insitu::ScalarType::f32, {1, std::int64_t(v.stride_y), std::int64_t(v.stride_z)}};
+}
+
+// The solver's and the session's memory on this rank, checked together before either exists; and
+// the movies every rank will hold open. Collective: every rank refuses, or none.
+void check_run_resources(const seismic::SolverConfig& solver, const insitu::SessionConfig& cfg, bool force) {
+  int ranks = 1, rank = 0, sharing = 1;
+#ifdef PANOPTES_HAVE_MPI
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm node;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
+  MPI_Comm_size(node, &sharing);
+  MPI_Comm_free(&node);
+#endif
+  std::string refusal;
+  try {
+    const auto& g = solver.grid;
+    const render::GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
+    const long long cameras = insitu::rig_camera_count(cfg, grid);
+    std::int64_t tasks = 0;
+    for (const auto& t : cfg.tasks)
+      tasks += std::int64_t(std::max<std::size_t>(
+          1, std::max({t.isovalues.size(), t.slice_positions.size(), t.windows.size()})));
+    insitu::check_open_streams(cameras, int(std::min<std::int64_t>(tasks, INT_MAX)), ranks);
+    if (!force) {
+      MemoryEstimate e = seismic::estimate_solver_memory(solver, ranks);
+      const double slab = double(g.nx) * g.ny * (std::ceil(double(g.nz) / ranks) + 4);
+      e.add(insitu::estimate_session_memory(cfg, slab, cameras, ranks, omp_get_max_threads()));
+      refusal = memory_refusal(e, available_memory(), sharing, "this run", "pass --force");
+    }
+  } catch (const std::exception& e) {
+    refusal = e.what();
+  }
+  int refused = refusal.empty() ? 0 : 1;
+#ifdef PANOPTES_HAVE_MPI
+  MPI_Allreduce(MPI_IN_PLACE, &refused, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+#endif
+  if (refused) throw Error(refusal.empty() ? "another rank of this run refused to start (see its message)" : refusal);
 }
 
 }  // namespace
@@ -97,11 +132,33 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
                                     "\"; the seismic run provides phi_p (div v) and phi_s (|curl v|)");
 
   MpiScope mpi;
+  check_run_resources(rc.solver, cfg, options.force);
+  cfg.check_memory = false;  // checked above for the solver and the session together
 #ifdef PANOPTES_HAVE_MPI
   seismic::Solver solver(rc.solver, MPI_COMM_WORLD);
 #else
   seismic::Solver solver(rc.solver);
 #endif
+  const int steps = rc.solver.steps;
+  // A snapshot interval below the time step cannot be honoured (at most one snapshot per step).
+  if (cfg.schedule.every_time > 0 && cfg.schedule.every_time < solver.dt())
+    throw FileError(source, "schedule.every_time = " + std::to_string(cfg.schedule.every_time) +
+                                " s is shorter than the solver's time step of " + std::to_string(solver.dt()) +
+                                " s; expected at least one step between snapshots");
+  // Expected number of snapshots, for the progress bar (the times of velocity are (s + 0.5)·dt).
+  const std::int64_t expected64 =
+      cfg.schedule.every_steps > 0
+          ? steps / cfg.schedule.every_steps
+          : std::int64_t(std::floor((steps - 0.5) * solver.dt() / cfg.schedule.every_time)) + 1 -
+                std::int64_t(std::floor(-0.5 * solver.dt() / cfg.schedule.every_time) + 1);
+  int expected = int(std::min<std::int64_t>(expected64, INT_MAX));
+  if (cfg.schedule.max_snapshots > 0) expected = std::min(expected, cfg.schedule.max_snapshots);
+  if (expected <= 0)
+    throw FileError(source, "the schedule takes no snapshot in " + std::to_string(steps) + " steps of " +
+                                std::to_string(solver.dt()) + " s (schedule." +
+                                (cfg.schedule.every_steps > 0 ? "every_steps = " + std::to_string(cfg.schedule.every_steps)
+                                                              : "every_time = " + std::to_string(cfg.schedule.every_time)) +
+                                "); the database would hold no frames");
   const auto& g = rc.solver.grid;
   const render::GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
   insitu::LocalBlock block;
@@ -114,17 +171,6 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
 #endif
   const bool root = solver.rank() == 0;
   const bool tty = ::isatty(STDERR_FILENO);
-  const int steps = rc.solver.steps;
-  // Expected number of snapshots, for the progress bar.
-  int expected = 0;
-  for (int s = 0; s < steps; ++s) {
-    const double t = (s + 0.5) * solver.dt();
-    if (cfg.schedule.every_steps > 0 ? (s + 1) % cfg.schedule.every_steps == 0
-                                     : std::floor(t / cfg.schedule.every_time) >
-                                           std::floor((t - solver.dt()) / cfg.schedule.every_time))
-      ++expected;
-  }
-  if (cfg.schedule.max_snapshots > 0) expected = std::min(expected, cfg.schedule.max_snapshots);
   if (root && !options.quiet)
     std::fprintf(stderr,
                  "panoptes run: %dx%dx%d grid, %d steps of %.3g s on %d rank(s); %d cameras x %d tasks = %d streams of "
@@ -213,15 +259,14 @@ CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--out", opt->out, "Database directory (overrides [output] dir)");
   sub->add_flag("--overwrite", opt->overwrite, "Replace an existing database");
   sub->add_flag("-q,--quiet", opt->quiet, "No progress output");
+  sub->add_flag("--force", opt->force,
+                "Start even when the estimated memory per rank exceeds what the rank has available");
   sub->footer(std::string(insitu::config_keys_help()));
   sub->callback([config, opt] {
-    std::ifstream in(*config);
-    if (!in) throw FileError(*config, "cannot open the configuration file");
-    std::stringstream ss;
-    ss << in.rdbuf();
+    const std::string text = read_regular_file(*config, insitu::kMaxConfigBytes, "configuration file");
     opt->command_line = "panoptes run " + *config + (opt->out.empty() ? "" : " --out " + opt->out);
     const std::string base = std::filesystem::path(*config).parent_path().string();
-    run_seismic_insitu(ss.str(), *config, base.empty() ? "." : base, *opt);
+    run_seismic_insitu(text, *config, base.empty() ? "." : base, *opt);
   });
 });
 

@@ -2,7 +2,10 @@
 // stamp of (camera, task, frame), for tests and benchmarks of the player.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <climits>
+#include <thread>
 #include <cstdio>
 #include <regex>
 #include <memory>
@@ -11,6 +14,8 @@
 #include "app/command.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/memory.hpp"
+#include "video/writer_memory.hpp"
 #include "store/synthetic.hpp"
 
 namespace {
@@ -22,6 +27,7 @@ struct Args {
   bool overwrite = false;
   int gop = 10, crf = -1, threads = 0;
   std::string preset, title = "synthetic database";
+  bool force = false;
 };
 
 void run(const Args& a, const std::string& command_line) {
@@ -44,6 +50,20 @@ void run(const Args& a, const std::string& command_line) {
   if (a.crf >= 0) o.video.crf = a.crf;
   if (!a.preset.empty()) o.video.preset = a.preset;
   o.video.validate();
+  const long long streams = checked_product(a.cameras, a.tasks, "--cameras x --tasks (movies)", INT_MAX);
+  if (o.width > 16384 || o.height > 16384)
+    throw Error("--size \"" + a.size + "\": expected at most 16384 pixels per side");
+  if (!a.force) {
+    // Streams are written a few at a time (one encoder each); the manifest and camera table grow
+    // with the cameras.
+    const double px = double(o.width) * o.height;
+    const int parallel = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
+    MemoryEstimate e;
+    e.add("encoders", std::max(parallel, 1) * (video::open_writer_bytes(px, o.video.gop) +
+                                               video::live_encoder_bytes(px) + px * 3));
+    e.add("manifest", double(a.cameras) * 1500 + double(streams) * 16);
+    check_memory(e, available_memory(), 1, "this synthetic database", "pass --force");
+  }
 
   const bool tty = ::isatty(STDERR_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
@@ -55,7 +75,6 @@ void run(const Args& a, const std::string& command_line) {
   });
   if (tty) std::fprintf(stderr, "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const long long streams = (long long)a.cameras * a.tasks;
   std::printf("wrote %s: %d cameras x %d tasks = %lld streams, %d frames of %dx%d each, in %.2f s (%.0f streams/s)\n",
               a.out.c_str(), a.cameras, a.tasks, streams, a.frames, o.width, o.height, seconds, streams / seconds);
 }
@@ -81,6 +100,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--preset", args->preset, "x264 preset (default: the video default)");
   sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->capture_default_str();
   sub->add_option("--title", args->title, "Title stored in the manifest")->capture_default_str();
+  sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
   sub->callback([args] {
     panoptes::install_stop_handlers();
     // The effective settings, so the provenance reproduces the database.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/file_read.hpp"
 #include "core/vec3.hpp"
 
 namespace panoptes::app {
@@ -56,29 +57,32 @@ void convert(const char* src, std::size_t n, bool big_endian, std::vector<float>
   }
 }
 
-inline void check_dims(const std::string& path, const std::array<long long, 3>& d) {
+/// Largest volume accepted: 2^34 points (64 GB of float32), at most 2^24 per axis.
+inline constexpr long long kMaxVolumePoints = 1LL << 34;
+
+// Returns the number of points; the bounds keep every size computed from it far from overflow.
+inline std::size_t check_dims(const std::string& path, const std::array<long long, 3>& d) {
+  const std::string dims = std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]);
   for (long long n : d)
     if (n < 2 || n > (1 << 24))
-      throw FileError(path, "volume of " + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]) +
-                                " points; expected at least 2 points per axis");
+      throw FileError(path, "volume of " + dims + " points; expected 2 .. 16777216 points per axis");
+  if (d[0] * d[1] > kMaxVolumePoints / d[2])
+    throw FileError(path, "volume of " + dims + " points is more than the limit of " + std::to_string(kMaxVolumePoints) +
+                              " points");
+  return std::size_t(d[0] * d[1] * d[2]);
 }
 
 inline std::string read_all(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open the file for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return read_regular_file(path, std::uint64_t(kMaxVolumePoints) * 8 + (1 << 20), "volume file");
 }
 
 }  // namespace volume_detail
 
-/// Reads a NumPy .npy file holding a 3-D array of float32 or float64 (either byte order). C order
+/// Parses the contents of a NumPy .npy file (`path` names it in errors) holding a 3-D array of float32 or float64 (either byte order). C order
 /// (fortran_order False) with shape (nz, ny, nx) — the last axis is x, the fastest; Fortran order with
 /// shape (nx, ny, nz). Origin 0, spacing 1. Throws FileError naming the file and what is wrong.
-inline Volume read_npy(const std::string& path) {
+inline Volume parse_npy(const std::string& data, const std::string& path) {
   using namespace volume_detail;
-  const std::string data = read_all(path);
   if (data.size() < 10 || std::memcmp(data.data(), "\x93NUMPY", 6) != 0)
     throw FileError(path, "not a NumPy .npy file (missing the \\x93NUMPY magic)");
   const int major = static_cast<unsigned char>(data[6]);
@@ -112,11 +116,12 @@ inline Volume read_npy(const std::string& path) {
   const std::string descr = header.substr(p + 1, header.find(q, p + 1) - p - 1);
   // fortran_order
   p = value_of("fortran_order");
-  const bool fortran = header.compare(p, 4, "True") == 0;
+  const bool fortran = p < header.size() && header.compare(p, 4, "True") == 0;
   // shape
   p = value_of("shape");
   const auto close = header.find(')', p);
-  if (header[p] != '(' || close == std::string::npos) throw FileError(path, "malformed .npy shape in " + header);
+  if (p >= header.size() || header[p] != '(' || close == std::string::npos)
+    throw FileError(path, "malformed .npy shape in " + header);
   std::vector<long long> shape;
   {
     std::string inner = header.substr(p + 1, close - p - 1);
@@ -129,9 +134,8 @@ inline Volume read_npy(const std::string& path) {
   Volume v;
   const std::array<long long, 3> d = fortran ? std::array<long long, 3>{shape[0], shape[1], shape[2]}
                                              : std::array<long long, 3>{shape[2], shape[1], shape[0]};
-  check_dims(path, d);
+  const std::size_t n = check_dims(path, d);
   v.dims = {int(d[0]), int(d[1]), int(d[2])};
-  const std::size_t n = std::size_t(d[0] * d[1] * d[2]);
   const std::size_t offset = header_start + header_len;
   if (descr.size() != 3 || (descr[0] != '<' && descr[0] != '>' && descr[0] != '=' && descr[0] != '|') ||
       (descr.substr(1) != "f4" && descr.substr(1) != "f8"))
@@ -146,12 +150,14 @@ inline Volume read_npy(const std::string& path) {
   return v;
 }
 
-/// Reads a VTK legacy file with DATASET STRUCTURED_POINTS and one float or double SCALARS array of
+/// Reads a NumPy .npy file (see parse_npy).
+inline Volume read_npy(const std::string& path) { return parse_npy(volume_detail::read_all(path), path); }
+
+/// Parses the contents of a VTK legacy file (`path` names it in errors) with DATASET STRUCTURED_POINTS and one float or double SCALARS array of
 /// POINT_DATA, ASCII or BINARY (big-endian, as the format prescribes). Throws FileError naming the
 /// file, the keyword or value and what was expected.
-inline Volume read_vtk(const std::string& path) {
+inline Volume parse_vtk(const std::string& data, const std::string& path) {
   using namespace volume_detail;
-  const std::string data = read_all(path);
   std::size_t pos = 0;
   auto next_line = [&]() -> std::string {
     if (pos >= data.size()) throw FileError(path, "unexpected end of file in the VTK header");
@@ -211,8 +217,7 @@ inline Volume read_vtk(const std::string& path) {
     }
   }
   if (!structured) throw FileError(path, "no DATASET STRUCTURED_POINTS line before the data");
-  check_dims(path, d);
-  const std::size_t n = std::size_t(d[0] * d[1] * d[2]);
+  const std::size_t n = check_dims(path, d);
   if (npoints >= 0 && std::size_t(npoints) != n)
     throw FileError(path, "POINT_DATA " + std::to_string(npoints) + " but DIMENSIONS give " + std::to_string(n) + " points");
   for (int a = 0; a < 3; ++a)
@@ -226,8 +231,12 @@ inline Volume read_vtk(const std::string& path) {
     if (elem == 4) convert<float>(data.data() + pos, n, true, v.values);
     else convert<double>(data.data() + pos, n, true, v.values);
   } else {
+    // Every ASCII value takes at least one character and one separator: refuse before allocating.
+    const std::size_t left = data.size() - std::min(pos, data.size());
+    if (left + 1 < 2 * n)
+      throw FileError(path, "ASCII data: " + std::to_string(left) + " bytes cannot hold " + std::to_string(n) + " values");
     v.values.resize(n);
-    const char* c = data.c_str() + pos;
+    const char* c = data.c_str() + std::min(pos, data.size());
     char* end = nullptr;
     for (std::size_t i = 0; i < n; ++i) {
       const double x = std::strtod(c, &end);
@@ -238,6 +247,9 @@ inline Volume read_vtk(const std::string& path) {
   }
   return v;
 }
+
+/// Reads a VTK legacy file (see parse_vtk).
+inline Volume read_vtk(const std::string& path) { return parse_vtk(volume_detail::read_all(path), path); }
 
 /// Reads a volume by file extension (.npy or .vtk); anything else is refused with the supported list.
 inline Volume read_volume(const std::string& path) {

@@ -10,12 +10,15 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/file_read.hpp"
 
 namespace panoptes::camera {
 
 namespace {
 
 constexpr long long kMaxCamerasPerShell = 10'000'000;  // beyond this a typo is more likely than intent
+constexpr long long kMaxCameras = 10'000'000;          // over all shells
+constexpr std::size_t kMaxShells = 1000;
 const char* const kSyntax =
     "expected yinyang[:NTxNP], latlon[:NLATxNLON[+poles]], fibonacci[:N], file:PATH or the path of an existing "
     "camera file, optionally followed by @R1,R2,... (shell radii in bounding-sphere radii)";
@@ -130,6 +133,12 @@ RigSpec RigSpec::parse(std::string_view text) {
   if (upper > kMaxCamerasPerShell)
     bad_spec(text, std::to_string(upper) + " cameras per shell is more than the limit of " +
                        std::to_string(kMaxCamerasPerShell));
+  if (spec.radii.size() > kMaxShells)
+    bad_spec(text, std::to_string(spec.radii.size()) + " shells is more than the limit of " + std::to_string(kMaxShells));
+  if (upper * (long long)spec.radii.size() > kMaxCameras)
+    bad_spec(text, std::to_string(upper) + " cameras x " + std::to_string(spec.radii.size()) + " shells = " +
+                       std::to_string(upper * (long long)spec.radii.size()) + " cameras is more than the limit of " +
+                       std::to_string(kMaxCameras));
   return spec;
 }
 
@@ -200,17 +209,32 @@ struct FileCamera {
   std::string where;  // "line 7" / "camera 3", for messages
 };
 
+constexpr int kMaxJsonDepth = 16;
+
+// A JSON value for a message, cut short.
+std::string shown(const nlohmann::json& j) {
+  std::string s = j.dump();
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  return s;
+}
+
 Vec3 json_vec3(const nlohmann::json& j, const std::string& path, const std::string& where, const char* key) {
   if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
-    throw FileError(path, where + ": \"" + key + "\" is " + j.dump() + "; expected an array of 3 numbers");
+    throw FileError(path, where + ": \"" + key + "\" is " + shown(j) + "; expected an array of 3 numbers");
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
 }
 
 std::vector<FileCamera> parse_json_cameras(const std::string& text, const std::string& path) {
   nlohmann::json doc;
   try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+    // Bounded nesting: deeper documents are refused while parsing, before a DOM (and the recursive
+    // dump() of an error message) could exhaust the stack.
+    doc = nlohmann::json::parse(text, [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+      if (depth > kMaxJsonDepth)
+        throw FileError(path, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels; expected a camera list");
+      return true;
+    });
+  } catch (const nlohmann::json::exception& e) {
     throw FileError(path, std::string("not valid JSON (") + e.what() + ")");
   }
   const nlohmann::json* list = &doc;
@@ -224,7 +248,7 @@ std::vector<FileCamera> parse_json_cameras(const std::string& text, const std::s
     const nlohmann::json& c = (*list)[k];
     FileCamera fc;
     fc.where = "camera " + std::to_string(k);
-    if (!c.is_object()) throw FileError(path, fc.where + " is " + c.dump() + "; expected an object");
+    if (!c.is_object()) throw FileError(path, fc.where + " is " + shown(c) + "; expected an object");
     for (const auto& item : c.items()) {
       const std::string& key = item.key();
       if (key != "position" && key != "look_at" && key != "up" && key != "fov_y_degrees" && key != "shell" &&
@@ -244,19 +268,19 @@ std::vector<FileCamera> parse_json_cameras(const std::string& text, const std::s
     }
     if (c.contains("fov_y_degrees")) {
       if (!c["fov_y_degrees"].is_number())
-        throw FileError(path, fc.where + ": \"fov_y_degrees\" is " + c["fov_y_degrees"].dump() + "; expected a number");
+        throw FileError(path, fc.where + ": \"fov_y_degrees\" is " + shown(c["fov_y_degrees"]) + "; expected a number");
       fc.fov = c["fov_y_degrees"].get<double>();
       if (!(fc.fov > 0 && fc.fov < 180))
         throw FileError(path, fc.where + ": fov_y_degrees " + format_double(fc.fov) + "; expected 0 < fov < 180");
     }
     if (c.contains("shell")) {
       if (!c["shell"].is_number_integer() || c["shell"].get<long long>() < 0 || c["shell"].get<long long>() > 1000000)
-        throw FileError(path, fc.where + ": \"shell\" is " + c["shell"].dump() + "; expected an integer >= 0");
+        throw FileError(path, fc.where + ": \"shell\" is " + shown(c["shell"]) + "; expected an integer >= 0");
       fc.shell = c["shell"].get<int>();
     }
     if (c.contains("patch")) {
       if (!c["patch"].is_string())
-        throw FileError(path, fc.where + ": \"patch\" is " + c["patch"].dump() + "; expected a string");
+        throw FileError(path, fc.where + ": \"patch\" is " + shown(c["patch"]) + "; expected a string");
       fc.patch = c["patch"].get<std::string>();
     }
     cams.push_back(std::move(fc));
@@ -316,15 +340,13 @@ std::vector<FileCamera> parse_text_cameras(const std::string& text, const std::s
 
 Rig read_rig_file(const std::string& path, const Domain& domain) {
   domain.validate();
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw FileError(path, "cannot open the camera file");
-  std::ostringstream buf;
-  buf << f.rdbuf();
-  const std::string text = buf.str();
+  const std::string text = read_regular_file(path, kMaxRigFileBytes, "camera file");
   const auto first = text.find_first_not_of(" \t\r\n");
   const bool json = first != std::string::npos && (text[first] == '{' || text[first] == '[');
   std::vector<FileCamera> cams = json ? parse_json_cameras(text, path) : parse_text_cameras(text, path);
   if (cams.empty()) throw FileError(path, "no cameras; expected at least one");
+  if ((long long)cams.size() > kMaxCameras)
+    throw FileError(path, std::to_string(cams.size()) + " cameras is more than the limit of " + std::to_string(kMaxCameras));
 
   Rig rig;
   rig.center = domain.center();

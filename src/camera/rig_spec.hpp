@@ -12,6 +12,7 @@
 // Any built-in kind may end with "@R1,R2,..." — shell radii in units of the domain's bounding-sphere
 // radius (default @3); several radii repeat the pattern on shells, outermost = shell 0. A leading
 // "shells:" is accepted for readability: "shells:yinyang@1.5,2.5,4".
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,6 +21,9 @@
 #include "camera/rig.hpp"
 
 namespace panoptes::camera {
+
+/// Largest camera file read_rig_file() accepts (about 10^7 cameras as text).
+inline constexpr std::uint64_t kMaxRigFileBytes = 1ull << 30;
 
 /// The kind and parameters of a rig.
 struct RigSpec {

@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -10,6 +11,7 @@
 
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
+#include "core/file_read.hpp"
 
 namespace panoptes::insitu {
 
@@ -63,6 +65,16 @@ long long integer(const Ctx& c, const toml::table& t, const std::string& key, co
   if (!n) return def;
   if (auto v = n->value_exact<int64_t>()) return *v;
   c.fail(where + key, "expected an integer");
+}
+
+// An integer key that must fit an int field: checked before narrowing (4294967336 is not 40).
+int int_in(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def,
+           long long lo, long long hi) {
+  const long long v = integer(c, t, key, where, def);
+  if (v < lo || v > hi)
+    c.fail(where + key, std::to_string(v) + " is out of range (expected an integer in " + std::to_string(lo) + " .. " +
+                            std::to_string(hi) + ")");
+  return int(v);
 }
 
 bool boolean(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, bool def) {
@@ -218,9 +230,9 @@ TaskConfig parse_task(const Ctx& c, const toml::table& t, std::size_t index) {
 
 void SessionConfig::validate() const {
   if (output_dir.empty()) throw Error("output.dir: must not be empty");
-  if (width < 2 || height < 2 || width > 16384 || height > 16384)
+  if (width < 2 || height < 2 || width > kMaxImageSide || height > kMaxImageSide)
     throw Error("image.width/height: " + std::to_string(width) + "x" + std::to_string(height) +
-                "; expected 2..16384 pixels each");
+                "; expected 2.." + std::to_string(kMaxImageSide) + " pixels each");
   (void)camera::RigSpec::parse(rig);  // throws naming the text
   if (tasks.empty()) throw Error("task: no [[task]] given; at least one visualization task is required");
   std::set<std::string> names;
@@ -243,7 +255,7 @@ void SessionConfig::validate() const {
 SessionConfig parse_session_config(const toml::table& root, const std::string& source,
                                    const std::vector<std::string>& foreign_sections) {
   const Ctx c{source};
-  std::set<std::string> allowed{"output", "image", "rig", "schedule", "video", "render", "task"};
+  std::set<std::string> allowed{"output", "image", "rig", "schedule", "video", "render", "task", "resources"};
   for (const auto& f : foreign_sections) allowed.insert(f);
   only_keys(c, root, "", allowed);
   SessionConfig s;
@@ -256,11 +268,11 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* im = table(c, root, "image")) {
     only_keys(c, *im, "image", {"width", "height", "background", "outline"});
-    s.width = int(integer(c, *im, "width", "image.", s.width));
-    s.height = int(integer(c, *im, "height", "image.", s.height));
-    if (s.width < 2 || s.height < 2 || s.width > 16384 || s.height > 16384)
+    s.width = int_in(c, *im, "width", "image.", s.width, INT_MIN, INT_MAX);
+    s.height = int_in(c, *im, "height", "image.", s.height, INT_MIN, INT_MAX);
+    if (s.width < 2 || s.height < 2 || s.width > kMaxImageSide || s.height > kMaxImageSide)
       c.fail("image.width/height", std::to_string(s.width) + "x" + std::to_string(s.height) +
-                                       " pixels; expected 2..16384 each");
+                                       " pixels; expected 2.." + std::to_string(kMaxImageSide) + " each");
     if (const auto* bg = im->get("background")) s.background = colour(c, *bg, "image.background");
     s.outline = boolean(c, *im, "outline", "image.", true);
   }
@@ -283,7 +295,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     const bool has_time = sc->get("every_time") != nullptr;
     s.schedule.every_steps = integer(c, *sc, "every_steps", "schedule.", has_time ? 0 : s.schedule.every_steps);
     s.schedule.every_time = num(c, *sc, "every_time", "schedule.", 0);
-    s.schedule.max_snapshots = int(integer(c, *sc, "max_snapshots", "schedule.", 0));
+    s.schedule.max_snapshots = int_in(c, *sc, "max_snapshots", "schedule.", 0, 0, INT_MAX);
     if (s.schedule.every_steps < 0) c.fail("schedule.every_steps", "expected an integer > 0");
     if (s.schedule.every_time < 0) c.fail("schedule.every_time", "expected a time > 0");
     if ((s.schedule.every_steps > 0) == (s.schedule.every_time > 0))
@@ -292,10 +304,10 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* v = table(c, root, "video")) {
     only_keys(c, *v, "video", {"crf", "preset", "gop", "threads", "fps"});
-    s.video.crf = int(integer(c, *v, "crf", "video.", s.video.crf));
+    s.video.crf = int_in(c, *v, "crf", "video.", s.video.crf, 0, 51);
     s.video.preset = str(c, *v, "preset", "video.", s.video.preset);
-    s.video.gop = int(integer(c, *v, "gop", "video.", s.video.gop));
-    s.video.threads = int(integer(c, *v, "threads", "video.", s.video.threads));
+    s.video.gop = int_in(c, *v, "gop", "video.", s.video.gop, 1, INT_MAX);
+    s.video.threads = int_in(c, *v, "threads", "video.", s.video.threads, 0, 1024);
     s.video.fps = num(c, *v, "fps", "video.", s.video.fps);
     try {
       s.video.validate();
@@ -318,6 +330,10 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.render.termination_alpha = float(num(c, *r, "termination_alpha", "render.", s.render.termination_alpha));
     if (!(s.render.termination_alpha > 0.5f && s.render.termination_alpha <= 1.0f))
       c.fail("render.termination_alpha", "expected a value in (0.5, 1]");
+  }
+  if (const auto* r = table(c, root, "resources")) {
+    only_keys(c, *r, "resources", {"check_memory"});
+    s.check_memory = boolean(c, *r, "check_memory", "resources.", true);
   }
   if (const auto* t = root.get("task")) {
     const auto* a = t->as_array();
@@ -369,11 +385,7 @@ SessionConfig parse_combined_config(const std::string& text, const std::string& 
 }
 
 SessionConfig load_session_config(const std::string& path, const std::vector<std::string>& foreign_sections) {
-  std::ifstream in(path);
-  if (!in) throw FileError(path, "cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_session_config_text(ss.str(), path, foreign_sections);
+  return parse_session_config_text(read_regular_file(path, kMaxConfigBytes, "configuration file"), path, foreign_sections);
 }
 
 const char* config_keys_help() {
@@ -390,6 +402,8 @@ const char* config_keys_help() {
             the reference "ref" of relative windows); reference = "snapshot" (this snapshot's quantile)
             | "running-max" (running maximum over snapshots: colours comparable across frames, but
             decaying waves fade); skip_empty = true; termination_alpha = 0.998
+[resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
+            available: MemAvailable or the cgroup limit; false = panoptes run --force)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |
             "isosurface" | "slice"; field = "name" (volume2: fields = ["a", "b"])
   volume:     preset = "hot" (p-wave, s-wave, diverging, grayscale, hot, rainbow); extinction_scale = 1;

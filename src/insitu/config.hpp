@@ -16,6 +16,11 @@ class table;
 
 namespace panoptes::insitu {
 
+/// Largest image side accepted (pixels); the memory check bounds the product with the rig.
+inline constexpr int kMaxImageSide = 16384;
+/// Largest configuration file read (bytes).
+inline constexpr unsigned long long kMaxConfigBytes = 16ull << 20;
+
 /// A value window: absolute [lo, hi], or relative (lo·ref, hi·ref) where ref is the running maximum
 /// of the `percentile` quantile of |field| over the whole grid (this snapshot's, or the running
 /// maximum over snapshots: SessionConfig::running_max).
@@ -73,6 +78,9 @@ struct SessionConfig {
   /// Reference of relative windows: this snapshot's quantile (false), or its running maximum over
   /// snapshots (true: colours comparable across frames, but decaying waves fade out).
   bool running_max = false;
+  /// Refuse to start when the estimated memory of a rank exceeds what it has available ([resources]
+  /// check_memory; false = `--force`, for people who know better than the estimate).
+  bool check_memory = true;
 
   /// Checks ranges and consistency (not the grid); throws panoptes::Error naming the key.
   void validate() const;

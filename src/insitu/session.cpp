@@ -13,16 +13,25 @@
 #include <optional>
 #include <sstream>
 
+#include <omp.h>
+
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/log.hpp"
+#include "insitu/resources.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
 
 namespace panoptes::insitu {
 
 using render::Index3;
+
+namespace {
+// Rigs of this many cameras or more report the stages of their construction (log level info).
+constexpr long long kReportRigCameras = 100000;
+}  // namespace
 
 LocalBlock LocalBlock::slab(const render::GridGeometry& g, int axis, int parts, int index, int ghosts) {
   if (axis < 0 || axis > 2 || parts < 1 || index < 0 || index >= parts || parts > g.dims[axis])
@@ -163,6 +172,7 @@ struct Session::Impl {
 
   void init();
   void build_tasks();
+  void check_resources();
   store::Manifest make_manifest() const;
   void load_fields(const std::vector<FieldInput>& fields);
   double global_percentile(int field);
@@ -218,16 +228,30 @@ void Session::Impl::init() {
     if (b.has_brick && !b.available.contains(b.required)) exchange_needed = true;
 
   build_tasks();
+  check_resources();
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
   camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
   spec.up = {cfg.up[0], cfg.up[1], cfg.up[2]};
+  // Large rigs take seconds to build (rig, cameras, navigation graph, manifest): say so as it goes.
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool report = rank == 0 && spec.kind != camera::RigSpec::Kind::file &&
+                      spec.cameras_per_shell() * (long long)spec.radii.size() >= kReportRigCameras;
+  auto stage = [&](const std::string& what) {
+    if (report)
+      log::info("session: " + what + " (" + fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) +
+                " s)");
+  };
+  stage("building the rig " + cfg.rig);
   rig = camera::make_rig(spec, domain);
+  cameras.reserve(std::size_t(rig.size()));
   for (int c = 0; c < rig.size(); ++c) cameras.push_back(rig.camera(c, cfg.width, cfg.height));
   for (int c = rank; c < rig.size(); c += size) owned.push_back(c);
   references.resize(field_names.size());
+  stage(std::to_string(rig.size()) + " cameras placed; building the navigation graph and the manifest");
 
   // Rank 0 creates the directory and manifest first; the others then open their movies' writers.
   const store::Manifest man = make_manifest();
+  stage("manifest ready; creating the database");
   if (rank == 0) {
     store::WriterOptions o;
     o.overwrite = cfg.overwrite;
@@ -241,12 +265,45 @@ void Session::Impl::init() {
     o.writes_manifest = false;
     writer.emplace(store::DatabaseWriter::create(cfg.output_dir, man, o));
   }
+  stage("database created");
   const int slots = size;
   partials.assign(std::size_t(slots), std::vector<render::PartialImage>(tasks.size()));
   send_buf.resize(std::size_t(slots));
   received.assign(std::size_t(size), std::vector<render::PartialImage>(tasks.size()));
   composited.resize(tasks.size());
   images.resize(tasks.size());
+}
+
+// Refuses, before the rig, the writers and the buffers exist, a session this rank cannot hold.
+// Collective: if any rank refuses, every rank throws (the others would wait for it forever).
+void Session::Impl::check_resources() {
+  std::string refusal;
+  try {
+    const long long cameras = rig_camera_count(cfg, grid);
+    check_open_streams(cameras, int(tasks.size()), size);
+    if (cfg.check_memory) {
+      const double points = me().has_brick ? double(me().required.size()) : 0.0;
+      int sharing = 1;
+#ifdef PANOPTES_HAVE_MPI
+      if (size > 1) {
+        MPI_Comm node;
+        MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
+        MPI_Comm_size(node, &sharing);
+        MPI_Comm_free(&node);
+      }
+#endif
+      refusal = memory_refusal(estimate_session_memory(cfg, points, cameras, size, omp_get_max_threads()),
+                               available_memory(), sharing, "this in-situ session",
+                               "set check_memory = false in [resources] (panoptes run --force)");
+    }
+  } catch (const std::exception& e) {
+    refusal = e.what();
+  }
+  int refused = refusal.empty() ? 0 : 1;
+#ifdef PANOPTES_HAVE_MPI
+  if (size > 1) MPI_Allreduce(MPI_IN_PLACE, &refused, 1, MPI_INT, MPI_MAX, comm);
+#endif
+  if (refused) throw Error(refusal.empty() ? "another rank of this session refused to start (see its message)" : refusal);
 }
 
 void Session::Impl::build_tasks() {

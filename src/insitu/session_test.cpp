@@ -9,6 +9,8 @@
 
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/memory.hpp"
+#include "insitu/resources.hpp"
 #include "insitu/session.hpp"
 #include "render/synthetic_fields.hpp"
 #include "store/database.hpp"
@@ -64,6 +66,79 @@ TEST(InsituConfig, ErrorsNameTheKey) {
   EXPECT_NE(error_of("[[task]]\nname = \"v\"\nfield = \"f\"\nwindow = [1, 0]\n").find("lo < hi"), std::string::npos);
   EXPECT_NE(error_of(std::string(kTask) + "[seismic]\nx = 1\n").find("seismic: unknown key"), std::string::npos);
   EXPECT_NE(error_of("x = [").find("TOML syntax error"), std::string::npos);
+}
+
+// Issue 15: absurd configurations are refused before anything is built.
+TEST(InsituConfig, IntegersAreRangeCheckedBeforeNarrowing) {
+  EXPECT_NE(error_of(std::string(kTask) + "[image]\nwidth = 4294967336\n")
+                .find("image.width: 4294967336 is out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[schedule]\nmax_snapshots = 4294967297\n").find("schedule.max_snapshots"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[video]\ngop = -4294967295\n").find("video.gop"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[resources]\ncheck_memory = 1\n").find("resources.check_memory"),
+            std::string::npos);
+  EXPECT_FALSE(insitu::parse_session_config_text(std::string(kTask) + "[resources]\ncheck_memory = false\n", "t")
+                   .check_memory);
+}
+
+TEST(InsituConfig, RigSpecsAreBounded) {
+  // More cameras over all shells than the limit (each shell alone is allowed).
+  EXPECT_NE(error_of(std::string(kTask) + "[rig]\nspec = \"fibonacci:5000000@2,3,4\"\n").find("is more than the limit"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTask) + "[rig]\nspec = \"fibonacci:10000001\"\n").find("is more than the limit"),
+            std::string::npos);
+}
+
+// A rig file must be a regular file: /dev/zero used to be read for ever.
+TEST(InsituResources, RigFileMustBeARegularFile) {
+  auto c = insitu::parse_session_config_text(std::string(kTask) + "[rig]\nspec = \"file:/dev/zero\"\n", "t");
+  const render::GridGeometry grid{{16, 16, 16}, {0, 0, 0}, {1, 1, 1}};
+  try {
+    (void)insitu::rig_camera_count(c, grid);
+    FAIL() << "no error";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: is a character device; expected a regular camera file"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(InsituResources, HugeImagesAndRigsDoNotFitAndSmallOnesDo) {
+  auto c = insitu::parse_session_config_text(std::string(kTask), "t");
+  const double points = 64.0 * 64 * 64;
+  const MemoryLimit machine{24e9, "test"};
+  EXPECT_EQ(memory_refusal(insitu::estimate_session_memory(c, points, 130, 1, 2), machine, 1, "x", "y"), "");
+  c.width = c.height = 16384;  // 268 Mpixel per camera: several GB of partial images and writers
+  const std::string why = memory_refusal(insitu::estimate_session_memory(c, points, 130, 1, 2), machine, 1, "this session", "--force");
+  EXPECT_NE(why.find("this session needs about"), std::string::npos) << why;
+  EXPECT_NE(why.find("24.0 GB available (test)"), std::string::npos) << why;
+  c.width = 920, c.height = 896;
+  // 10^7 cameras: 10^7 open writers alone are ~11 TB.
+  EXPECT_NE(memory_refusal(insitu::estimate_session_memory(c, points, 10'000'000, 1, 2), machine, 1, "x", "y"), "");
+  EXPECT_THROW(insitu::check_open_streams(10'000'000, 3, 1), Error);
+  EXPECT_THROW(insitu::check_open_streams(2'000'000'000, 2, 1), Error);  // cameras x tasks beyond an int
+  EXPECT_EQ(insitu::check_open_streams(130, 3, 4), 98);
+}
+
+TEST(InsituResources, SessionRefusesBeforeBuildingAnything) {
+  const fs::path dir = fs::temp_directory_path() / ("panoptes_resources_" + std::to_string(::getpid()));
+  // 16 tasks of 16384^2 pixels: ~0.4 TB of partial images alone, more than any machine this runs on.
+  std::string windows = "windows = [";
+  for (int i = 1; i <= 16; ++i) windows += "[0, " + std::to_string(i) + "],";
+  windows.back() = ']';
+  auto c = insitu::parse_session_config_text(
+      std::string(kTask) + windows + "\n[image]\nwidth = 16384\nheight = 16384\n", "t");
+  c.output_dir = dir.string();
+  const render::GridGeometry grid{{16, 16, 16}, {0, 0, 0}, {1, 1, 1}};
+  try {
+    insitu::Session s(c, grid, insitu::LocalBlock::whole(grid));
+    FAIL() << "a 16384x16384 image for 130 cameras was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("needs about"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("check_memory = false"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir));  // nothing was written
 }
 
 insitu::SessionConfig small_config(const std::string& dir) {

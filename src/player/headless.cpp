@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/file_read.hpp"
 #include "core/png.hpp"
 
 namespace panoptes::player {
@@ -110,6 +111,10 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
       if (key == "t" && eq != std::string::npos) {
         c.t = parse_double(value, where);
         if (c.t < 0) throw Error(where + ": time t=" + value + " is negative");
+        // A run shows every tick up to the last command: an absurd time would play for ever.
+        if (c.t > kMaxScriptSeconds)
+          throw Error(where + ": time t=" + value + " is beyond the limit of " + std::to_string(int(kMaxScriptSeconds)) +
+                      " s");
         have_t = true;
         continue;
       }
@@ -178,11 +183,7 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
 }
 
 std::vector<ScriptCommand> read_script(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw FileError(path.string(), "cannot read the script");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_script(buffer.str(), path.string());
+  return parse_script(read_regular_file(path.string(), 16u << 20, "script"), path.string());
 }
 
 HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOptions& options) {

@@ -15,7 +15,7 @@
 //   t=SECONDS end                stop the run here (no frame is shown at this time)
 // Without `end` (and without an explicit duration) the run ends once the last command's effect has
 // been shown; without any command it plays the database once.
-// Times are virtual seconds from the start and must not decrease.
+// Times are virtual seconds from the start, must not decrease and are at most kMaxScriptSeconds.
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -27,6 +27,9 @@
 #include "player/keys.hpp"
 
 namespace panoptes::player {
+
+/// Latest time a script command may have (virtual seconds: one day).
+inline constexpr double kMaxScriptSeconds = 86400;
 
 /// One parsed script line.
 struct ScriptCommand {

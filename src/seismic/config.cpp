@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <string_view>
+#include <unordered_set>
 
 #include "core/error.hpp"
 
@@ -69,6 +71,12 @@ void SolverConfig::validate() const {
   require(g.nx >= 2 * n + 5 && g.ny >= 2 * n + 5 && g.nz >= 2 * n + 5,
           "grid " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" + std::to_string(g.nz) +
               " is too small: every axis needs at least 2*pml_cells + 5 = " + std::to_string(2 * n + 5) + " nodes");
+  // The solver indexes a plane of the ghosted grid with int: keep nx·ny (and each axis) well inside it.
+  require(g.nx <= kMaxAxisNodes && g.ny <= kMaxAxisNodes && g.nz <= kMaxAxisNodes &&
+              (long long)(g.nx + 4) * (g.ny + 4) <= kMaxPlaneNodes,
+          "grid " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" + std::to_string(g.nz) +
+              " is too large: expected at most " + std::to_string(kMaxAxisNodes) + " nodes per axis and " +
+              std::to_string(kMaxPlaneNodes) + " nodes per x-y plane");
   require(g.h > 0 && std::isfinite(g.h), "grid spacing h must be > 0, got " + std::to_string(g.h));
   require(boundary.pml_reflection > 0 && boundary.pml_reflection < 1,
           "boundary.pml_reflection must be in (0, 1), got " + std::to_string(boundary.pml_reflection));
@@ -78,6 +86,23 @@ void SolverConfig::validate() const {
   require(record_every >= 1, "record_every must be >= 1, got " + std::to_string(record_every));
   require(attenuation.mechanisms >= 3, "attenuation.mechanisms must be >= 3, got " +
                                            std::to_string(attenuation.mechanisms));
+  if (medium.kind == MediumSpec::Kind::layered) {
+    // Depth is positive down from the surface z = 0; a layer cannot start above it, and each layer
+    // starts below the previous one (otherwise the earlier one has no thickness and is silently lost).
+    require(!medium.layers.empty(), "medium: no layers given");
+    for (std::size_t l = 0; l < medium.layers.size(); ++l) {
+      const Layer& L = medium.layers[l];
+      require(std::isfinite(L.top), "medium.layer[" + std::to_string(l) + "].top is not a finite depth");
+      require(l > 0 || L.top == 0, "medium.layer[0].top = " + std::to_string(L.top) +
+                                       " m; the first layer must start at the surface, depth 0 (z is positive down)");
+      require(L.top >= 0, "medium.layer[" + std::to_string(l) + "].top = " + std::to_string(L.top) +
+                              " m lies above the surface (depth 0; z is positive down)");
+      require(l == 0 || L.top > medium.layers[l - 1].top,
+              "medium.layer[" + std::to_string(l) + "].top = " + std::to_string(L.top) + " m is not below layer " +
+                  std::to_string(l - 1) + "'s top " + std::to_string(medium.layers[l - 1].top) +
+                  " m; list the layers from the surface down");
+    }
+  }
   // The non-absorbing region every source and receiver must lie in.
   const double lo[3] = {n * g.h, n * g.h, boundary.free_surface ? 0.0 : n * g.h};
   const double hi[3] = {(g.nx - 1 - n) * g.h, (g.ny - 1 - n) * g.h, (g.nz - 1 - n) * g.h};
@@ -95,15 +120,19 @@ void SolverConfig::validate() const {
     for (double m : sources[i].moment) require(std::isfinite(m), "source " + std::to_string(i) + ": non-finite moment");
     for (double f : sources[i].force) require(std::isfinite(f), "source " + std::to_string(i) + ": non-finite force");
   }
+  // Messages are built only on failure, and names go into a set (not compared pairwise): receiver
+  // lines give up to 10^5 receivers each.
+  std::unordered_set<std::string_view> names;
+  names.reserve(receivers.size());
   for (const auto& r : receivers) {
-    require(!r.name.empty(), "a receiver has an empty name");
-    require(r.name.find_first_of("/\\") == std::string::npos, "receiver name '" + r.name + "' contains a slash");
-    require(inside(r.position),
-            "receiver '" + r.name + "' at " + pos_str(r.position) + " is outside the non-absorbing domain " + region.str());
+    if (r.name.empty()) throw Error("a receiver has an empty name");
+    if (r.name.find_first_of("/\\") != std::string::npos)
+      throw Error("receiver name '" + r.name + "' contains a slash");
+    if (!inside(r.position))
+      throw Error("receiver '" + r.name + "' at " + pos_str(r.position) + " is outside the non-absorbing domain " +
+                  region.str());
+    if (!names.insert(r.name).second) throw Error("two receivers are named '" + r.name + "'");
   }
-  for (std::size_t i = 0; i < receivers.size(); ++i)
-    for (std::size_t j = i + 1; j < receivers.size(); ++j)
-      require(receivers[i].name != receivers[j].name, "two receivers are named '" + receivers[i].name + "'");
 }
 
 }  // namespace panoptes::seismic

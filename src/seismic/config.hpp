@@ -14,6 +14,10 @@
 
 namespace panoptes::seismic {
 
+/// Largest grid accepted per axis and per x-y plane (the solver indexes a plane with int).
+inline constexpr int kMaxAxisNodes = 1 << 20;
+inline constexpr long long kMaxPlaneNodes = (1LL << 31) - 1;
+
 /// A uniform grid of nx × ny × nz nodes with spacing h, INCLUDING the absorbing layers.
 struct GridSpec {
   int nx = 0, ny = 0, nz = 0;

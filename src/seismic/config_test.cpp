@@ -1,10 +1,12 @@
 // TOML configuration: every section parses; unknown keys and wrong types are errors naming the key.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "core/error.hpp"
 #include "seismic/config_toml.hpp"
+#include "seismic/resources.hpp"
 
 using namespace panoptes::seismic;
 
@@ -106,4 +108,59 @@ TEST(SeismicConfig, ErrorsNameTheKey) {
   EXPECT_NE(error_of(replace(kValid, "[grid]", "[grids]")).find("grids: unknown key"), std::string::npos);
   EXPECT_NE(error_of("[grid\n").find("TOML syntax error"), std::string::npos);
   EXPECT_NE(error_of(replace(kValid, "type = \"layered\"", "type = \"fluid\"")).find("medium.type"), std::string::npos);
+}
+
+// Issue 15: absurd values are refused before the run, naming the key, instead of being narrowed,
+// accepted or ending in std::bad_alloc.
+TEST(SeismicConfig, IntegersAreRangeCheckedBeforeNarrowing) {
+  // 4294967336 = 2^32 + 40 would run as nx = 40 if narrowed to int unchecked.
+  EXPECT_NE(error_of(replace(kValid, "nx = 30", "nx = 4294967336"))
+                .find("grid.nx: 4294967336 is out of range (expected an integer in 1 .. 1048576)"),
+            std::string::npos);
+  EXPECT_NE(error_of(replace(kValid, "steps = 10", "steps = 9223372036854775807")).find("time.steps: 9223372036854775807 is out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of(replace(kValid, "steps = 10", "steps = 0")).find("time.steps: 0 is out of range"), std::string::npos);
+  EXPECT_NE(error_of(replace(kValid, "pml_cells = 8", "pml_cells = 4294967304")).find("boundary.pml_cells"),
+            std::string::npos);
+}
+
+TEST(SeismicConfig, LayersMustStartAtTheSurfaceAndGoDown) {
+  const std::string above = replace(kValid, "top = 0\n", "top = -500\n");
+  EXPECT_NE(error_of(above).find("medium.layer[0].top = -500"), std::string::npos) << error_of(above);
+  EXPECT_NE(error_of(above).find("must start at the surface"), std::string::npos);
+  const std::string order = replace(kValid, "top = 300.0", "top = 0");
+  EXPECT_NE(error_of(order).find("medium.layer[1].top = 0"), std::string::npos) << error_of(order);
+  EXPECT_NE(error_of(order).find("from the surface down"), std::string::npos);
+}
+
+TEST(SeismicConfig, GridsBeyondTheSolversIndexRangeAreRefused) {
+  std::string big = replace(replace(kValid, "nx = 30", "nx = 100000"), "ny = 30", "ny = 100000");
+  EXPECT_NE(error_of(big).find("is too large"), std::string::npos) << error_of(big);
+}
+
+TEST(SeismicConfig, ManyReceiversValidateQuickly) {
+  // Receiver names used to be compared pairwise: 3 lines of 10^5 took minutes.
+  std::string text = kValid;
+  for (int l = 0; l < 3; ++l)
+    text += "[[receiver_line]]\nname = \"l" + std::to_string(l) +
+            "\"\nstart = [500, 500, 0]\nend = [900, 900, 0]\ncount = 100000\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  const RunConfig rc = parse_run_config(text, "test.toml", ".");
+  EXPECT_GE(rc.solver.receivers.size(), 300000u);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
+}
+
+TEST(SeismicResources, EstimateCountsTheArraysAndTheTraces) {
+  const RunConfig rc = parse_run_config(kValid, "test.toml", ".");
+  SolverConfig c = rc.solver;
+  c.grid = {2000, 2000, 2000, 10.0};
+  // 2000^3 nodes x (9 wavefield + 2 derived + 18 memory variables floats) alone is ~0.9 TB.
+  const double big = estimate_solver_memory(c, 1).total();
+  EXPECT_GT(big, 8e11);
+  EXPECT_LT(estimate_solver_memory(c, 4).total(), big / 3.5);  // z-slabs split it over ranks
+  c = rc.solver;
+  c.steps = 2147483647;
+  c.record_every = 1;
+  // The receiver traces are reserved for every step: 8 bytes x (1 + 3 x receivers) x 2^31.
+  EXPECT_GT(estimate_solver_memory(c, 1).total(), 1.7e10);
 }

@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/file_read.hpp"
 #include "seismic/solver.hpp"
 
 namespace panoptes::seismic {
@@ -65,6 +67,16 @@ long long integer(const Ctx& c, const toml::table& t, const std::string& key, co
   }
   if (auto v = n->value_exact<int64_t>()) return *v;
   c.fail(where + key, "expected an integer");
+}
+
+// An integer key that must fit an int field: checked before narrowing (4294967336 is not 40).
+int int_in(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def,
+           long long lo, long long hi, bool required = false) {
+  const long long v = integer(c, t, key, where, def, required);
+  if (v < lo || v > hi)
+    c.fail(where + key, std::to_string(v) + " is out of range (expected an integer in " + std::to_string(lo) + " .. " +
+                            std::to_string(hi) + ")");
+  return int(v);
 }
 
 bool boolean(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, bool def) {
@@ -165,18 +177,18 @@ RunConfig parse_run_config(const std::string& text, const std::string& source_na
   const auto* g = table(c, root, "grid", "");
   if (!g) c.fail("grid", "missing table [grid] (nx, ny, nz, h)");
   only_keys(c, *g, "grid", {"nx", "ny", "nz", "h"});
-  s.grid.nx = int(integer(c, *g, "nx", "grid.", 0, true));
-  s.grid.ny = int(integer(c, *g, "ny", "grid.", 0, true));
-  s.grid.nz = int(integer(c, *g, "nz", "grid.", 0, true));
+  s.grid.nx = int_in(c, *g, "nx", "grid.", 0, 1, kMaxAxisNodes, true);
+  s.grid.ny = int_in(c, *g, "ny", "grid.", 0, 1, kMaxAxisNodes, true);
+  s.grid.nz = int_in(c, *g, "nz", "grid.", 0, 1, kMaxAxisNodes, true);
   s.grid.h = num(c, *g, "h", "grid.", 0, true);
 
   const auto* tm = table(c, root, "time", "");
   if (!tm) c.fail("time", "missing table [time] (steps)");
   only_keys(c, *tm, "time", {"steps", "dt", "courant", "record_every"});
-  s.steps = int(integer(c, *tm, "steps", "time.", 0, true));
+  s.steps = int_in(c, *tm, "steps", "time.", 0, 1, INT_MAX, true);
   s.dt = num(c, *tm, "dt", "time.", 0);
   s.courant = num(c, *tm, "courant", "time.", 0.9);
-  s.record_every = int(integer(c, *tm, "record_every", "time.", 1));
+  s.record_every = int_in(c, *tm, "record_every", "time.", 1, 1, INT_MAX);
 
   const auto* m = table(c, root, "medium", "");
   if (!m) c.fail("medium", "missing table [medium]");
@@ -214,7 +226,7 @@ RunConfig parse_run_config(const std::string& text, const std::string& source_na
   if (const auto* b = table(c, root, "boundary", "")) {
     only_keys(c, *b, "boundary", {"free_surface", "pml_cells", "pml_reflection", "pml_frequency"});
     s.boundary.free_surface = boolean(c, *b, "free_surface", "boundary.", true);
-    s.boundary.pml_cells = int(integer(c, *b, "pml_cells", "boundary.", 10));
+    s.boundary.pml_cells = int_in(c, *b, "pml_cells", "boundary.", 10, 0, 100000);
     s.boundary.pml_reflection = num(c, *b, "pml_reflection", "boundary.", 1e-4);
     s.boundary.pml_frequency = num(c, *b, "pml_frequency", "boundary.", 0);
   }
@@ -223,7 +235,7 @@ RunConfig parse_run_config(const std::string& text, const std::string& source_na
     s.attenuation.fmin = num(c, *a, "fmin", "attenuation.", 0);
     s.attenuation.fmax = num(c, *a, "fmax", "attenuation.", 0);
     s.attenuation.fref = num(c, *a, "fref", "attenuation.", 0);
-    s.attenuation.mechanisms = int(integer(c, *a, "mechanisms", "attenuation.", 3));
+    s.attenuation.mechanisms = int_in(c, *a, "mechanisms", "attenuation.", 3, 3, 16);
   }
 
   if (const auto* n = root.get("source")) {
@@ -328,12 +340,9 @@ RunConfig parse_run_config(const std::string& text, const std::string& source_na
 }
 
 RunConfig load_run_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw FileError(path, "cannot open configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = read_regular_file(path, 16ull << 20, "configuration file");
   const auto base = std::filesystem::path(path).parent_path().string();
-  return parse_run_config(ss.str(), path, base.empty() ? "." : base);
+  return parse_run_config(text, path, base.empty() ? "." : base);
 }
 
 const char* config_keys_help() {

@@ -84,4 +84,48 @@ expect_error 's/field = "phi_p"/field = "pressure"/' 'field "pressure"'
 expect_error 's/^nx = 28/nx = "big"/' 'grid.nx'
 expect_error 's/^spec = "fibonacci:4"/spec = "cube"/' 'rig.spec'
 expect_error 's/^preset = "p-wave"/preset = "violet"/' 'unknown preset "violet"'
+
+# Issue 15 (FIFOs and layer order: unit tests FileRead.*, SeismicConfig.*): absurd configurations are refused at once, in one line naming the number and the limit,
+# before any database exists (never std::bad_alloc, a hang or gigabytes of memory).
+expect_one_line() {  # $1 = what, $2 = expected message part; runs bad.toml
+  local start=$SECONDS
+  if timeout 20 "$bin" run bad.toml --out bad_db > bad.log 2>&1; then echo "FAIL: accepted ($1)"; exit 1; fi
+  grep -qF -- "$2" bad.log || { echo "FAIL: for ($1) expected \"$2\", got:"; cat bad.log; exit 1; }
+  [ "$(wc -l < bad.log)" = 1 ] || { echo "FAIL: ($1) not one line:"; cat bad.log; exit 1; }
+  grep -q "bad_alloc" bad.log && { echo "FAIL: ($1) bad_alloc"; exit 1; }
+  (( SECONDS - start < 15 )) || { echo "FAIL: ($1) took $((SECONDS - start)) s"; exit 1; }
+  [ ! -e bad_db ] || { echo "FAIL: ($1) created a database before failing"; exit 1; }
+}
+sed -e 's/^nx = 28/nx = 2000/; s/^ny = 24/ny = 2000/; s/^nz = 20/nz = 2000/' tiny.toml > bad.toml
+expect_one_line "2000^3 grid" "this run needs about"
+grep -qF "pass --force" bad.log || { cat bad.log; echo "FAIL: no --force hint"; exit 1; }
+sed -e 's/^steps = 40/steps = 2147483647/' tiny.toml > bad.toml
+printf '[[receiver_line]]\nname = "l"\nstart = [600.0, 600.0, 0.0]\nend = [1500.0, 1500.0, 0.0]\ncount = 100\n' >> bad.toml
+expect_one_line "steps near 2^31" "receiver traces"
+sed -e 's/^nx = 28/nx = 4294967336/' tiny.toml > bad.toml
+expect_one_line "nx narrowed" "grid.nx: 4294967336 is out of range"
+sed -e 's|^spec = "fibonacci:4"|spec = "file:/dev/zero"|' tiny.toml > bad.toml
+expect_one_line "rig from /dev/zero" "/dev/zero: is a character device"
+for rig in "fibonacci:10000000" "fibonacci:1000000@2,3,4,5,6"; do
+  sed -e "s|^spec = \"fibonacci:4\"|spec = \"$rig\"|" tiny.toml > bad.toml
+  if timeout 20 "$bin" run bad.toml --out bad_db > bad.log 2>&1; then echo "FAIL: accepted $rig"; exit 1; fi
+  grep -qE "open-file limit|needs about" bad.log || { echo "FAIL: $rig:"; cat bad.log; exit 1; }
+  [ "$(wc -l < bad.log)" = 1 ] && [ ! -e bad_db ] || { echo "FAIL: $rig:"; cat bad.log; exit 1; }
+done
+sed -e 's/^every_steps = 10/every_time = 1e-300/' tiny.toml > bad.toml
+expect_one_line "every_time = 1e-300" "is shorter than the solver's time step"
+sed -e 's/^every_steps = 10/every_steps = 1000/' tiny.toml > bad.toml
+expect_one_line "no snapshot" "the schedule takes no snapshot in 40 steps"
+# 16384 x 16384 for every camera, and a sweep of 16 windows: hundreds of GB of partial images.
+sed -e 's/^width = 40/width = 16384/; s/^height = 32/height = 16384/' \
+    -e 's/^preset = "p-wave"/preset = "p-wave"\nwindows = [[0,1],[0,2],[0,3],[0,4],[0,5],[0,6],[0,7],[0,8],[0,9],[0,10],[0,11],[0,12],[0,13],[0,14],[0,15],[0,16]]/' \
+    tiny.toml > bad.toml
+expect_one_line "16384^2 images" "partial images"
+sed -e 's/^type = "homogeneous"/type = "layered"\n[[medium.layer]]\ntop = -100.0/' tiny.toml > bad.toml
+expect_one_line "layer above the surface" "must start at the surface"
+# The limit can be set explicitly (batch systems without cgroups); --force runs anyway.
+cp tiny.toml bad.toml
+PANOPTES_MEMORY_LIMIT=1M expect_one_line "1 MB limit" "available (PANOPTES_MEMORY_LIMIT)"
+PANOPTES_MEMORY_LIMIT=1M "$bin" run tiny.toml --out forced_db --force -q > forced.log 2>&1 || { cat forced.log; echo "FAIL: --force"; exit 1; }
+check_complete forced_db
 echo "run.sh: ok"

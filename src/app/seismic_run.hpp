@@ -1,0 +1,20 @@
+#pragma once
+// The seismic solver with in-situ visualization, shared by `panoptes run` and `panoptes demo`.
+#include <string>
+
+namespace panoptes::app {
+
+/// Options of a seismic in-situ run.
+struct SeismicRunOptions {
+  std::string out;  ///< overrides [output] dir when not empty
+  bool overwrite = false;
+  bool quiet = false;
+  std::string command_line;
+  bool force = false;  ///< start even when the memory estimate exceeds what a rank has available
+};
+
+/// Runs the solver with in-situ visualization from TOML text (defined in cmd_run.cpp).
+void run_seismic_insitu(const std::string& text, const std::string& source, const std::string& base_dir,
+                        const SeismicRunOptions& options);
+
+}  // namespace panoptes::app

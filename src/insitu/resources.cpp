@@ -1,0 +1,67 @@
+#include "insitu/resources.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+
+#include "camera/rig_spec.hpp"
+#include "core/error.hpp"
+#include "video/writer_memory.hpp"
+
+namespace panoptes::insitu {
+
+namespace {
+// Rig camera, render camera, manifest entry, navigation graph row and its build, camera table row:
+// measured as the resident growth of `panoptes rig fibonacci:N` and Session construction (see
+// docs/insitu.md, "Resources"), rounded up.
+constexpr double kBytesPerCamera = 1500;
+}  // namespace
+
+MemoryEstimate estimate_session_memory(const SessionConfig& cfg, double block_points, long long cameras, int ranks,
+                                       int encode_threads) {
+  ranks = std::max(ranks, 1);
+  std::vector<std::string> fields;
+  for (const TaskConfig& t : cfg.tasks)
+    for (const auto& f : t.fields)
+      if (std::find(fields.begin(), fields.end(), f) == fields.end()) fields.push_back(f);
+  double tasks = 0;  // sweeps expand to one task per value
+  for (const TaskConfig& t : cfg.tasks)
+    tasks += double(std::max<std::size_t>(
+        1, t.kind == TaskConfig::Kind::isosurface ? t.isovalues.size()
+                                                  : t.kind == TaskConfig::Kind::slice ? t.slice_positions.size()
+                                                                                      : t.windows.size()));
+  const double px = double(cfg.width) * cfg.height;
+  const double owned = std::ceil(double(cameras) / ranks);
+  MemoryEstimate e;
+  // float32 copy of each field over the brick, its macro-cell min/max and the ghost exchange.
+  e.add("field copies", double(fields.size()) * block_points * (4 + 1));
+  // Partial images (premultiplied RGBA + depth floats) of one camera round: rendered ones, their
+  // send buffers and the received ones, plus the composite; full frames at worst.
+  e.add("partial images", (3.0 * ranks + 1) * tasks * px * 20);
+  e.add("finished frames", tasks * px * 3 + std::max(encode_threads, 1) * video::live_encoder_bytes(px));
+  e.add("open movie writers", owned * tasks * video::open_writer_bytes(px, cfg.video.gop));
+  e.add("rig and manifest", double(cameras) * kBytesPerCamera);
+  return e;
+}
+
+long long rig_camera_count(const SessionConfig& cfg, const render::GridGeometry& grid) {
+  const camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
+  if (spec.kind != camera::RigSpec::Kind::file) return spec.cameras_per_shell() * (long long)spec.radii.size();
+  const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
+  return camera::read_rig_file(spec.path, domain).size();
+}
+
+long long check_open_streams(long long cameras, int tasks, int ranks) {
+  const long long streams = checked_product(cameras, tasks, "cameras x tasks (movies)", INT_MAX);
+  const long long per_rank = (streams + std::max(ranks, 1) - 1) / std::max(ranks, 1);
+  const long long limit = open_file_limit();
+  // Keep room for the manifest, the lock, MPI and the C library.
+  if (limit >= 0 && per_rank > limit - 64)
+    throw Error(std::to_string(cameras) + " cameras x " + std::to_string(tasks) + " tasks = " + std::to_string(streams) +
+                " movies, " + std::to_string(per_rank) + " open at once on each of " + std::to_string(ranks) +
+                " rank(s), but the open-file limit (ulimit -n) is " + std::to_string(limit) +
+                "; use fewer cameras or tasks, more ranks, or raise the limit");
+  return per_rank;
+}
+
+}  // namespace panoptes::insitu

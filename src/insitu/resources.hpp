@@ -1,0 +1,26 @@
+#pragma once
+// What an in-situ session will hold in memory and open files, per rank, before it builds anything.
+#include <string>
+
+#include "core/memory.hpp"
+#include "insitu/config.hpp"
+#include "render/field_view.hpp"
+
+namespace panoptes::insitu {
+
+/// Peak resident bytes of one rank of a Session: float32 copies of the fields over its brick
+/// (`block_points` points, ghosts included), partial images in flight (camera rounds of `ranks`,
+/// every task, full frames at worst), finished frames, the open writers of the streams it owns and
+/// the rig / manifest / navigation graph of `cameras` cameras. `encode_threads` frames encode at once.
+MemoryEstimate estimate_session_memory(const SessionConfig& config, double block_points, long long cameras,
+                                       int ranks, int encode_threads);
+
+/// The number of cameras config.rig gives: computed for built-in rigs, read for file rigs (bounded).
+long long rig_camera_count(const SessionConfig& config, const render::GridGeometry& grid);
+
+/// Movies open at once on one rank (its share of cameras × tasks), or throws Error naming the count
+/// and the open-file limit (ulimit -n) when they cannot all be open; also refuses a cameras × tasks
+/// count beyond an int.
+long long check_open_streams(long long cameras, int tasks, int ranks);
+
+}  // namespace panoptes::insitu
