@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -12,13 +13,29 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
+// Inputs under a "pending*" directory still crash code another change is fixing: replayed only with
+// PANOPTES_FUZZ_PENDING=1 (see the README in such a directory).
+bool pending(const std::filesystem::path& p) {
+  for (const auto& part : p)
+    if (part.string().rfind("pending", 0) == 0) return true;
+  return false;
+}
+
 int main(int argc, char** argv) {
+  const char* with_pending = std::getenv("PANOPTES_FUZZ_PENDING");
+  const bool replay_pending = with_pending && std::string(with_pending) == "1";
   std::vector<std::filesystem::path> files;
   for (int i = 1; i < argc; ++i) {
     const std::filesystem::path p(argv[i]);
     if (std::filesystem::is_directory(p)) {
-      for (const auto& e : std::filesystem::recursive_directory_iterator(p))
-        if (e.is_regular_file()) files.push_back(e.path());
+      for (const auto& e : std::filesystem::recursive_directory_iterator(p)) {
+        if (!e.is_regular_file() || e.path().extension() == ".md") continue;
+        if (pending(std::filesystem::relative(e.path(), p)) && !replay_pending) {
+          std::fprintf(stderr, "replay: %s skipped (pending a fix; PANOPTES_FUZZ_PENDING=1 replays it)\n", e.path().c_str());
+          continue;
+        }
+        files.push_back(e.path());
+      }
     } else if (std::filesystem::is_regular_file(p)) {
       files.push_back(p);
     } else {
