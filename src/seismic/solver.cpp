@@ -724,7 +724,9 @@ void Solver::Impl::velocity_row(int k, int j, const M& mat0) {
   }
   // CPML: ψ ← b·ψ + a·∂f and f += coefficient·ψ after the plain update (κ = 1), layers only.
   const int cx = pmlx.count();
-  for (const auto& [i0, i1, s0] : pmlx.runs) {
+  // Not a structured binding: clang 14 (the fuzz build) cannot capture those in "omp simd".
+  for (const auto& run : pmlx.runs) {
+    const int i0 = run[0], i1 = run[1], s0 = run[2];
     const std::size_t p = (std::size_t(k) * ny + j) * cx + s0;
     float* __restrict q0 = psix[0].data() + p;
     float* __restrict q1 = psix[1].data() + p;
@@ -945,7 +947,9 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
     const float* __restrict ah = pmlx.a_half.data();
     const float* __restrict bf = pmlx.b_full.data();
     const float* __restrict af = pmlx.a_full.data();
-    for (const auto& [i0, i1, s0] : pmlx.runs) {
+    // Not a structured binding: clang 14 (the fuzz build) cannot capture those in "omp simd".
+    for (const auto& run : pmlx.runs) {
+      const int i0 = run[0], i1 = run[1], s0 = run[2];
       const std::size_t p = (std::size_t(k) * ny + j) * cx + s0;
       float* __restrict q0 = psix[3].data() + p;
       float* __restrict q1 = psix[4].data() + p;
@@ -965,7 +969,9 @@ void Solver::Impl::stress_row(int k, int j, const M& mat0) {
     }
   }
   if (L > 0)
-    for (const auto& [i0, i1, s0] : pmlx.runs) {
+    // Not a structured binding: clang 14 (the fuzz build) cannot capture those in "omp simd".
+    for (const auto& run : pmlx.runs) {
+      const int i0 = run[0], i1 = run[1], s0 = run[2];
       const std::size_t p = (std::size_t(k) * ny + j) * cx + s0;
       visco_pml(m, b, i0, i1, psix[3].data() + p, 0, psix[4].data() + p, sxy, rxy, CMXY(0), psix[5].data() + p, sxz, rxz,
                 CMXZ(0));

@@ -89,4 +89,14 @@ grep -q "p-wave" "$tmp/err.txt" || fail "bad preset error does not list presets:
 if "$panoptes" render "$tmp/sphere.vtk" --task slice:w:0.5 --out "$tmp/e6" 2> "$tmp/err.txt"; then fail "accepted axis w"; fi
 if "$panoptes" render "$tmp/missing.npy" --out "$tmp/e7" 2> "$tmp/err.txt"; then fail "accepted a missing file"; fi
 grep -q "missing.npy" "$tmp/err.txt" || fail "missing-file error does not name the file"
+# Issue 15: memory and open files are checked before the database exists; a device is not a volume.
+if PANOPTES_MEMORY_LIMIT=1M "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 32x32 --out "$tmp/e8" 2> "$tmp/err.txt"; then
+  fail "accepted with 1 MB"
+fi
+grep -q "this render needs about" "$tmp/err.txt" && [ ! -e "$tmp/e8" ] || fail "memory: $(cat "$tmp/err.txt")"
+if "$panoptes" render /dev/zero.npy --out "$tmp/e9" 2> "$tmp/err.txt"; then fail "accepted /dev/zero.npy"; fi
+ln -s /dev/zero "$tmp/zero.npy"
+if "$panoptes" render "$tmp/zero.npy" --out "$tmp/e9" 2> "$tmp/err.txt"; then fail "accepted /dev/zero"; fi
+grep -q "is a character device" "$tmp/err.txt" || fail "device: $(cat "$tmp/err.txt")"
+if "$panoptes" render "$tmp/sphere.vtk" --size 20000x20 --out "$tmp/e10" 2> "$tmp/err.txt"; then fail "accepted 20000 pixels"; fi
 echo "render: ok"

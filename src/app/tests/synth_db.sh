@@ -41,4 +41,13 @@ start=$(date +%s%N)
 elapsed_ms=$((($(date +%s%N) - start) / 1000000))
 [ "$(find "$tmp/many/movies" -name '*.mp4' | wc -l)" -eq 500 ] || fail "expected 500 movies"
 echo "synth-db: 500 streams of 10 frames 64x64 in ${elapsed_ms} ms"
+# Issue 15: counts and memory are checked before anything is written; --force overrides the estimate.
+if "$panoptes" synth-db "$tmp/huge" --cameras 16000000 --tasks 65536 2> "$tmp/err.txt"; then fail "accepted 10^12 streams"; fi
+grep -q "16000000 x 65536 is more than the limit" "$tmp/err.txt" || fail "overflow: $(cat "$tmp/err.txt")"
+if PANOPTES_MEMORY_LIMIT=1M "$panoptes" synth-db "$tmp/small" --cameras 2 --tasks 1 --frames 1 2> "$tmp/err.txt"; then
+  fail "accepted with 1 MB"
+fi
+grep -q "1.0 MB available (PANOPTES_MEMORY_LIMIT)" "$tmp/err.txt" || fail "memory: $(cat "$tmp/err.txt")"
+[ ! -e "$tmp/small" ] || fail "refused run created its database"
+PANOPTES_MEMORY_LIMIT=1M "$panoptes" synth-db "$tmp/small" --cameras 2 --tasks 1 --frames 1 --force > /dev/null || fail "--force"
 echo "synth_db: ok"
