@@ -97,10 +97,12 @@ void SolverConfig::validate() const {
                                        " m; the first layer must start at the surface, depth 0 (z is positive down)");
       require(L.top >= 0, "medium.layer[" + std::to_string(l) + "].top = " + std::to_string(L.top) +
                               " m lies above the surface (depth 0; z is positive down)");
-      require(l == 0 || L.top > medium.layers[l - 1].top,
-              "medium.layer[" + std::to_string(l) + "].top = " + std::to_string(L.top) + " m is not below layer " +
-                  std::to_string(l - 1) + "'s top " + std::to_string(medium.layers[l - 1].top) +
-                  " m; list the layers from the surface down");
+      // The message names layer l − 1: build it only when there is one (found by fuzz_toml_config:
+      // an eager message read layers[-1] for a homogeneous medium).
+      if (l > 0 && !(L.top > medium.layers[l - 1].top))
+        throw Error("medium.layer[" + std::to_string(l) + "].top = " + std::to_string(L.top) + " m is not below layer " +
+                    std::to_string(l - 1) + "'s top " + std::to_string(medium.layers[l - 1].top) +
+                    " m; list the layers from the surface down");
     }
   }
   // The non-absorbing region every source and receiver must lie in.
