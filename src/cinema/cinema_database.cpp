@@ -24,7 +24,7 @@ std::string read_text(const fs::path& path) {
 
 // Spec A values are JSON numbers or strings; names in files use the text as ParaView writes it
 // (integers without a decimal point).
-std::string value_text(const nlohmann::json& v, const std::string& source, const std::string& name) {
+std::string value_text(const nlohmann::ordered_json& v, const std::string& source, const std::string& name) {
   if (v.is_string()) return v.get<std::string>();
   if (v.is_number_integer()) return std::to_string(v.get<long long>());
   if (v.is_number()) {
@@ -61,9 +61,9 @@ CinemaTable read_spec_a(const fs::path& dir) {
   t.dir = dir;
   t.spec = "A";
   t.source = (dir / "info.json").string();
-  nlohmann::json j;
+  nlohmann::ordered_json j;  // parameters keep the file's order
   try {
-    j = nlohmann::json::parse(read_text(dir / "info.json"));
+    j = nlohmann::ordered_json::parse(read_text(dir / "info.json"));
   } catch (const nlohmann::json::exception& e) {
     throw FileError(t.source, std::string("not valid JSON: ") + e.what());
   }

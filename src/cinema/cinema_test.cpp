@@ -30,18 +30,18 @@ void write_file(const fs::path& p, const std::string& s) {
   std::ofstream(p, std::ios::binary) << s;
 }
 
-// A smooth picture that differs with every parameter: a gradient tinted by `tint` and a disc whose
-// place follows phi/theta and whose size follows time.
+// A smooth picture, as renderings are, that differs with every parameter: a gradient tinted by
+// `tint` and a soft blob whose place follows phi/theta and whose size follows time.
 Image picture(double phi, double theta, double time, int tint, int w = 48, int h = 40) {
   Image img(w, h, 3);
   const double cx = w * (0.5 + phi / 400.0), cy = h * (0.5 - theta / 200.0), r = 5 + 3 * time;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       std::uint8_t* p = img.at(x, y);
-      const bool disc = (x - cx) * (x - cx) + (y - cy) * (y - cy) < r * r;
-      p[0] = std::uint8_t(disc ? 240 : 40 + 3 * x);
-      p[1] = std::uint8_t(disc ? 200 : 30 + 4 * y);
-      p[2] = std::uint8_t((tint * 70 + (disc ? 150 : 60)) % 256);
+      const double b = std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (r * r));
+      p[0] = std::uint8_t(40 + 2 * x + 150 * b);
+      p[1] = std::uint8_t(30 + 3 * y + 120 * b);
+      p[2] = std::uint8_t(60 + 50 * tint + 100 * b);
     }
   return img;
 }
