@@ -34,12 +34,12 @@ for f in README.md docs/formats.md examples/heat_c/heat.c examples/heat_c/CMakeL
          examples/heat_fortran/heat.f90 examples/heat_fortran/CMakeLists.txt; do
   [ -e "$doc/$f" ] || fail "$doc/$f not installed"
 done
-grep -q "$prefix" "$libdir/pkgconfig/panoptes.pc" || fail "panoptes.pc does not name the install prefix"
+grep "$prefix" "$libdir/pkgconfig/panoptes.pc" >/dev/null || fail "panoptes.pc does not name the install prefix"
 
 step "libpanoptes.so exports the C API only"
 exported=$(nm -D --defined-only "$libdir/libpanoptes.so" | awk '{print $3}' | grep -v '^panoptes_' || true)
 [ -z "$exported" ] || fail "libpanoptes.so exports more than panoptes_*: $(echo "$exported" | head -5 | tr '\n' ' ')"
-nm -D --defined-only "$libdir/libpanoptes.so" | grep -q ' panoptes_create$' || fail "panoptes_create not exported"
+nm -D --defined-only "$libdir/libpanoptes.so" | grep ' panoptes_create$' >/dev/null || fail "panoptes_create not exported"
 
 step "installed panoptes runs from another directory without LD_LIBRARY_PATH"
 (cd / && "$prefix/bin/panoptes" --help >/dev/null) || fail "installed panoptes --help"
@@ -55,8 +55,8 @@ run_and_check() {  # name binary example
       { cat "$dir/run.log"; fail "$name with $np ranks"; }
     local out
     out=$(cd / && "$prefix/bin/panoptes" info --json "$dir/${example}_db") || fail "panoptes info on $name np $np: $out"
-    echo "$out" | grep -Eq '"status": *"complete"' || fail "$name np $np: database not complete: $out"
-    echo "$out" | grep -Eq '"frames": *3' || fail "$name np $np: expected 3 frames: $out"
+    grep -E '"status": *"complete"' <<<"$out" >/dev/null || fail "$name np $np: database not complete: $out"
+    grep -E '"frames": *3' <<<"$out" >/dev/null || fail "$name np $np: expected 3 frames: $out"
     echo "$name, $np rank(s): database complete, 3 frames"
   done
 }
