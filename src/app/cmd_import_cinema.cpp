@@ -26,6 +26,7 @@ void run(const Args& a) {
   for (std::string item; std::getline(list, item, ',');)
     if (!item.empty()) o.group_by.push_back(item);
   o.title = a.title;
+  o.command_line = "panoptes import-cinema " + a.in + " " + a.out + (a.group_by.empty() ? "" : " --group-by " + a.group_by);
   o.overwrite = a.overwrite;
   o.threads = a.threads;
   if (a.crf >= 0) o.video.crf = a.crf;

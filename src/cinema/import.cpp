@@ -171,6 +171,8 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   m.title = o.title.empty() ? "Cinema database " + fs::absolute(cdb).lexically_normal().filename().string() : o.title;
   if (m.title == "Cinema database ") m.title = "Cinema database";
   m.provenance.program = "panoptes import-cinema";
+  m.provenance.version = "0.1.0";
+  m.provenance.command_line = o.command_line;
   m.provenance.extra["cinema_spec"] = t.spec;
   m.provenance.extra["cinema_source"] = fs::absolute(cdb).lexically_normal().string();
   m.times = times;

@@ -20,6 +20,7 @@ struct ImportOptions {
   /// Empty = every column except time, camera, phi, theta and FILE.
   std::vector<std::string> group_by;
   std::string title;              ///< manifest title (default: "Cinema database <name>")
+  std::string command_line;       ///< recorded in the provenance
   video::VideoSettings video;     ///< encoder settings of every movie
   bool overwrite = false;
   int threads = 0;                ///< streams encoded in parallel (0 = hardware concurrency)
