@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The installed package, used from outside as a user's project would: `cmake --install` into a
 # temporary prefix, then the C and Fortran heat examples built OUT OF TREE against it, once with CMake
-# (find_package(Panoptes)) and once with pkg-config, each run with 1 and 2 MPI ranks, and each
-# database checked with the installed `panoptes info`. Also: only the C API is exported from
+# (find_package(Panoptes)) and once with pkg-config; the CMake builds run with 1 and 2 MPI ranks, the
+# pkg-config builds with 2 (the CI budget: each run costs an MPI start-up), and every database is
+# checked with the installed `panoptes info`. Also: only the C API is exported from
 # libpanoptes.so, the installed executable runs without LD_LIBRARY_PATH, and the installed Python
 # package imports and reads a frame.
 #   install_test.sh BUILD_DIR WORK_DIR
@@ -16,7 +17,8 @@ prefix=$work/prefix
 unset LD_LIBRARY_PATH PKG_CONFIG_PATH CMAKE_PREFIX_PATH || true
 
 fail() { echo "install_test: FAIL: $*" >&2; exit 1; }
-step() { echo "== $*"; }
+start=$(date +%s%N)
+step() { local ms=$((($(date +%s%N) - start) / 1000000)); printf '== [%d.%d s] %s\n' $((ms / 1000)) $((ms % 1000 / 100)) "$*"; }
 
 step "cmake --install $build --prefix $prefix"
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
@@ -46,9 +48,10 @@ step "installed panoptes runs from another directory without LD_LIBRARY_PATH"
 
 ex=$doc/examples
 steps=20   # snapshots at steps 0, 10, 20 (heat.toml: every_steps = 10)
-run_and_check() {  # name binary example
+run_and_check() {  # name binary example ranks...
   local name=$1 bin=$2 example=$3
-  for np in 1 2; do
+  shift 3
+  for np in "$@"; do
     local dir=$work/run_${name}_np$np
     mkdir -p "$dir"
     (cd "$dir" && mpiexec --oversubscribe -np "$np" "$bin" "$ex/$example/heat.toml" $steps >run.log 2>&1) ||
@@ -68,17 +71,17 @@ for example in heat_c heat_fortran; do
     { cat "$work/cmake_$example.log"; fail "configure $example against the install"; }
   cmake --build "$work/cmake_$example" >>"$work/cmake_$example.log" 2>&1 ||
     { cat "$work/cmake_$example.log"; fail "build $example against the install"; }
-  run_and_check "cmake_$example" "$work/cmake_$example/$example" $example
+  run_and_check "cmake_$example" "$work/cmake_$example/$example" $example 1 2
 done
 
 step "pkg-config builds of the examples"
 export PKG_CONFIG_PATH=$libdir/pkgconfig
 cc -O2 "$ex/heat_c/heat.c" $(pkg-config --cflags --libs panoptes) -o "$work/pkg_heat_c" ||
   fail "cc heat.c \$(pkg-config --cflags --libs panoptes)"
-run_and_check pkg_heat_c "$work/pkg_heat_c" heat_c
+run_and_check pkg_heat_c "$work/pkg_heat_c" heat_c 2
 mpifort -O2 "$ex/heat_fortran/heat.f90" $(pkg-config --cflags --libs panoptes-fortran) -o "$work/pkg_heat_fortran" ||
   fail "mpifort heat.f90 \$(pkg-config --cflags --libs panoptes-fortran)"
-run_and_check pkg_heat_fortran "$work/pkg_heat_fortran" heat_fortran
+run_and_check pkg_heat_fortran "$work/pkg_heat_fortran" heat_fortran 2
 
 pydir=$(find "$prefix" -type d -name panoptes -path '*-packages/*' | head -1)
 if [ -n "$pydir" ]; then
@@ -92,4 +95,4 @@ assert f.shape == (96, 96, 3) and f.dtype.name == 'uint8', (f.shape, f.dtype)
 print('python:', panoptes.__file__, db.frame_count, 'frames', f.shape)
 " || fail "import panoptes from the install"
 fi
-echo "install_test: OK"
+step "install_test: OK"

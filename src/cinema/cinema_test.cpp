@@ -48,6 +48,20 @@ Image picture(double phi, double theta, double time, int tint, int w = 48, int h
 
 Image frame_of(const store::Database& db, int c, int t, int f) { return db.stream(c, t)->read_rgba(f); }
 
+// Options with only some fields set (designated initializers would warn about the others).
+cinema::ImportOptions grouped_by(std::vector<std::string> columns) {
+  cinema::ImportOptions o;
+  o.group_by = std::move(columns);
+  return o;
+}
+cinema::ExportOptions export_options(std::vector<int> frames, std::string format = "png", bool overwrite = false) {
+  cinema::ExportOptions o;
+  o.frames = std::move(frames);
+  o.format = std::move(format);
+  o.overwrite = overwrite;
+  return o;
+}
+
 std::string error_of(const std::function<void()>& f) {
   try {
     f();
@@ -69,7 +83,7 @@ TEST(CinemaExport, WritesSpecDAndImportReadsTheSameDatabaseBack) {
   so.height = 48;
   so.video.gop = 1;
   store::write_synthetic_database(tmp / "db", so);
-  const auto report = cinema::export_cinema(tmp / "db", tmp / "out.cdb", {.frames = {0, 2}});
+  const auto report = cinema::export_cinema(tmp / "db", tmp / "out.cdb", export_options({0, 2}));
   EXPECT_EQ(report.images, 5 * 3 * 2);
 
   // data.csv: parameters, then FILE last; floats with a decimal point; CRLF rows (RFC 4180).
@@ -111,7 +125,7 @@ TEST(CinemaExport, WritesSpecDAndImportReadsTheSameDatabaseBack) {
   // JPEG export: smaller files, still a faithful picture; an existing export needs --overwrite.
   EXPECT_NE(error_of([&] { cinema::export_cinema(tmp / "db", tmp / "out.cdb", {}); }).find("use --overwrite"),
             std::string::npos);
-  cinema::export_cinema(tmp / "db", tmp / "out.cdb", {.format = "jpg", .overwrite = true});
+  cinema::export_cinema(tmp / "db", tmp / "out.cdb", export_options({}, "jpg", true));
   EXPECT_TRUE(fs::exists(tmp / "out.cdb/image/c0/t0/f1.jpg"));
   EXPECT_FALSE(fs::exists(tmp / "out.cdb/image/c0/t0/f0.png"));
   EXPECT_GE(psnr(read_image((tmp / "out.cdb/image/c1/t1/f1.jpg").string()), frame_of(a, 1, 1, 1)), 30.0);
@@ -225,8 +239,8 @@ TEST(CinemaImport, AscentSpecA) {
   EXPECT_EQ(m.cameras[5].labels.lat_deg, 0);
   EXPECT_EQ(m.cameras[5].labels.lon_deg, 90);
   EXPECT_GE(psnr(frame_of(db, 5, 1, 2), picture(90 - 180, 0, 2, 1)), 40.0);
-  EXPECT_EQ(cinema::plan_import(cdb, {.group_by = {"var"}}).manifest.task_count(), 2);
-  const std::string e = error_of([&] { cinema::import_cinema(cdb, tmp / "db2", {.group_by = {"nosuch"}}); });
+  EXPECT_EQ(cinema::plan_import(cdb, grouped_by({"var"})).manifest.task_count(), 2);
+  const std::string e = error_of([&] { cinema::import_cinema(cdb, tmp / "db2", grouped_by({"nosuch"})); });
   EXPECT_NE(e.find("--group-by column \"nosuch\" does not exist; columns: time, phi, theta, var"), std::string::npos) << e;
 }
 
@@ -277,7 +291,7 @@ TEST(CinemaImport, RefusesBadInputsWithClearMessages) {
   // Rows that differ only in a column left out of --group-by.
   fs::remove(cdb / "data.csv");
   write_file(cdb / "data.csv", "time,phi,theta,var,level,FILE\n0,0,0,p,1,a.png\n0,0,0,p,2,b.png\n");
-  EXPECT_EQ(error_of([&] { cinema::plan_import(cdb, {.group_by = {"var"}}); }),
+  EXPECT_EQ(error_of([&] { cinema::plan_import(cdb, grouped_by({"var"})); }),
             where + " line 3: same camera, task and time as " + where + " line 2; they differ in level: add it to --group-by");
 
   make("0,0,120,a.png\n");
