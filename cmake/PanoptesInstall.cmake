@@ -1,4 +1,4 @@
-# `cmake --install`: the panoptes executable, libpanoptes.so (C API) and the Fortran module library,
+# `cmake --install`: libpanoptes.so (C API) and the Fortran module library,
 # panoptes.h and the Fortran .mod files, PanoptesConfig.cmake (+ version file, imported targets
 # Panoptes::panoptes and Panoptes::fortran), panoptes.pc / panoptes-fortran.pc, the Python package,
 # the docs and the examples, under the GNUInstallDirs locations.
@@ -8,9 +8,7 @@ set(PANOPTES_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/Panoptes CACHE STRING
     "Where PanoptesConfig.cmake is installed (relative to the prefix)")
 mark_as_advanced(PANOPTES_CMAKE_DIR)
 
-if(TARGET panoptes)
-  install(TARGETS panoptes RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-endif()
+# The panoptes executable (and the web player's files) are installed by src/app and src/web.
 
 if(TARGET panoptes_capi)
   set(_targets panoptes_capi)
