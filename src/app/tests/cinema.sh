@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# `panoptes export-cinema` / `import-cinema`: a database out to Cinema Spec D and back, checked with
+# `panoptes info`; bad inputs give one-line errors naming the file and line.
+set -euo pipefail
+panoptes=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "cinema.sh: $*"; exit 1; }
+
+"$panoptes" synth-db "$tmp/db" --cameras 3 --tasks 2 --frames 4 --size 64x48 >/dev/null
+out=$("$panoptes" export-cinema "$tmp/db" "$tmp/x.cdb" --frames 0:4:2 --format jpg)
+grep "Cinema Spec D, 12 jpg images" <<<"$out" >/dev/null || fail "unexpected export output: $out"
+head -1 "$tmp/x.cdb/data.csv" | grep '^time,camera,phi,theta,task,isovalue,FILE' >/dev/null || fail "bad header: $(head -1 "$tmp/x.cdb/data.csv")"
+[ "$(find "$tmp/x.cdb/image" -name '*.jpg' | wc -l)" -eq 12 ] || fail "expected 12 images"
+
+out=$("$panoptes" import-cinema "$tmp/x.cdb" "$tmp/back")
+grep "from Cinema Spec D: 3 cameras x 2 tasks = 6 movies, 2 frames each" <<<"$out" >/dev/null || fail "unexpected import output: $out"
+info=$("$panoptes" info --json "$tmp/back")
+grep -Eq '"status": *"complete"' <<<"$info" >/dev/null || fail "imported database not complete: $info"
+
+# An existing database is refused; a bad Cinema database is one error line naming file and line.
+if "$panoptes" import-cinema "$tmp/x.cdb" "$tmp/back" 2>"$tmp/err"; then fail "overwrote without --overwrite"; fi
+grep -q "^panoptes: error: .*already holds a Panoptes database" "$tmp/err" || fail "bad message: $(cat "$tmp/err")"
+printf 'time,phi,theta,FILE\n0,0,north,image/c0/t0/f0.jpg\n' >"$tmp/x.cdb/data.csv"
+if "$panoptes" import-cinema "$tmp/x.cdb" "$tmp/bad" 2>"$tmp/err"; then fail "accepted a non-numeric theta"; fi
+[ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "error is not one line: $(cat "$tmp/err")"
+grep -q '^panoptes: error: .*x.cdb/data.csv line 2: theta "north" (column theta) is not a number$' "$tmp/err" ||
+  fail "bad message: $(cat "$tmp/err")"
+"$panoptes" export-cinema --help | grep -- "--format" >/dev/null || fail "export-cinema --help"
+"$panoptes" import-cinema --help | grep -- "--group-by" >/dev/null || fail "import-cinema --help"
+echo "cinema.sh: ok"

@@ -1,0 +1,55 @@
+#pragma once
+// Cinema image database (Spec D or Spec A) -> Panoptes movie database: parameter columns become the
+// time axis, the cameras (phi/theta -> directions on a sphere, navigation graph computed) and the
+// tasks with their parameter axes; the images become one movie per (camera, task). Mapping:
+// docs/formats.md, "Cinema databases".
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "store/manifest.hpp"
+#include "video/video_settings.hpp"
+
+namespace panoptes::cinema {
+
+/// Options of import_cinema.
+struct ImportOptions {
+  /// Columns whose value combinations make the tasks (numeric ones also become parameter axes).
+  /// Empty = every column except time, camera, phi, theta and FILE.
+  std::vector<std::string> group_by;
+  std::string title;              ///< manifest title (default: "Cinema database <name>")
+  std::string command_line;       ///< recorded in the provenance
+  video::VideoSettings video;     ///< encoder settings of every movie
+  bool overwrite = false;
+  int threads = 0;                ///< streams encoded in parallel (0 = hardware concurrency)
+};
+
+/// How a Cinema table maps onto a Panoptes database (plan_import's result; no image read yet).
+struct ImportPlan {
+  store::Manifest manifest;       ///< cameras, graph, tasks, axes, times; image size filled in
+  /// files[(camera * tasks + task) * frames + frame] = the image's absolute path.
+  std::vector<std::filesystem::path> files;
+  std::string spec;               ///< "D" or "A"
+};
+
+/// Reads IN.cdb and plans the database. Throws FileError/Error (naming the file, the row and the
+/// value) for: a non-numeric time, phi or theta; two rows for the same (camera, task, frame); a
+/// (camera, task, frame) without an image; a FILE outside the database; a missing or unreadable
+/// image; images of different sizes; a --group-by column that does not exist.
+ImportPlan plan_import(const std::filesystem::path& cdb, const ImportOptions& options = {});
+
+/// What import_cinema wrote.
+struct ImportReport {
+  int cameras = 0, tasks = 0, frames = 0;
+  std::string spec;
+};
+
+/// plan_import, then writes the movie database to `out` (DatabaseWriter; refuses an existing database
+/// without overwrite). progress(done, total) in images, from one thread.
+ImportReport import_cinema(const std::filesystem::path& cdb, const std::filesystem::path& out,
+                           const ImportOptions& options = {},
+                           const std::function<void(std::int64_t, std::int64_t)>& progress = {});
+
+}  // namespace panoptes::cinema

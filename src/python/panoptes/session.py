@@ -1,0 +1,59 @@
+"""In-situ visualization from a Python simulation."""
+import os
+
+from . import _panoptes
+
+
+class Session:
+    """An in-situ visualization session (the C API's panoptes_session, for Python).
+
+    config: path of a TOML file, or TOML text (anything containing a newline); keys as for
+    `panoptes run` (docs/insitu.md). comm: an mpi4py communicator; without one, MPI_COMM_WORLD when
+    MPI is initialized (e.g. by mpi4py), else one process. Every call is collective over comm.
+    """
+
+    def __init__(self, config, comm=None):
+        config = os.fspath(config)
+        is_file = "\n" not in config
+        self._s = _panoptes.Session(config, is_file, comm)
+
+    def set_grid(self, dims, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)):
+        """The global grid: dims = points per axis (nx, ny, nz), origin and spacing in world units."""
+        self._s.set_grid([int(d) for d in dims], [float(o) for o in origin], [float(s) for s in spacing])
+
+    def set_block(self, offset, extent, ghost_lo=(0, 0, 0), ghost_hi=(0, 0, 0)):
+        """This rank's owned points (0-based (x, y, z) offset, extent) and the ghost layers its arrays hold."""
+        self._s.set_block([int(v) for v in offset], [int(v) for v in extent], [int(v) for v in ghost_lo],
+                          [int(v) for v in ghost_hi])
+
+    def set_field(self, name, array):
+        """Binds a float32/float64 array of shape (nz, ny, nx) of the block INCLUDING its ghost layers.
+        The array is not copied: the session reads it at the next process()/snapshot()."""
+        self._s.set_field(name, array)
+
+    def process(self, step, time):
+        """Renders and stores a snapshot if the schedule asks for one; returns whether it did."""
+        return self._s.process(int(step), float(time))
+
+    def snapshot(self, time):
+        """Renders and stores a snapshot now."""
+        self._s.snapshot(float(time))
+
+    def finalize(self):
+        """Closes the movies and marks the database complete."""
+        self._s.finalize()
+
+    output_dir = property(lambda self: self._s.output_dir)
+    rank = property(lambda self: self._s.rank)
+    ranks = property(lambda self: self._s.ranks)
+    camera_count = property(lambda self: self._s.camera_count)
+    task_count = property(lambda self: self._s.task_count)
+    snapshots = property(lambda self: self._s.snapshots)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, traceback):
+        if kind is None:
+            self.finalize()
+        return False

@@ -1,0 +1,198 @@
+// `_panoptes.Session`: insitu::Session for a Python simulation. Fields are NumPy arrays used in place
+// (no copy): the session keeps a reference to each array until it is rebound, and reads it during
+// process()/snapshot(). Communicators come from mpi4py (its C API, mpi4py/mpi4py.h).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "insitu/session.hpp"
+#include "python/bindings.hpp"
+
+#ifdef PANOPTES_HAVE_MPI4PY
+#include <mpi4py/mpi4py.h>
+#endif
+
+namespace py = pybind11;
+
+namespace panoptes::python {
+namespace {
+
+std::array<int, 3> triple(const std::vector<long long>& v, const char* what, const char* call) {
+  if (v.size() != 3)
+    throw Error(std::string(call) + ": " + what + " has " + std::to_string(v.size()) + " entries; expected 3 (x, y, z)");
+  for (long long x : v)
+    if (x < 0 || x > (1LL << 31) - 1)
+      throw Error(std::string(call) + ": " + what + " entry " + std::to_string(x) + "; expected 0 .. 2^31-1");
+  return {int(v[0]), int(v[1]), int(v[2])};
+}
+
+class PySession {
+ public:
+  PySession(const std::string& config, bool is_file, const py::object& comm) {
+    config_ = is_file ? insitu::load_session_config(config) : insitu::parse_session_config_text(config, "configuration text");
+    config_.validate();
+    config_.program = "panoptes Python";
+    if (!comm.is_none()) {
+#if defined(PANOPTES_HAVE_MPI4PY)
+      // Imported here, not at module import: mpi4py.MPI initializes MPI, which reading a database
+      // must not do. A caller that passes a communicator has imported mpi4py already.
+      if (import_mpi4py() < 0) throw py::error_already_set();
+      MPI_Comm* c = PyMPIComm_Get(comm.ptr());
+      if (!c) throw py::error_already_set();
+      comm_ = *c;
+#else
+      throw Error("Session: a communicator was given, but this Panoptes was built without MPI or without mpi4py");
+#endif
+    }
+  }
+
+  void set_grid(const std::vector<long long>& dims, const std::array<double, 3>& origin,
+                const std::array<double, 3>& spacing) {
+    need_no_session("set_grid", "grid");
+    const auto d = triple(dims, "dims", "set_grid");
+    render::GridGeometry g{{d[0], d[1], d[2]}, {origin[0], origin[1], origin[2]}, {spacing[0], spacing[1], spacing[2]}};
+    try {
+      g.validate();
+    } catch (const std::exception& e) {
+      throw Error(std::string("set_grid: ") + e.what());
+    }
+    grid_ = g;
+  }
+
+  void set_block(const std::vector<long long>& offset, const std::vector<long long>& extent,
+                 const std::vector<long long>& ghost_lo, const std::vector<long long>& ghost_hi) {
+    need_no_session("set_block", "block");
+    const auto o = triple(offset, "offset", "set_block"), e = triple(extent, "extent", "set_block");
+    const auto lo = triple(ghost_lo, "ghost_lo", "set_block"), hi = triple(ghost_hi, "ghost_hi", "set_block");
+    insitu::LocalBlock b;
+    for (int a = 0; a < 3; ++a) b.offset[a] = o[a], b.extent[a] = e[a], b.ghost_lo[a] = lo[a], b.ghost_hi[a] = hi[a];
+    block_ = b;
+  }
+
+  /// Binds `array` (shape (nz, ny, nx) of the GHOSTED block, float32 or float64, any strides) without
+  /// copying it.
+  void set_field(const std::string& name, const py::array& array) {
+    if (!block_) throw Error("set_field: call set_block first");
+    const insitu::LocalBlock& b = *block_;
+    const std::array<py::ssize_t, 3> shape{b.extent[2] + b.ghost_lo[2] + b.ghost_hi[2],
+                                           b.extent[1] + b.ghost_lo[1] + b.ghost_hi[1],
+                                           b.extent[0] + b.ghost_lo[0] + b.ghost_hi[0]};
+    const bool f32 = py::isinstance<py::array_t<float>>(array), f64 = py::isinstance<py::array_t<double>>(array);
+    if (!f32 && !f64)
+      throw Error("set_field: field \"" + name + "\" has dtype " + py::str(array.dtype()).cast<std::string>() +
+                  "; expected float32 or float64");
+    if (array.ndim() != 3 || array.shape(0) != shape[0] || array.shape(1) != shape[1] || array.shape(2) != shape[2]) {
+      std::string got = "(";
+      for (py::ssize_t i = 0; i < array.ndim(); ++i) got += (i ? ", " : "") + std::to_string(array.shape(i));
+      throw Error("set_field: field \"" + name + "\" has shape " + got + ")" + "; expected (" + std::to_string(shape[0]) +
+                  ", " + std::to_string(shape[1]) + ", " + std::to_string(shape[2]) +
+                  ") = (nz, ny, nx) of the block including its ghost layers");
+    }
+    const py::ssize_t item = array.itemsize();
+    std::array<std::int64_t, 3> stride{};  // elements per x, y, z step
+    for (int a = 0; a < 3; ++a) {
+      const py::ssize_t s = array.strides(2 - a);
+      if (s % item != 0)
+        throw Error("set_field: field \"" + name + "\" has a stride of " + std::to_string(s) +
+                    " bytes, not a multiple of its element size; pass numpy.ascontiguousarray(a)");
+      stride[a] = s / item;
+    }
+    insitu::FieldInput in;
+    in.name = name;
+    const std::int64_t shift = b.ghost_lo[0] * stride[0] + b.ghost_lo[1] * stride[1] + b.ghost_lo[2] * stride[2];
+    in.data = static_cast<const char*>(array.data()) + shift * item;
+    in.type = f64 ? insitu::ScalarType::f64 : insitu::ScalarType::f32;
+    in.stride = stride;
+    fields_[name] = {in, array};  // the reference keeps the array alive while the session may read it
+  }
+
+  bool process(long long step, double time) {
+    insitu::Session& s = session();
+    const auto in = inputs();
+    py::gil_scoped_release release;
+    return s.process(step, time, in);
+  }
+
+  void snapshot(double time) {
+    insitu::Session& s = session();
+    const auto in = inputs();
+    py::gil_scoped_release release;
+    s.snapshot(time, in);
+  }
+
+  void finalize() {
+    insitu::Session& s = session();
+    py::gil_scoped_release release;
+    s.finalize();
+  }
+
+  insitu::Session& session() {
+    if (session_) return *session_;
+    if (!grid_) throw Error("set_grid must be called before the first snapshot");
+    if (!block_) throw Error("set_block must be called before the first snapshot");
+    py::gil_scoped_release release;  // collective construction: other ranks may still be in Python
+#ifdef PANOPTES_HAVE_MPI
+    int init = 0;
+    MPI_Initialized(&init);
+    if (comm_ || init) {
+      session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_, comm_ ? *comm_ : MPI_COMM_WORLD);
+      return *session_;
+    }
+#endif
+    session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_);
+    return *session_;
+  }
+
+  std::string output_dir() const { return config_.output_dir; }
+
+ private:
+  void need_no_session(const char* call, const char* what) const {
+    if (session_) throw Error(std::string(call) + ": the " + what + " cannot change after the first snapshot");
+  }
+  std::vector<insitu::FieldInput> inputs() const {
+    std::vector<insitu::FieldInput> v;
+    for (const auto& [name, f] : fields_) v.push_back(f.first);
+    return v;
+  }
+
+  insitu::SessionConfig config_;
+#ifdef PANOPTES_HAVE_MPI
+  std::optional<MPI_Comm> comm_;
+#else
+  std::optional<int> comm_;
+#endif
+  std::optional<render::GridGeometry> grid_;
+  std::optional<insitu::LocalBlock> block_;
+  std::map<std::string, std::pair<insitu::FieldInput, py::array>> fields_;
+  std::unique_ptr<insitu::Session> session_;
+};
+
+}  // namespace
+
+void bind_session(py::module_& m) {
+  py::class_<PySession>(m, "Session")
+      .def(py::init<std::string, bool, py::object>(), py::arg("config"), py::arg("is_file"), py::arg("comm"))
+      .def("set_grid", &PySession::set_grid, py::arg("dims"), py::arg("origin"), py::arg("spacing"))
+      .def("set_block", &PySession::set_block, py::arg("offset"), py::arg("extent"), py::arg("ghost_lo"),
+           py::arg("ghost_hi"))
+      .def("set_field", &PySession::set_field, py::arg("name"), py::arg("array"))
+      .def("process", &PySession::process, py::arg("step"), py::arg("time"))
+      .def("snapshot", &PySession::snapshot, py::arg("time"))
+      .def("finalize", &PySession::finalize)
+      .def_property_readonly("output_dir", &PySession::output_dir)
+      .def_property_readonly("rank", [](PySession& s) { return s.session().rank(); })
+      .def_property_readonly("ranks", [](PySession& s) { return s.session().ranks(); })
+      .def_property_readonly("camera_count", [](PySession& s) { return s.session().camera_count(); })
+      .def_property_readonly("task_count", [](PySession& s) { return s.session().task_count(); })
+      .def_property_readonly("snapshots", [](PySession& s) { return s.session().snapshots(); });
+}
+
+}  // namespace panoptes::python

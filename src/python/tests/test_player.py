@@ -1,0 +1,45 @@
+"""panoptes.Player: the engine, headless, on a virtual clock."""
+import numpy as np
+import pytest
+
+import panoptes
+
+
+def test_navigate_step_seek_and_read(synth_db):
+    db = panoptes.open(synth_db)
+    p = panoptes.Player(db)
+    assert p.selection == {"camera": 0, "task": 0, "frame": 0}
+    assert np.array_equal(p.image(), db.frame(0, 0, 0))
+    assert p.navigate("right") and p.camera == 1
+    assert p.navigate("left") and p.camera == 0
+    assert p.step_axis("isovalue", +1) and p.task == 1
+    assert not p.step_axis("isovalue", -2)  # off the end of the axis: refused, nothing changes
+    assert p.task == 1
+    p.seek(3)
+    shown = p.shown()
+    assert (shown["camera"], shown["task"], shown["frame"], shown["status"]) == (0, 1, 3, "ok")
+    assert shown["time"] == pytest.approx(0.3)
+    assert np.array_equal(shown["image"], db.frame(0, 1, 3))
+    assert p.next_task() and p.task == 2
+    assert p.jump_to_camera(3) and p.camera == 3
+
+
+def test_virtual_clock_plays_at_the_database_rate(synth_db):
+    p = panoptes.Player(synth_db, prefetch=False)
+    assert not p.playing
+    p.play()
+    p.advance(2.5 / p.fps)  # two and a half frame periods
+    assert p.frame_index == 2
+    p.pause()
+    p.advance(1.0)
+    assert p.frame_index == 2
+    stats = p.statistics()
+    assert "frames_shown" in stats or "counters" in stats
+
+
+def test_bad_commands(synth_db):
+    p = panoptes.Player(synth_db)
+    with pytest.raises(panoptes.Error, match='direction "sideways"; expected left, right, up, down, in or out'):
+        p.navigate("sideways")
+    with pytest.raises(panoptes.Error, match='no parameter axis "speed"'):
+        p.step_axis("speed")
