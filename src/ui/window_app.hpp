@@ -11,7 +11,7 @@ namespace panoptes::ui {
 
 /// Options of run_window(). Defaults suit an interactive session.
 struct WindowOptions {
-  /// Initial window size in pixels; 0 = the database's frame size (clamped to the screen).
+  /// Initial window size in pixels; 0 x 0 = the frame's aspect filling most (85 %) of the display.
   int width = 0, height = 0;
   bool fullscreen = false;
   /// Use SDL's software renderer even if an accelerated one exists (tests under Xvfb, remote X).
@@ -21,8 +21,10 @@ struct WindowOptions {
 
   /// Where playback starts.
   int camera = 0, task = 0, frame = 0;
-  /// Playback speed factor (¼ … 8) and whether playback starts running / loops at the end.
-  double speed = 1.0;
+  /// Playback speed factor (¼ … 8) and whether playback starts running / loops at the end. 0 = automatic:
+  /// ×1 of the database's playback rate, slowed down (to ×¼ at most) when the whole run would last
+  /// under 4 s.
+  double speed = 0;
   bool paused = false;
   bool loop = true;
   /// Frame cache cap for the engine in bytes; 0 = the engine's default for this machine.

@@ -134,6 +134,8 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   o.paused = true;
   o.virtual_time = true;
   o.script = script;
+  o.width = kW;  // a window of the frame's size shows it 1:1 at zoom 1
+  o.height = kH;
   o.max_frames = 40;  // 40 ticks of 1/30 s: the script ends at t = 1.0 s (tick 30)
   o.screenshot_on_exit = dir_->path / "window.png";
   o.output_dir = dir_->path;
@@ -234,6 +236,8 @@ TEST_F(WindowTest, MouseDragSnapsWheelZoomsAroundTheCursorRightDragPans) {
   o.vsync = false;
   o.paused = true;
   o.virtual_time = true;
+  o.width = kW;
+  o.height = kH;
   o.camera = 1;  // at longitude 90°, looking along -y with z up: screen right is -x
   o.max_frames = 30;
   o.before_frame = [&](int n) {
@@ -281,6 +285,9 @@ TEST_F(WindowTest, MissingStreamShowsThePlaceholderAndPlaybackGoesOn) {
   o.software_renderer = true;
   o.vsync = false;
   o.virtual_time = true;  // playing: 20 ticks of 1/30 s at 30 fps advance 19 frames (looping over 6)
+  o.width = kW;
+  o.height = kH;
+  o.speed = 1;  // not the automatic slow-down of a short run
   o.camera = 3;
   o.max_frames = 20;
   o.screenshot_on_exit = dir_->path / "missing.png";
