@@ -94,13 +94,13 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       const auto& sel = info.selection;
       const auto& cam = m.cameras[std::size_t(sel.camera)];
       const auto& task = m.tasks[std::size_t(sel.task)];
-      ImGui::Text("t = %.4g   frame %d / %d   %s x%.2g%s%s", info.sim_time, sel.frame + 1, info.frame_count, info.playing ? "playing" : "paused", info.speed,
+      ImGui::Text("t = %.4g   frame %d of %d   %s x%.2g%s%s", info.sim_time, sel.frame, info.frame_count, info.playing ? "playing" : "paused", info.speed,
                   info.direction < 0 ? " reverse" : "", info.loop ? "" : " once");
       ImGui::Text("camera %d%s%s   lat %+.0f  lon %+.0f%s", sel.camera, cam.labels.patch.empty() ? "" : " ",
                   cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg,
                   info.shell_count > 1 ? ("   shell " + std::to_string(cam.labels.shell)).c_str() : "");
       const std::string params = format_parameters(m, task);
-      ImGui::Text("task %d / %d: %s%s%s", sel.task + 1, int(m.tasks.size()), task.name.c_str(),
+      ImGui::Text("task %d of %d: %s%s%s", sel.task, int(m.tasks.size()), task.name.c_str(),
                   params.empty() ? "" : "   ", params.c_str());
       if (info.active_axis >= 0 && info.active_axis < int(m.axes.size()))
         ImGui::Text("PgUp/PgDn axis: %s", m.axes[std::size_t(info.active_axis)].name.c_str());

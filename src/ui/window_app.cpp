@@ -559,6 +559,8 @@ WindowResult WindowApp::run() {
     result.view_w = int(std::lround(fr.w));
     result.view_h = int(std::lround(fr.h));
     result.hud_drawn = hud_.panel_drawn();
+    result.window_w = out_w_;
+    result.window_h = out_h_;
     result.status = std::string(player::to_string(shown.status));
   }
   if (recorder_.active()) {
