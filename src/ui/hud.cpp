@@ -191,21 +191,28 @@ void Hud::draw_help(float vw, float vh) {
                         Row{"wheel", "magnify around the cursor"}, Row{"right drag", "pan the magnified frame"},
                         Row{"mini-map click", "jump to that camera"}})
     rows.push_back(r);
-  // Always fits: as many key/description column pairs as the window's height needs, and a smaller
-  // font if even three pairs would not fit.
-  const float line = ImGui::GetTextLineHeightWithSpacing() + 2;
-  const float avail = vh * 0.9f - 3 * line;
+  // Always fits the window: 1, 2 or 3 key/description column pairs — the fewest that fit the height,
+  // as long as they fit the width — and whatever still does not fit scrolls (shrinking ImGui's bitmap
+  // font makes it unreadable, so it is not shrunk).
+  const ImGuiStyle& style = ImGui::GetStyle();
+  float key_w = 0, what_w = 0;
+  for (const Row& r : rows) {
+    key_w = std::max(key_w, ImGui::CalcTextSize(r.key.data(), r.key.data() + r.key.size()).x);
+    what_w = std::max(what_w, ImGui::CalcTextSize(r.what.data(), r.what.data() + r.what.size()).x);
+  }
+  const float pair_w = key_w + what_w + 4 * style.CellPadding.x + style.ItemSpacing.x;
+  const float row_h = ImGui::GetTextLineHeight() + 2 * style.CellPadding.y;
+  const float chrome_w = 2 * style.WindowPadding.x, chrome_h = 2 * style.WindowPadding.y + ImGui::GetFrameHeight();
   int pairs = 1;
-  while (pairs < 3 && float((int(rows.size()) + pairs - 1) / pairs) * line > avail) ++pairs;
-  const float fit = float((int(rows.size()) + pairs - 1) / pairs) * line > avail
-                        ? std::max(0.5f, avail / (float((int(rows.size()) + pairs - 1) / pairs) * line))
-                        : 1.f;
+  while (pairs < 3 && float((int(rows.size()) + pairs - 1) / pairs) * row_h > vh * 0.95f - chrome_h &&
+         float(pairs + 1) * pair_w <= vw * 0.95f - chrome_w)
+    ++pairs;
   ImGui::SetNextWindowPos(ImVec2(vw / 2, vh / 2), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(vw * 0.98f, vh * 0.95f));
   ImGui::SetNextWindowBgAlpha(0.9f);
   if (ImGui::Begin("Panoptes keys (H / F1 closes)", &show_help,
-                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse)) {
-    ImGui::SetWindowFontScale(fit);
+                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse |
+                       ImGuiWindowFlags_HorizontalScrollbar)) {
     remember_window();
     const int per_column = (int(rows.size()) + pairs - 1) / pairs;
     if (ImGui::BeginTable("##keys", 2 * pairs, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
