@@ -20,7 +20,7 @@ struct PlayArgs {
   std::string script, frames_out, stats;
   double duration = 0;
   int camera = 0, task = 0, frame = 0;
-  double speed = 1;
+  double speed = 0;  // 0 = automatic (window) / x1 (headless)
   bool paused = false, no_loop = false;
   double cache_mb = 0;
   bool no_prefetch = false;
@@ -64,7 +64,7 @@ void run_play(const PlayArgs& a) {
     if (!a.frames_out.empty()) o.frames_out = a.frames_out;
     if (!a.stats.empty()) o.stats_out = a.stats;
     // The speed option is a script command at t=0 so the run stays one code path.
-    if (a.speed != 1) {
+    if (a.speed > 0 && a.speed != 1) {
       player::ScriptCommand c;
       c.kind = player::ScriptCommand::Kind::speed;
       c.speed = a.speed;
@@ -132,7 +132,10 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--camera", args->camera, "Start camera id")->check(CLI::NonNegativeNumber);
   sub->add_option("--task", args->task, "Start task id")->check(CLI::NonNegativeNumber);
   sub->add_option("--frame", args->frame, "Start frame")->check(CLI::NonNegativeNumber);
-  sub->add_option("--speed", args->speed, "Playback speed factor")->check(CLI::Range(0.25, 8.0));
+  sub->add_option("--speed", args->speed,
+                  "Playback speed factor (0.25 .. 8) of the database's playback rate (default: x1, in the window "
+                  "slowed down so that a run of few frames lasts at least 4 s)")
+      ->check(CLI::Range(0.25, 8.0));
   sub->add_flag("--paused", args->paused, "Start paused");
   sub->add_flag("--no-loop", args->no_loop, "Stop at the end instead of looping");
   sub->add_option("--cache-mb", args->cache_mb, "Frame cache cap in MiB (default: min(1/8 of RAM, 2 GiB))")
@@ -140,7 +143,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_flag("--no-prefetch", args->no_prefetch, "Headless: disable background prefetch (for comparisons)");
   sub->add_option("--prefetch-threads", args->prefetch_threads, "Headless: prefetch threads")->check(CLI::Range(0, 64));
   sub->add_option("--readers", args->readers, "Headless: maximum open movie readers")->check(CLI::Range(2, 100000));
-  sub->add_option("--width", args->width, "Window width in pixels (default: the frame size)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--width", args->width, "Window width in pixels (default: the frame's aspect filling most of the display)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--height", args->height, "Window height in pixels")->check(CLI::NonNegativeNumber);
   sub->add_flag("--fullscreen", args->fullscreen, "Start in full screen");
   sub->add_flag("--software", args->software, "Use SDL's software renderer");

@@ -49,7 +49,59 @@ struct Args {
   std::string title;
   int crf = -1;
   bool force = false;
+  std::string up_axis = "z_up";
+  bool quiet = false;
 };
+
+// Quotes a command-line word for a POSIX shell when it needs it, so the recorded line can be run again.
+std::string shell_word(const std::string& w) {
+  if (!w.empty() && w.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=/.,:@%") ==
+                        std::string::npos)
+    return w;
+  std::string q = "'";
+  for (char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string number_text(double v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
+// The command line recorded in the manifest: every option that changes the pixels, with its value
+// (defaults included, so a later change of a default does not change what the line means).
+std::string recorded_command_line(const Args& a) {
+  std::string cl = "panoptes render";
+  for (const auto& i : a.inputs) cl += " " + shell_word(i);
+  cl += " --rig " + shell_word(a.rig);
+  for (const auto& t : a.tasks) cl += " --task " + shell_word(t);
+  cl += " --size " + shell_word(a.size);
+  cl += " --sample-distance " + number_text(a.sample_distance);
+  cl += " --percentile " + number_text(a.percentile);
+  if (!a.spacing.empty()) cl += " --spacing " + shell_word(a.spacing);
+  if (!a.origin.empty()) cl += " --origin " + shell_word(a.origin);
+  cl += " --background " + shell_word(a.background);
+  if (a.no_outline) cl += " --no-outline";
+  if (a.crf >= 0) cl += " --crf " + std::to_string(a.crf);
+  cl += " --up-axis " + a.up_axis;
+  if (!a.title.empty()) cl += " --title " + shell_word(a.title);
+  cl += " --out " + shell_word(a.out);
+  return cl;
+}
+
+// An all-NaN (or all-infinite) volume renders as empty frames: say so rather than write them silently.
+void warn_if_not_finite(const std::string& file, const std::vector<float>& values) {
+  std::size_t finite = 0;
+  for (float v : values) finite += std::isfinite(v) ? 1 : 0;
+  if (finite == 0 && !values.empty())
+    std::fprintf(stderr, "panoptes: warning: %s: none of its %zu values is a finite number (all NaN or infinite); "
+                 "its frames will be empty\n", file.c_str(), values.size());
+  else if (finite < values.size())
+    std::fprintf(stderr, "panoptes: warning: %s: %zu of %zu values are NaN or infinite; they are rendered as empty\n",
+                 file.c_str(), values.size() - finite, values.size());
+}
 
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option) {
   std::vector<double> v;
@@ -151,8 +203,18 @@ CliTask parse_task(const std::string& text, const render::GridGeometry& grid) {
   return t;
 }
 
+// A bar on a terminal; otherwise (logs, pipes) one line per tenth of the work.
 void progress(bool tty, long long done, long long total, double elapsed) {
-  if (!tty) return;
+  if (!tty) {
+    static long long last_tenth = -1;
+    const long long tenth = total ? 10 * done / total : 10;
+    if (tenth == last_tenth) return;
+    last_tenth = tenth;
+    const double eta = done ? elapsed * double(total - done) / double(done) : 0;
+    std::fprintf(stderr, "render: %lld/%lld images (%d%%), %.0f s elapsed, ETA %.0f s\n", done, total,
+                 int(total ? 100 * done / total : 100), elapsed, eta);
+    return;
+  }
   const int width = 30;
   const int filled = total ? int(width * done / total) : width;
   const double eta = done ? elapsed * double(total - done) / double(done) : 0;
@@ -200,7 +262,9 @@ void run(const Args& a, const std::string& command_line) {
     tasks.push_back(parse_task(t, grid));
 
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
-  const camera::Rig rig = camera::make_rig(a.rig, domain);
+  camera::RigSpec rig_spec = camera::RigSpec::parse(a.rig);
+  rig_spec.up_axis = camera::parse_up_axis(a.up_axis);
+  const camera::Rig rig = camera::make_rig(rig_spec, domain);
   const camera::NavigationGraph graph = camera::build_navigation_graph(rig);
 
   store::Manifest man;
@@ -211,6 +275,7 @@ void run(const Args& a, const std::string& command_line) {
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
   man.domain.origin = grid.origin;
   man.domain.spacing = grid.spacing;
+  man.domain.up_axis = a.up_axis;
   man.image.width = width;
   man.image.height = height;
   if (a.crf >= 0) man.video.crf = a.crf;
@@ -263,7 +328,8 @@ void run(const Args& a, const std::string& command_line) {
     check_memory(e, available, 1, "this render", "pass --force");
   }
   store::DatabaseWriter writer = store::DatabaseWriter::create(a.out, man, a.overwrite);
-  const bool tty = ::isatty(STDERR_FILENO);
+  const bool tty = ::isatty(STDERR_FILENO) && !a.quiet;
+  const bool show_progress = !a.quiet;
   const long long total = (long long)files.size() * rig.size() * (long long)tasks.size();
   long long done = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -279,6 +345,7 @@ void run(const Args& a, const std::string& command_line) {
 
   for (std::size_t f = 0; f < files.size(); ++f) {
     app::Volume vol = f == 0 ? std::move(first) : app::read_volume(files[f]);
+    warn_if_not_finite(files[f], vol.values);
     if (vol.dims != grid.dims)
       throw FileError(files[f], "volume of " + std::to_string(vol.dims[0]) + "x" + std::to_string(vol.dims[1]) + "x" +
                                     std::to_string(vol.dims[2]) + " points; expected " + std::to_string(grid.dims[0]) + "x" +
@@ -317,7 +384,7 @@ void run(const Args& a, const std::string& command_line) {
       }
       if (error) std::rethrow_exception(error);
       done += n;
-      progress(tty, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      if (show_progress) progress(tty, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     if (c0 >= rig.size()) {  // a snapshot cut short by a signal is abandoned: the manifest keeps the last one
       writer.set_time(int(f), double(f));
@@ -367,14 +434,15 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--title", args->title, "Title stored in the manifest");
   sub->add_option("--crf", args->crf, "x264 quality 0..51 (default: the video default)");
   sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
+  sub->add_option("--up-axis", args->up_axis,
+                  "Which way is up in the volume: z_up, or z_down (z is depth, as in seismology); the rig's poles, "
+                  "latitudes, the images' up and the player's Up key follow it")
+      ->check(CLI::IsMember({"z_up", "z_down"}))
+      ->capture_default_str();
+  sub->add_flag("-q,--quiet", args->quiet, "No progress output");
   sub->callback([args] {
     install_stop_handlers();
-    std::string cl = "panoptes render";
-    for (const auto& i : args->inputs) cl += " " + i;
-    cl += " --rig " + args->rig;
-    for (const auto& t : args->tasks) cl += " --task " + t;
-    cl += " --size " + args->size + " --out " + args->out;
-    run(*args, cl);
+    run(*args, recorded_command_line(*args));
   });
 });
 

@@ -123,8 +123,9 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   cfg.program = "panoptes run";
   cfg.command_line = options.command_line;
   cfg.units = "m";
-  // Depth is +z (down): show the free surface at the top of every image.
-  cfg.up = {0, 0, -1};
+  // Depth is +z (down): the sky is −z, so the rig's poles, latitudes and the images' up follow it
+  // (the free surface at the top of every image) unless the file says otherwise.
+  if (cfg.up_axis.empty()) cfg.up_axis = "z_down";
   for (const auto& t : cfg.tasks)
     for (const auto& f : t.fields)
       if (f != "phi_p" && f != "phi_s")

@@ -143,7 +143,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto output = std::make_shared<std::string>();
   auto quiet = std::make_shared<bool>(false);
   sub->add_option("config", *config, "TOML configuration file (keys below)")->required();
-  sub->add_option("-o,--output", *output, "output directory (overrides [output] directory)");
+  sub->add_option("--out", *output, "Output directory (overrides [output] directory), as --out of every other command");
   sub->add_flag("-q,--quiet", *quiet, "print nothing but errors");
   sub->footer(panoptes::seismic::config_keys_help());
   sub->callback([=] { run(*config, *output, *quiet); });

@@ -1,5 +1,6 @@
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "app/command.hpp"
@@ -38,7 +39,13 @@ int main(int argc, char** argv) {
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return root.exit(e);
+    // --help and --version are "errors" of exit code 0: let CLI11 print them. Everything else is one
+    // line in the house style and status 1, like any other error.
+    if (e.get_exit_code() == 0) return root.exit(e);
+    std::string where;
+    for (const CLI::App* sub : root.get_subcommands()) where = std::string(" ") + sub->get_name();
+    std::fprintf(stderr, "panoptes: error: %s (see `panoptes%s --help`)\n", e.what(), where.c_str());
+    return 1;
   } catch (const panoptes::Interrupted& e) {
     std::fprintf(stderr, "panoptes: interrupted: %s\n", e.what());
     return 128 + e.signal();

@@ -94,7 +94,7 @@ void latitude_longitude(const Vec3& d, double& latitude_deg, double& longitude_d
 }
 
 Rig place_on_shells(const std::vector<PatternPoint>& pattern, const Domain& domain, std::vector<double> radii,
-                    double fov_y_degrees, Vec3 up) {
+                    double fov_y_degrees, Vec3 up, UpAxis up_axis) {
   domain.validate();
   if (pattern.empty()) throw Error("rig: the camera pattern is empty; expected at least one camera");
   if (radii.empty()) throw Error("rig: no shell radius given; expected at least one");
@@ -105,7 +105,9 @@ Rig place_on_shells(const std::vector<PatternPoint>& pattern, const Domain& doma
   for (std::size_t s = 1; s < radii.size(); ++s)
     if (radii[s] == radii[s - 1])
       throw Error("rig: shell radius " + std::to_string(radii[s]) + " given twice; expected distinct radii");
-  if (norm(up) == 0 || !std::isfinite(norm(up))) throw Error("rig: up vector is zero; expected a direction");
+  const SkyFrame frame = SkyFrame::of(up_axis);
+  if (norm(up) == 0) up = frame.sky;
+  if (!std::isfinite(norm(up))) throw Error("rig: up vector is not finite; expected a direction");
   const double R = domain.radius();
   double fov = fov_y_degrees;
   if (fov <= 0) {
@@ -121,18 +123,20 @@ Rig place_on_shells(const std::vector<PatternPoint>& pattern, const Domain& doma
   Rig rig;
   rig.center = domain.center();
   rig.shell_count = int(radii.size());
+  rig.up_axis = up_axis;
   rig.cameras.reserve(pattern.size() * radii.size());
   for (int s = 0; s < int(radii.size()); ++s)
     for (const PatternPoint& p : pattern) {
       RigCamera c;
-      const Vec3 d = normalize(p.direction);
+      const Vec3 local = normalize(p.direction);
+      const Vec3 d = frame.to_world(local);
       c.radius = radii[s] * R;
       c.position = rig.center + d * c.radius;
       c.look_at = rig.center;
       c.up = up;
       c.fov_y_degrees = fov;
       c.patch = p.patch;
-      latitude_longitude(d, c.latitude_deg, c.longitude_deg);
+      latitude_longitude(local, c.latitude_deg, c.longitude_deg);
       c.shell = s;
       rig.cameras.push_back(std::move(c));
     }

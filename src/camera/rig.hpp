@@ -17,6 +17,7 @@
 
 #include "camera/camera.hpp"
 #include "camera/framing.hpp"
+#include "camera/orientation.hpp"
 #include "core/vec3.hpp"
 
 namespace panoptes::camera {
@@ -56,8 +57,8 @@ struct RigCamera {
   Vec3 up{0, 0, 1};         ///< requested up (the Camera makes it orthogonal; fallback at the poles)
   double fov_y_degrees = 45;  ///< vertical field of view for a square (or landscape) image
   std::string patch;          ///< "yin", "yang", "latlon", "fibonacci", "file", ...
-  double latitude_deg = 0;    ///< of the direction from the domain centre to the camera
-  double longitude_deg = 0;   ///< atan2(y, x) of that direction, in (−180°, 180°]
+  double latitude_deg = 0;    ///< of the direction from the domain centre to the camera, towards the sky
+  double longitude_deg = 0;   ///< atan2(north, east) of that direction (sky frame), in (−180°, 180°]
   int shell = 0;              ///< 0 = outermost radius
   double radius = 0;          ///< distance from the domain centre, world units
 };
@@ -69,6 +70,7 @@ struct Rig {
   Vec3 center;         ///< domain centre (look-at of the generated rigs)
   std::vector<RigCamera> cameras;
   int shell_count = 1;
+  UpAxis up_axis = UpAxis::z_up;  ///< the domain's sky: poles, latitudes and up vectors follow it
 
   int size() const { return int(cameras.size()); }
   /// A pinhole camera for camera `id` rendering width x height pixels; the field of view is widened
@@ -80,12 +82,14 @@ struct Rig {
 
 /// Places pattern points on shells around the domain: for each radius (in bounding-sphere radii,
 /// sorted from the largest = shell 0), a camera at centre + direction·radius·R looking at the centre
-/// with the requested up (default world +z). The field of view is the same on every shell (so a
+/// with the requested up. Pattern directions are in the sky frame of `up_axis` (pattern +z = sky,
+/// SkyFrame::to_world); a zero `up` (the default) asks for the sky direction, so the images show the
+/// sky side at the top. The field of view is the same on every shell (so a
 /// closer shell magnifies: zoom by switching camera): `fov_y_degrees` if > 0, else the one that fits
 /// the bounding sphere from the outermost shell (fit_fov_y_degrees). Throws panoptes::Error on an
 /// empty pattern, non-positive or duplicate radii, or an outermost radius <= 1 with automatic fov.
 Rig place_on_shells(const std::vector<PatternPoint>& pattern, const Domain& domain, std::vector<double> radii,
-                    double fov_y_degrees = 0, Vec3 up = {0, 0, 1});
+                    double fov_y_degrees = 0, Vec3 up = {0, 0, 0}, UpAxis up_axis = UpAxis::z_up);
 
 /// Latitude and longitude (degrees) of a direction.
 void latitude_longitude(const Vec3& direction, double& latitude_deg, double& longitude_deg);

@@ -185,12 +185,12 @@ Rig make_rig(const RigSpec& spec, const Domain& domain) {
     case RigSpec::Kind::latlon: pattern = latlon_pattern(spec.rows, spec.columns, spec.poles); break;
     case RigSpec::Kind::fibonacci: pattern = fibonacci_pattern(spec.count); break;
     case RigSpec::Kind::file: {
-      Rig rig = read_rig_file(spec.path, domain);
+      Rig rig = read_rig_file(spec.path, domain, spec.up_axis);
       rig.spec = spec.to_string();
       return rig;
     }
   }
-  Rig rig = place_on_shells(pattern, domain, spec.radii, spec.fov_y_degrees, spec.up);
+  Rig rig = place_on_shells(pattern, domain, spec.radii, spec.fov_y_degrees, spec.up, spec.up_axis);
   rig.spec = spec.to_string();
   return rig;
 }
@@ -338,7 +338,8 @@ std::vector<FileCamera> parse_text_cameras(const std::string& text, const std::s
 
 }  // namespace
 
-Rig read_rig_file(const std::string& path, const Domain& domain) {
+Rig read_rig_file(const std::string& path, const Domain& domain, UpAxis up_axis) {
+  const SkyFrame frame = SkyFrame::of(up_axis);
   domain.validate();
   const std::string text = read_regular_file(path, kMaxRigFileBytes, "camera file");
   const auto first = text.find_first_not_of(" \t\r\n");
@@ -359,7 +360,7 @@ Rig read_rig_file(const std::string& path, const Domain& domain) {
     RigCamera c;
     c.position = fc.position;
     c.look_at = fc.has_look_at ? fc.look_at : rig.center;
-    c.up = fc.up;
+    c.up = fc.has_up ? fc.up : frame.sky;
     if (norm(c.up) == 0) throw FileError(path, fc.where + ": up vector is zero; expected a direction");
     if (!(norm(c.position - c.look_at) > 0))
       throw FileError(path, fc.where + ": position equals the look-at point; expected distinct points");
@@ -375,12 +376,13 @@ Rig read_rig_file(const std::string& path, const Domain& domain) {
       c.fov_y_degrees = fit_fov_y_degrees(dc, R);
     }
     c.patch = fc.patch;
-    latitude_longitude(normalize(c.position - rig.center), c.latitude_deg, c.longitude_deg);
+    sky_latitude_longitude(frame, normalize(c.position - rig.center), c.latitude_deg, c.longitude_deg);
     c.shell = fc.shell;
     shells.insert(fc.shell);
     rig.cameras.push_back(std::move(c));
   }
   rig.shell_count = int(shells.size());
+  rig.up_axis = up_axis;
   if (*shells.rbegin() != rig.shell_count - 1)
     throw FileError(path, "shell indices " + std::to_string(*shells.begin()) + ".." + std::to_string(*shells.rbegin()) +
                               " have gaps; expected every shell 0.." + std::to_string(*shells.rbegin()) + " to have a camera");

@@ -36,11 +36,12 @@ struct RigSpec {
   std::string path;    ///< file: the camera file
   std::vector<double> radii{kDefaultRadius};  ///< shell radii, bounding-sphere radii (not for file)
   double fov_y_degrees = 0;                   ///< 0 = frame the domain from the outermost shell
-  Vec3 up{0, 0, 1};                           ///< requested up vector of every generated camera
+  Vec3 up{0, 0, 0};                           ///< requested up of every camera; zero = the sky direction
+  UpAxis up_axis = UpAxis::z_up;              ///< which way is up in the domain (not part of the string)
 
   /// Parses the string syntax above; throws panoptes::Error naming the text and what was expected.
   static RigSpec parse(std::string_view text);
-  /// Canonical string form: parse(to_string()) gives the same spec (fov and up are not part of it).
+  /// Canonical string form: parse(to_string()) gives the same spec (fov, up and up_axis are not part of it).
   std::string to_string() const;
   /// Cameras per shell (0 for file rigs, whose count is known only after reading the file).
   long long cameras_per_shell() const;
@@ -54,13 +55,14 @@ Rig make_rig(std::string_view text, const Domain& domain);
 /// Reads an explicit camera list. Positions are world coordinates.
 ///  - JSON (a file whose first non-blank character is '{' or '['): either an array of cameras or
 ///    {"cameras": [...]}; each camera {"position": [x,y,z], optional "look_at": [x,y,z] (default: the
-///    domain centre), "up": [x,y,z] (default [0,0,1]), "fov_y_degrees": f (default: the field of view
+///    domain centre), "up": [x,y,z] (default: the sky direction of the spec's up_axis), "fov_y_degrees": f (default: the field of view
 ///    that frames the domain's bounding sphere from the camera's distance to the domain centre),
 ///    "shell": k (default 0), "patch": "name" (default "file")}.
 ///  - Text: one camera per line, numbers separated by blanks or commas, '#' starts a comment:
 ///    `x y z [lx ly lz [ux uy uz [fov [shell]]]]`.
 /// Shell indices must cover 0..S−1 without gaps. Throws FileError naming the file, the line or
 /// camera and the bad value.
-Rig read_rig_file(const std::string& path, const Domain& domain);
+/// Latitudes and longitudes are measured in the sky frame of `up_axis`.
+Rig read_rig_file(const std::string& path, const Domain& domain, UpAxis up_axis = UpAxis::z_up);
 
 }  // namespace panoptes::camera

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "camera/rig_stats.hpp"
 #include "core/error.hpp"
@@ -86,6 +87,49 @@ TEST(YinYang, NoTwoCamerasCloseAtAnyResolution) {
     EXPECT_GE(int(p.size()), nt * np + (nt * np * 3) / 4) << nt << "x" << np;
     EXPECT_LE(int(p.size()), 2 * nt * np);
   }
+}
+
+// Seismology's z is depth (positive down): the rig's sky pole, latitudes, camera up vectors and the
+// navigation graph's Up must all point to −z, and camera 0 must look at the scene from above.
+TEST(Orientation, ZDownRigLooksFromTheSkyAndUpGoesTowardsIt) {
+  const Domain domain{{0, 0, 0}, {25600, 51200, 16000}};
+  RigSpec spec = RigSpec::parse("yinyang");
+  spec.up_axis = UpAxis::z_down;
+  const Rig rig = make_rig(spec, domain);
+  ASSERT_EQ(rig.size(), 130);
+  EXPECT_EQ(rig.up_axis, UpAxis::z_down);
+  const Vec3 sky{0, 0, -1};
+  // Camera 0: the first Yin row, obliquely above the surface (latitude 36°), looking down at it.
+  const RigCamera& c0 = rig.cameras[0];
+  EXPECT_NEAR(c0.latitude_deg, 36, 1e-9);
+  EXPECT_GT(dot(rig.direction(0), sky), 0.5);
+  const Camera cam0 = rig.camera(0, 528, 512);
+  EXPECT_LT(dot(cam0.forward(), sky), -0.5) << "camera 0 must look down";
+  EXPECT_GT(dot(cam0.up(), sky), 0.5) << "the sky must be at the top of the image";
+  const NavigationGraph g = build_navigation_graph(rig);
+  int ups = 0;
+  for (int c = 0; c < rig.size(); ++c) {
+    const RigCamera& rc = rig.cameras[std::size_t(c)];
+    EXPECT_EQ(rc.up, sky);
+    // Latitude is measured towards the sky.
+    double lat = 0, lon = 0;
+    sky_latitude_longitude(SkyFrame::of(UpAxis::z_down), rig.direction(c), lat, lon);
+    EXPECT_NEAR(lat, rc.latitude_deg, 1e-9);
+    EXPECT_NEAR(std::sin(lat * std::numbers::pi / 180), dot(rig.direction(c), sky), 1e-9);
+    const int up = g.neighbours[std::size_t(c)].up;
+    if (up < 0 || rc.latitude_deg > 60) continue;  // near the sky pole, Up goes over the top
+    ++ups;
+    EXPECT_GT(rig.cameras[std::size_t(up)].latitude_deg, rc.latitude_deg - 1e-9) << "Up from camera " << c;
+  }
+  EXPECT_GT(ups, 90);
+  // z up (the default) keeps today's layout exactly.
+  const Rig plain = make_rig("yinyang", domain);
+  EXPECT_EQ(plain.up_axis, UpAxis::z_up);
+  EXPECT_EQ(plain.cameras[0].up, (Vec3{0, 0, 1}));
+  EXPECT_GT(plain.direction(0).z, 0.5);
+  EXPECT_NEAR(plain.cameras[0].latitude_deg, 36, 1e-9);
+  EXPECT_EQ(parse_up_axis("z_down"), UpAxis::z_down);
+  EXPECT_THROW(parse_up_axis("down"), Error);
 }
 
 TEST(LatLon, CountsAndPoles) {

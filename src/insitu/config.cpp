@@ -277,7 +277,13 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.outline = boolean(c, *im, "outline", "image.", true);
   }
   if (const auto* r = table(c, root, "rig")) {
-    only_keys(c, *r, "rig", {"spec", "up"});
+    only_keys(c, *r, "rig", {"spec", "up", "up_axis"});
+    s.up_axis = str(c, *r, "up_axis", "rig.", s.up_axis);
+    try {
+      if (!s.up_axis.empty()) (void)camera::parse_up_axis(s.up_axis);
+    } catch (const std::exception& e) {
+      c.fail("rig.up_axis", e.what());
+    }
     s.rig = str(c, *r, "spec", "rig.", s.rig);
     if (const auto* up = r->get("up")) {
       const auto v = numbers(c, *up, "rig.up");
@@ -303,7 +309,10 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     if (s.schedule.max_snapshots < 0) c.fail("schedule.max_snapshots", "expected 0 (unlimited) or more");
   }
   if (const auto* v = table(c, root, "video")) {
-    only_keys(c, *v, "video", {"crf", "preset", "gop", "threads", "fps"});
+    only_keys(c, *v, "video", {"crf", "preset", "gop", "threads", "fps", "playback_fps"});
+    s.playback_fps = num(c, *v, "playback_fps", "video.", 0);
+    if (!(s.playback_fps == 0 || (s.playback_fps > 0 && s.playback_fps <= 1000)))
+      c.fail("video.playback_fps", "expected 0 (none) or a rate in (0, 1000] frames per second");
     s.video.crf = int_in(c, *v, "crf", "video.", s.video.crf, 0, 51);
     s.video.preset = str(c, *v, "preset", "video.", s.video.preset);
     s.video.gop = int_in(c, *v, "gop", "video.", s.video.gop, 1, INT_MAX);
@@ -395,9 +404,12 @@ const char* config_keys_help() {
 [image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box)
 [rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,
             optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R);
-            up = [0, 0, 1] (world direction shown upwards in the images)
+            up_axis = "z_up" | "z_down" (which way is the sky: poles, latitudes, the cameras' up and the
+            player's Up key follow it; `panoptes run` and `panoptes demo` use "z_down", as z is depth);
+            up = [x, y, z] (world direction shown upwards in the images; default: the sky)
 [schedule]  every_steps = 10 | every_time = DT (exactly one); max_snapshots = 0 (unlimited)
-[video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4)
+[video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4);
+            playback_fps = 0 (the player's preferred rate; 0 = fps)
 [render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid:
             the reference "ref" of relative windows); reference = "snapshot" (this snapshot's quantile)
             | "running-max" (running maximum over snapshots: colours comparable across frames, but

@@ -66,7 +66,9 @@ struct SessionConfig {
   std::string command_line;
   std::string units;                  ///< length unit of the grid, for the manifest
   std::string rig = "yinyang";        ///< camera::RigSpec string
-  std::array<double, 3> up{0, 0, 1};  ///< requested up vector of the rig's cameras (world)
+  std::array<double, 3> up{0, 0, 0};  ///< requested up vector of the rig's cameras (world); 0 = the sky
+  std::string up_axis;                ///< which way is up in the domain: "z_up" / "z_down"; "" = z_up
+  double playback_fps = 0;            ///< preferred playback rate for players (0 = the video's fps)
   int width = 920, height = 896;
   std::vector<TaskConfig> tasks;
   ScheduleConfig schedule;

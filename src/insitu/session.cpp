@@ -232,6 +232,7 @@ void Session::Impl::init() {
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
   camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
   spec.up = {cfg.up[0], cfg.up[1], cfg.up[2]};
+  spec.up_axis = cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis);
   // Large rigs take seconds to build (rig, cameras, navigation graph, manifest): say so as it goes.
   const auto t0 = std::chrono::steady_clock::now();
   const bool report = rank == 0 && spec.kind != camera::RigSpec::Kind::file &&
@@ -416,6 +417,8 @@ store::Manifest Session::Impl::make_manifest() const {
   man.domain.origin = grid.origin;
   man.domain.spacing = grid.spacing;
   man.domain.units = cfg.units;
+  man.domain.up_axis = cfg.up_axis;
+  man.playback_fps = cfg.playback_fps;
   man.image.width = cfg.width;
   man.image.height = cfg.height;
   man.video = cfg.video;

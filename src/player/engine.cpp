@@ -498,7 +498,9 @@ Engine::Engine(store::Database database, EngineOptions options) {
   m.frames = m.db.frame_count();
   m.times = m.db.manifest().times;
   m.db_status = m.db.status();
-  m.fps = m.db.manifest().video.fps > 0 ? m.db.manifest().video.fps : 30;
+  // The database's preferred playback rate (a run of few snapshots lasts seconds), else its video rate.
+  const auto& man = m.db.manifest();
+  m.fps = man.playback_fps > 0 ? man.playback_fps : man.video.fps > 0 ? man.video.fps : 30;
   m.directions.reserve(std::size_t(m.cameras));
   m.shells.reserve(std::size_t(m.cameras));
   for (const auto& c : m.db.manifest().cameras) {
@@ -622,6 +624,13 @@ bool Engine::apply(Action action) {
     case Action::slower: {
       const double before = m.speed_factor;
       set_speed(m.speed_factor / 2);
+      return m.speed_factor != before;
+    }
+    case Action::speed_up:
+    case Action::speed_down:
+    case Action::speed_reset: {
+      const double before = m.speed_factor;
+      set_speed(action == Action::speed_reset ? 1.0 : action == Action::speed_up ? m.speed_factor * 1.1 : m.speed_factor / 1.1);
       return m.speed_factor != before;
     }
     case Action::reverse: set_direction(-m.dir); return true;

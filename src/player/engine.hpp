@@ -186,7 +186,8 @@ class Engine {
   int refresh();
   /// Effective status of the database at construction or the last refresh().
   store::Status status() const;
-  double fps() const;  ///< the database's frame rate
+  /// Playback rate at speed ×1: the manifest's playback_fps if set, else its video fps.
+  double fps() const;
 
   // ---- selection and playback -------------------------------------------------------------------
   Selection selection() const;

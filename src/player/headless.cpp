@@ -182,6 +182,34 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
   return out;
 }
 
+void check_script(const std::vector<ScriptCommand>& script, const store::Manifest& m) {
+  using K = ScriptCommand::Kind;
+  for (const ScriptCommand& c : script) {
+    const std::string where = "script line " + std::to_string(c.line) + ": ";
+    const auto range = [](int n) { return n > 0 ? "0.." + std::to_string(n - 1) : std::string("none"); };
+    if (c.kind == K::camera && (c.value < 0 || c.value >= m.camera_count()))
+      throw Error(where + "camera " + std::to_string(c.value) + " does not exist; the database has cameras " +
+                  range(m.camera_count()));
+    if (c.kind == K::task && c.value >= 0 && c.value >= m.task_count())
+      throw Error(where + "task " + std::to_string(c.value) + " does not exist; the database has tasks " +
+                  range(m.task_count()));
+    if (c.kind == K::task && c.value < 0 && m.find_task(c.name) < 0) {
+      std::string names;
+      for (const auto& t : m.tasks) names += (names.empty() ? "" : ", ") + t.name;
+      throw Error(where + "no task named \"" + c.name + "\"; the database has: " + names);
+    }
+    if (c.kind == K::axis && m.find_axis(c.name) < 0) {
+      std::string names;
+      for (const auto& a : m.axes) names += (names.empty() ? "" : ", ") + a.name;
+      throw Error(where + "no parameter axis named \"" + c.name + "\"; the database has: " +
+                  (names.empty() ? std::string("none") : names));
+    }
+    if (c.kind == K::seek && c.value >= std::max(1, m.frames_written))
+      throw Error(where + "seek frame " + std::to_string(c.value) + " does not exist; the database has frames " +
+                  range(m.frames_written));
+  }
+}
+
 std::vector<ScriptCommand> read_script(const std::filesystem::path& path) {
   return parse_script(read_regular_file(path.string(), 16u << 20, "script"), path.string());
 }
@@ -191,6 +219,7 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
   EngineOptions eo = options.engine;
   eo.time_source = clock.source();
   Engine engine(dir, eo);
+  check_script(options.script, engine.manifest());
   const double fps = engine.fps();
 
   double duration = 0;

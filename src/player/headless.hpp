@@ -45,6 +45,11 @@ struct ScriptCommand {
   int line = 0;                  ///< 1-based line number in the script
 };
 
+/// Checks a parsed script against a database: camera ids, task ids and names, axis names and seek
+/// frames must exist (a typo must not be silently ignored). Throws Error naming the line, the value and
+/// the valid range.
+void check_script(const std::vector<ScriptCommand>& script, const store::Manifest& manifest);
+
 /// Parses a script. `source` names it in errors. Throws Error naming the line and the bad text.
 std::vector<ScriptCommand> parse_script(const std::string& text, const std::string& source = "script");
 /// Reads and parses a script file. Throws FileError when it cannot be read, Error on bad syntax.

@@ -124,6 +124,25 @@ TEST(Headless, ScriptedRunShowsTheExpectedStampsAndWritesFramesAndStats) {
   EXPECT_TRUE(j["commands"][0]["applied"].get<bool>());
 }
 
+TEST(Script, ReferencesToNothingAreErrorsNotSilentlyIgnored) {
+  const store::Manifest m = testing::ring_manifest(4, 2);
+  m.validate();
+  auto message = [&](const std::string& text) {
+    try {
+      check_script(parse_script(text), m);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message("t=0 camera=3\nt=0.1 task=1\nt=0.2 key=Right\n"), "accepted");
+  EXPECT_NE(message("t=0 key=Left\nt=1 camera=999\n").find("line 2: camera 999 does not exist; the database has cameras 0..3"),
+            std::string::npos);
+  EXPECT_NE(message("t=0 task=nosuch\n").find("no task named \"nosuch\""), std::string::npos);
+  EXPECT_NE(message("t=0 task=7\n").find("task 7 does not exist"), std::string::npos);
+  EXPECT_NE(message("t=0 axis=nope:+1\n").find("no parameter axis named \"nope\""), std::string::npos);
+}
+
 TEST(Headless, DeterministicAcrossRuns) {
   TempDir dir("player-headless-det");
   testing::write_stamped(dir.path, testing::ring_manifest(3, 1), 6);

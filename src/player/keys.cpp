@@ -26,9 +26,7 @@ constexpr std::array kBindings{
     KeyBinding{"8", Action::task_8, "task 8"},
     KeyBinding{"9", Action::task_9, "task 9"},
     KeyBinding{"PageUp", Action::axis_up, "active parameter axis: next value (other axes kept)"},
-    KeyBinding{"]", Action::axis_up, "same as PageUp"},
     KeyBinding{"PageDown", Action::axis_down, "active parameter axis: previous value"},
-    KeyBinding{"[", Action::axis_down, "same as PageDown"},
     KeyBinding{"A", Action::next_axis, "make the next parameter axis the active one"},
     KeyBinding{"Period", Action::frame_forward, "pause and step one frame forward ('.')"},
     KeyBinding{"Comma", Action::frame_back, "pause and step one frame back (',')"},
@@ -37,6 +35,9 @@ constexpr std::array kBindings{
     KeyBinding{"L", Action::toggle_loop, "loop on / off"},
     KeyBinding{"Shift+Period", Action::faster, "double the playback speed, up to x8 ('>')"},
     KeyBinding{"Shift+Comma", Action::slower, "halve the playback speed, down to x1/4 ('<')"},
+    KeyBinding{"]", Action::speed_up, "speed x1.1 (as mpv)"},
+    KeyBinding{"[", Action::speed_down, "speed /1.1 (as mpv)"},
+    KeyBinding{"Backspace", Action::speed_reset, "speed x1: the database's playback rate (as mpv)"},
     KeyBinding{"J", Action::reverse, "reverse the playback direction"},
     KeyBinding{"+", Action::zoom_in, "magnify around the cursor (also '=' and the mouse wheel)"},
     KeyBinding{"=", Action::zoom_in, "same as +"},
@@ -47,6 +48,7 @@ constexpr std::array kBindings{
     KeyBinding{"R", Action::record, "start / stop recording what is shown to an MP4"},
     KeyBinding{"H", Action::help, "help overlay"},
     KeyBinding{"F1", Action::help, "help overlay"},
+    KeyBinding{"I", Action::toggle_hud, "hide / show the HUD (status panel, mini-map, time slider)"},
     KeyBinding{"Escape", Action::quit, "quit"},
     KeyBinding{"Q", Action::quit, "quit"},
 };
@@ -77,6 +79,9 @@ std::string_view to_string(Action action) {
     case Action::faster: return "faster";
     case Action::slower: return "slower";
     case Action::reverse: return "reverse";
+    case Action::speed_up: return "speed_up";
+    case Action::speed_down: return "speed_down";
+    case Action::speed_reset: return "speed_reset";
     case Action::camera_left: return "camera_left";
     case Action::camera_right: return "camera_right";
     case Action::camera_up: return "camera_up";
@@ -104,6 +109,7 @@ std::string_view to_string(Action action) {
     case Action::screenshot: return "screenshot";
     case Action::record: return "record";
     case Action::help: return "help";
+    case Action::toggle_hud: return "toggle_hud";
     case Action::quit: return "quit";
   }
   return "unknown";
@@ -119,6 +125,7 @@ bool is_engine_action(Action action) {
     case Action::screenshot:
     case Action::record:
     case Action::help:
+    case Action::toggle_hud:
     case Action::quit:
       return false;
     default:

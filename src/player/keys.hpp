@@ -23,6 +23,9 @@ enum class Action {
   faster,          ///< Shift+Period ('>'): double the speed (max ×8)
   slower,          ///< Shift+Comma ('<'): halve the speed (min ×¼)
   reverse,         ///< J: toggle playback direction (forward/backward)
+  speed_up,        ///< ']': speed ×1.1 (as mpv)
+  speed_down,      ///< '[': speed ÷1.1 (as mpv)
+  speed_reset,     ///< Backspace: speed ×1 (as mpv)
   // cameras (the manifest's navigation graph)
   camera_left,     ///< Left
   camera_right,    ///< Right
@@ -34,8 +37,8 @@ enum class Action {
   next_task,       ///< Tab
   previous_task,   ///< Shift+Tab
   task_1, task_2, task_3, task_4, task_5, task_6, task_7, task_8, task_9,  ///< digit keys 1..9: task 0..8
-  axis_up,         ///< PageUp or ']': step the active parameter axis up, keeping the other axes
-  axis_down,       ///< PageDown or '[': step the active parameter axis down
+  axis_up,         ///< PageUp: step the active parameter axis up, keeping the other axes
+  axis_down,       ///< PageDown: step the active parameter axis down
   next_axis,       ///< A: make the next parameter axis the active one
   // front end only (Engine::apply ignores these)
   zoom_in,         ///< '+' / '=' (and the mouse wheel): magnify around the cursor
@@ -45,6 +48,7 @@ enum class Action {
   screenshot,      ///< S: save the shown frame as PNG
   record,          ///< R: start/stop recording what is shown to an MP4
   help,            ///< H or F1: help overlay
+  toggle_hud,      ///< I: hide / show the HUD (status panel, mini-map, time slider)
   quit,            ///< Escape or Q
 };
 

@@ -17,7 +17,11 @@ TEST(Keys, PaperKeysMapToEngineActions) {
   EXPECT_EQ(action_for_key("Shift+Tab"), Action::previous_task);
   EXPECT_EQ(action_for_key("Space"), Action::play_pause);
   EXPECT_EQ(action_for_key("PageUp"), Action::axis_up);
-  EXPECT_EQ(action_for_key("]"), Action::axis_up);
+  EXPECT_EQ(action_for_key("]"), Action::speed_up);  // as mpv
+  EXPECT_EQ(action_for_key("["), Action::speed_down);
+  EXPECT_EQ(action_for_key("Backspace"), Action::speed_reset);
+  EXPECT_EQ(action_for_key("PageUp"), Action::axis_up);
+  EXPECT_EQ(action_for_key("i"), Action::toggle_hud);
   EXPECT_EQ(action_for_key("PageDown"), Action::axis_down);
   EXPECT_EQ(action_for_key("Period"), Action::frame_forward);
   EXPECT_EQ(action_for_key("Comma"), Action::frame_back);

@@ -377,7 +377,7 @@ Unknown keys and wrong types are errors.
                 time s, delay default 0; S rises from 0 to 1, so M0 is the final moment)
 [[receiver]]    name, position = [x, y, z]  -> <output>/<name>.csv (time,vx,vy,vz in m/s)
 [[receiver_line]] name, start = [x,y,z], end = [x,y,z], count -> receivers <name>_000 ...
-[output]        directory (default "seismic_out"; --output overrides);
+[output]        directory (default "seismic_out"; --out overrides);
                 snapshot_fields = ["vz", "phi_p", ...] (default none): fields written as .npy
                 float32 of the GLOBAL grid, shape (nz, ny, nx), x fastest, to
                 <output>/snapshots/<field>_<step>.npy (step = steps done, 6 digits). Fields: vx, vy,

@@ -147,6 +147,10 @@ void Manifest::validate() const {
     if (image.padded_width < image.width || image.padded_height < image.height)
       fail("padded image size " + std::to_string(image.padded_width) + "x" + std::to_string(image.padded_height) +
            " is smaller than the image size " + std::to_string(image.width) + "x" + std::to_string(image.height));
+  if (!domain.up_axis.empty() && domain.up_axis != "z_up" && domain.up_axis != "z_down")
+    fail("domain.up_axis \"" + domain.up_axis + "\"; expected \"z_up\" or \"z_down\"");
+  if (!(playback_fps == 0 || (std::isfinite(playback_fps) && playback_fps > 0 && playback_fps <= 1000)))
+    fail("playback_fps " + std::to_string(playback_fps) + "; expected 0 (none) or a rate in (0, 1000] frames per second");
   try {
     video.validate();
   } catch (const Error& e) {
@@ -297,6 +301,8 @@ json manifest_json(const Manifest& m, const CameraTableRef* table) {
                  {"origin", vec3_json(m.domain.origin)},
                  {"spacing", vec3_json(m.domain.spacing)},
                  {"units", m.domain.units}};
+  if (!m.domain.up_axis.empty()) j["domain"]["up_axis"] = m.domain.up_axis;
+  if (m.playback_fps > 0) j["playback_fps"] = m.playback_fps;
   j["times"] = m.times;
   j["image"] = {{"width", m.image.width},
                 {"height", m.image.height},
@@ -402,7 +408,9 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
     if (const json* o = r.optional(*d, "origin", "domain")) m.domain.origin = r.vec3(*o, "domain.origin");
     if (const json* s = r.optional(*d, "spacing", "domain")) m.domain.spacing = r.vec3(*s, "domain.spacing");
     m.domain.units = r.opt_str(*d, "units", "domain");
+    m.domain.up_axis = r.opt_str(*d, "up_axis", "domain");
   }
+  if (const json* v = r.optional(j, "playback_fps", "")) m.playback_fps = r.num(*v, "playback_fps");
   if (const json* t = r.optional(j, "times", "")) {
     r.array(*t, "times");
     m.times.reserve(t->size());

@@ -55,7 +55,12 @@ struct Domain {
   Vec3 origin{0, 0, 0};
   Vec3 spacing{1, 1, 1};
   std::string units;  ///< length unit, e.g. "m", "km"; empty = dimensionless
+  /// Which way is up (towards the sky): "z_up", "z_down" (z is depth, as in seismology), or empty for
+  /// databases written before it was recorded, which the player treats as z_up.
+  std::string up_axis;
   bool operator==(const Domain&) const = default;
+  /// Unit vector towards the sky: (0, 0, −1) for "z_down", else (0, 0, 1).
+  Vec3 sky() const { return up_axis == "z_down" ? Vec3{0, 0, -1} : Vec3{0, 0, 1}; }
 };
 
 /// Size of every frame of every stream. Movies are coded at padded_* (even, for 4:2:0) and
@@ -170,6 +175,9 @@ struct Manifest {
   Status status = Status::running;
   int frames_written = 0;  ///< complete snapshots: every stream holds at least this many frames
   std::string movie_pattern = kDefaultMoviePattern;  ///< relative; must contain {camera} and {task}
+  /// Preferred playback rate in frames per second (0 = none: players use video.fps). A database of
+  /// few snapshots sets it so the whole run lasts several seconds instead of flashing by at 30 fps.
+  double playback_fps = 0;
 
   int camera_count() const { return int(cameras.size()); }
   int task_count() const { return int(tasks.size()); }

@@ -51,6 +51,8 @@ TEST(Manifest, SchemaRoundTripKeepsEveryField) {
   m.tasks[0].parameters["nested"] = {{"a", json::array({1, 2, 3})}, {"b", "text"}};
   m.rig.parameters["yang_rotation"] = json::array({-1, 0, 0});
   m.movie_pattern = "m/{camera}-{task}.mp4";
+  m.domain.up_axis = "z_down";
+  m.playback_fps = 12.5;
 
   const json j = to_json(m);
   EXPECT_EQ(j.at("schema_version"), kSchemaVersion);
@@ -76,6 +78,29 @@ TEST(Manifest, SchemaRoundTripKeepsEveryField) {
   int files = 0;
   for (auto& e : std::filesystem::directory_iterator(dir.path)) files += bool(e.is_regular_file());
   EXPECT_EQ(files, 2);
+}
+
+TEST(Manifest, OrientationAndPlaybackRateAreOptionalAndChecked) {
+  // Older databases carry neither: they read as "" (z up) and 0 (the video's rate), and are written
+  // back without the fields.
+  Manifest m = sample_manifest(3, 2, 16, 16);
+  json j = to_json(m);
+  EXPECT_FALSE(j["domain"].contains("up_axis"));
+  EXPECT_FALSE(j.contains("playback_fps"));
+  Manifest back = manifest_from_json(j, "mem");
+  EXPECT_EQ(back.domain.up_axis, "");
+  EXPECT_EQ(back.domain.sky(), (Vec3{0, 0, 1}));
+  EXPECT_EQ(back.playback_fps, 0);
+  j["domain"]["up_axis"] = "z_down";
+  j["playback_fps"] = 10;
+  back = manifest_from_json(j, "mem");
+  EXPECT_EQ(back.domain.sky(), (Vec3{0, 0, -1}));
+  EXPECT_EQ(back.playback_fps, 10);
+  j["domain"]["up_axis"] = "sideways";
+  EXPECT_THROW(manifest_from_json(j, "mem"), Error);
+  j["domain"]["up_axis"] = "z_up";
+  j["playback_fps"] = -1;
+  EXPECT_THROW(manifest_from_json(j, "mem"), Error);
 }
 
 TEST(Manifest, EmptyGraphAndMinimalFieldsAreValid) {

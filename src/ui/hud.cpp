@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string_view>
+#include <vector>
 
 #include "player/keys.hpp"
 
@@ -41,8 +43,12 @@ Hud::Hud(const store::Manifest& manifest) {
   std::vector<Vec3> dirs;
   std::vector<int> shells;
   dirs.reserve(manifest.cameras.size());
+  // The mini-map draws the sky at the top: directions go into the domain's sky frame (east, north,
+  // sky), the same frame camera::SkyFrame lays rigs out in (z_down: east = +y, north = +x, sky = −z).
+  const bool z_down = manifest.domain.up_axis == "z_down";
   for (const auto& c : manifest.cameras) {
-    dirs.push_back(c.position - c.look_at);
+    const Vec3 d = c.position - c.look_at;
+    dirs.push_back(z_down ? Vec3{d.y, d.x, -d.z} : d);
     shells.push_back(c.labels.shell);
   }
   minimap_.set_cameras(std::move(dirs), std::move(shells));
@@ -74,11 +80,13 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
 
   if (show_panel) {
     // Status panel, top right: the top-left corner belongs to the frame (and its stamp in tests).
-    // At most ~60 % of the width (and 440 px) so long messages wrap instead of covering the frame.
-    const float panel_w = std::max(std::min(vw * 0.6f, 440.f), std::min(vw, 240.f));
+    // Compact by default (4 lines), so the HUD hides only a small part of the picture; the session
+    // statistics are one click away under "details". Long messages wrap at ~45 % of the width.
+    const float scale = ImGui::GetIO().FontGlobalScale;
+    const float panel_w = std::max(std::min(vw * 0.45f, 460.f * scale), std::min(vw, 240.f));
     ImGui::SetNextWindowPos(ImVec2(vw - pad, pad), ImGuiCond_Always, ImVec2(1, 0));
-    ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(panel_w, vh));
-    ImGui::SetNextWindowBgAlpha(0.72f);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(panel_w, vh * 0.6f));
+    ImGui::SetNextWindowBgAlpha(0.6f);
     if (ImGui::Begin("##status", nullptr, kOverlayFlags)) {
       ImGui::PushTextWrapPos(panel_w - 2 * ImGui::GetStyle().WindowPadding.x);
       panel_drawn_ = true;
@@ -86,25 +94,16 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       const auto& sel = info.selection;
       const auto& cam = m.cameras[std::size_t(sel.camera)];
       const auto& task = m.tasks[std::size_t(sel.task)];
-      ImGui::Text("t = %.4g   frame %d of %d", info.sim_time, sel.frame, info.frame_count);
-      ImGui::Text("camera %d%s%s  lat %+.1f  lon %+.1f  shell %d", sel.camera, cam.labels.patch.empty() ? "" : " ",
-                  cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg, cam.labels.shell);
-      ImGui::Text("task %d of %d: %s", sel.task, int(m.tasks.size()), task.name.c_str());
+      ImGui::Text("t = %.4g   frame %d of %d   %s x%.2g%s%s", info.sim_time, sel.frame, info.frame_count, info.playing ? "playing" : "paused", info.speed,
+                  info.direction < 0 ? " reverse" : "", info.loop ? "" : " once");
+      ImGui::Text("camera %d%s%s   lat %+.0f  lon %+.0f%s", sel.camera, cam.labels.patch.empty() ? "" : " ",
+                  cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg,
+                  info.shell_count > 1 ? ("   shell " + std::to_string(cam.labels.shell)).c_str() : "");
       const std::string params = format_parameters(m, task);
-      if (!params.empty()) ImGui::Text("  %s", params.c_str());
+      ImGui::Text("task %d of %d: %s%s%s", sel.task, int(m.tasks.size()), task.name.c_str(),
+                  params.empty() ? "" : "   ", params.c_str());
       if (info.active_axis >= 0 && info.active_axis < int(m.axes.size()))
         ImGui::Text("PgUp/PgDn axis: %s", m.axes[std::size_t(info.active_axis)].name.c_str());
-      ImGui::Text("%s x%g%s%s", info.playing ? "playing" : "paused", info.speed, info.direction < 0 ? " reverse" : "",
-                  info.loop ? "  loop" : "");
-      ImGui::Text("display %.1f fps   zoom x%.2g", info.display_fps, info.zoom);
-      if (info.have_switch)
-        ImGui::Text("last switch %.2f ms (%s)  p99 %.2f ms", info.last_switch_ms,
-                    info.last_switch_hit ? "prefetched" : "decoded", info.switch_p99_ms);
-      else
-        ImGui::TextDisabled("last switch: none yet");
-      const std::int64_t shown = info.cache_hits + info.cache_misses;
-      ImGui::Text("cache %s / %s, hits %.0f%%", megabytes(info.cache_bytes).c_str(),
-                  megabytes(info.cache_capacity).c_str(), shown ? 100.0 * double(info.cache_hits) / double(shown) : 0.0);
       if (info.recording) {
         ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
         ImGui::TextWrapped("REC %s", info.recording_path.c_str());
@@ -116,16 +115,30 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
                            info.status_message.c_str());
         ImGui::PopStyleColor();
       }
-      ImGui::TextDisabled("H / F1: help   renderer: %s", info.renderer.c_str());
+      if (ImGui::TreeNodeEx("details", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
+        ImGui::Text("display %.1f fps   zoom x%.2g", info.display_fps, info.zoom);
+        if (info.have_switch)
+          ImGui::Text("last switch %.2f ms (%s)  p99 %.2f ms", info.last_switch_ms,
+                      info.last_switch_hit ? "prefetched" : "decoded", info.switch_p99_ms);
+        else
+          ImGui::TextDisabled("last switch: none yet");
+        const std::int64_t shown = info.cache_hits + info.cache_misses;
+        ImGui::Text("cache %s / %s, hits %.0f%%", megabytes(info.cache_bytes).c_str(),
+                    megabytes(info.cache_capacity).c_str(), shown ? 100.0 * double(info.cache_hits) / double(shown) : 0.0);
+        ImGui::TextDisabled("renderer: %s", info.renderer.c_str());
+      }
+      ImGui::SameLine();
+      ImGui::TextDisabled("  H: help   I: hide HUD");
       ImGui::PopTextWrapPos();
     }
     ImGui::End();
 
     // Mini-map, bottom right above the slider.
-    const float map = std::clamp(std::min(vw, vh) * 0.28f, 90.f, 220.f);
+    // Scales with the window: ~16 % of its smaller side (about 3 % of the picture's area).
+    const float map = std::clamp(std::min(vw, vh) * 0.16f, 80.f, 320.f);
     const float slider_h = ImGui::GetFrameHeightWithSpacing() + 2 * ImGui::GetStyle().WindowPadding.y;
     ImGui::SetNextWindowPos(ImVec2(vw - pad, vh - slider_h - pad), ImGuiCond_Always, ImVec2(1, 1));
-    ImGui::SetNextWindowBgAlpha(0.5f);
+    ImGui::SetNextWindowBgAlpha(0.35f);
     if (ImGui::Begin("##minimap", nullptr, kOverlayFlags)) {
       remember_window();
       req.jump_camera = minimap_.draw(info.selection.camera, info.neighbours, map);
@@ -169,36 +182,56 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
 }
 
 void Hud::draw_help(float vw, float vh) {
+  struct Row {
+    std::string_view key, what;
+  };
+  std::vector<Row> rows;
+  for (const auto& b : player::key_bindings()) rows.push_back({b.key, b.description});
+  for (const auto& r : {Row{"left drag", "rotate: snap to the camera nearest the dragged direction"},
+                        Row{"wheel", "magnify around the cursor"}, Row{"right drag", "pan the magnified frame"},
+                        Row{"mini-map click", "jump to that camera"}})
+    rows.push_back(r);
+  // Always fits the window: 1, 2 or 3 key/description column pairs — the fewest that fit the height,
+  // as long as they fit the width — and whatever still does not fit scrolls (shrinking ImGui's bitmap
+  // font makes it unreadable, so it is not shrunk).
+  const ImGuiStyle& style = ImGui::GetStyle();
+  float key_w = 0, what_w = 0;
+  for (const Row& r : rows) {
+    key_w = std::max(key_w, ImGui::CalcTextSize(r.key.data(), r.key.data() + r.key.size()).x);
+    what_w = std::max(what_w, ImGui::CalcTextSize(r.what.data(), r.what.data() + r.what.size()).x);
+  }
+  const float pair_w = key_w + what_w + 4 * style.CellPadding.x + style.ItemSpacing.x;
+  const float row_h = ImGui::GetTextLineHeight() + 2 * style.CellPadding.y;
+  const float chrome_w = 2 * style.WindowPadding.x, chrome_h = 2 * style.WindowPadding.y + ImGui::GetFrameHeight();
+  int pairs = 1;
+  while (pairs < 3 && float((int(rows.size()) + pairs - 1) / pairs) * row_h > vh * 0.95f - chrome_h &&
+         float(pairs + 1) * pair_w <= vw * 0.95f - chrome_w)
+    ++pairs;
   ImGui::SetNextWindowPos(ImVec2(vw / 2, vh / 2), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(vw * 0.95f, vh * 0.9f));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(vw * 0.98f, vh * 0.95f));
   ImGui::SetNextWindowBgAlpha(0.9f);
   if (ImGui::Begin("Panoptes keys (H / F1 closes)", &show_help,
-                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse)) {
+                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse |
+                       ImGuiWindowFlags_HorizontalScrollbar)) {
     remember_window();
-    if (ImGui::BeginTable("##keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
-      for (const auto& b : player::key_bindings()) {
+    const int per_column = (int(rows.size()) + pairs - 1) / pairs;
+    if (ImGui::BeginTable("##keys", 2 * pairs, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+      for (int r = 0; r < per_column; ++r) {
         ImGui::TableNextRow();
-        ImGui::TableNextColumn();
-        ImGui::TextUnformatted(b.key.data(), b.key.data() + b.key.size());
-        ImGui::TableNextColumn();
-        ImGui::TextUnformatted(b.description.data(), b.description.data() + b.description.size());
-      }
-      const char* mouse[][2] = {{"left drag", "rotate: snap to the camera nearest the dragged direction"},
-                                {"wheel", "magnify around the cursor"},
-                                {"right drag", "pan the magnified frame"},
-                                {"mini-map click", "jump to that camera"},
-                                {"I", "hide / show the HUD"}};
-      for (const auto& row : mouse) {
-        ImGui::TableNextRow();
-        ImGui::TableNextColumn();
-        ImGui::TextUnformatted(row[0]);
-        ImGui::TableNextColumn();
-        ImGui::TextUnformatted(row[1]);
+        for (int p = 0; p < pairs; ++p) {
+          const int i = p * per_column + r;
+          ImGui::TableNextColumn();
+          if (i < int(rows.size())) ImGui::TextUnformatted(rows[std::size_t(i)].key.data(), rows[std::size_t(i)].key.data() + rows[std::size_t(i)].key.size());
+          ImGui::TableNextColumn();
+          if (i < int(rows.size())) ImGui::TextUnformatted(rows[std::size_t(i)].what.data(), rows[std::size_t(i)].what.data() + rows[std::size_t(i)].what.size());
+        }
       }
       ImGui::EndTable();
     }
   }
   ImGui::End();
 }
+
+float Hud::scale_for(float vw, float vh) { return std::clamp(std::min(vw, vh) / 800.f, 1.f, 2.f); }
 
 }  // namespace panoptes::ui

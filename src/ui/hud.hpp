@@ -34,6 +34,7 @@ struct HudInfo {
   player::FrameStatus status = player::FrameStatus::ok;
   std::string status_message;
   std::vector<int> neighbours;    ///< graph neighbours of the current camera (mini-map)
+  int shell_count = 1;            ///< camera shells of the rig (the shell is shown only if > 1)
 };
 
 /// What the user did in the HUD this frame.
@@ -50,6 +51,10 @@ class Hud {
   explicit Hud(const store::Manifest& manifest);
 
   HudRequests draw(const HudInfo& info, float viewport_w, float viewport_h);
+
+  /// Font scale for a window of this size (set as ImGui's FontGlobalScale before the frame): the HUD
+  /// grows with big windows and stays readable in small ones.
+  static float scale_for(float viewport_w, float viewport_h);
 
   bool show_panel = true;  ///< status panel + mini-map + slider
   bool show_help = false;

@@ -30,7 +30,7 @@ constexpr std::array kNamed{
     NamedKey{SDLK_KP_5, "5"},            NamedKey{SDLK_KP_6, "6"},
     NamedKey{SDLK_KP_7, "7"},            NamedKey{SDLK_KP_8, "8"},
     NamedKey{SDLK_KP_9, "9"},            NamedKey{SDLK_GREATER, "Shift+Period"},
-    NamedKey{SDLK_LESS, "Shift+Comma"},
+    NamedKey{SDLK_LESS, "Shift+Comma"},  NamedKey{SDLK_BACKSPACE, "Backspace"},
 };
 
 std::string plain_name(SDL_Keycode key) {

@@ -28,7 +28,9 @@ TEST(SdlKeys, TypedKeysMapThroughThePlayersTable) {
   EXPECT_EQ(press(SDLK_l, KMOD_LSHIFT), Action::toggle_loop);
   EXPECT_EQ(press(SDLK_3), Action::task_3);
   EXPECT_EQ(press(SDLK_PAGEUP), Action::axis_up);
-  EXPECT_EQ(press(SDLK_RIGHTBRACKET), Action::axis_up);
+  EXPECT_EQ(press(SDLK_RIGHTBRACKET), Action::speed_up);  // as mpv
+  EXPECT_EQ(press(SDLK_BACKSPACE), Action::speed_reset);
+  EXPECT_EQ(press(SDLK_i), Action::toggle_hud);
   EXPECT_EQ(press(SDLK_F1), Action::help);
   EXPECT_EQ(press(SDLK_0), Action::zoom_reset);
   EXPECT_FALSE(press(SDLK_F7));

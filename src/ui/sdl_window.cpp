@@ -4,6 +4,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <cstdlib>
 
 #include "backends/imgui_impl_sdl.h"
@@ -48,9 +49,13 @@ SdlWindow::SdlWindow(const SdlWindowOptions& options) {
   int width = options.width, height = options.height;
   SDL_Rect usable{};
   if (SDL_GetDisplayUsableBounds(0, &usable) == 0 && usable.w > 0 && usable.h > 0) {
-    const double shrink = std::min({1.0, 0.95 * usable.w / width, 0.9 * usable.h / height});
-    width = std::max(64, int(width * shrink));
-    height = std::max(64, int(height * shrink));
+    const double fit = std::min(0.95 * usable.w / width, 0.9 * usable.h / height);
+    const double fill = options.fill_display > 0
+                            ? options.fill_display * std::min(double(usable.w) / width, double(usable.h) / height)
+                            : 1.0;
+    const double factor = std::min(fill, fit);
+    width = std::max(64, int(width * factor));
+    height = std::max(64, int(height * factor));
   }
   Uint32 wflags = SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI;
   if (options.fullscreen) wflags |= SDL_WINDOW_FULLSCREEN_DESKTOP;
@@ -111,6 +116,9 @@ void SdlWindow::set_fullscreen(bool on) {
 void SdlWindow::begin_imgui_frame() {
   ImGui_ImplSDLRenderer_NewFrame();
   ImGui_ImplSDL2_NewFrame();
+  // The backend keeps reporting the pointer while the window has keyboard focus, even after it left
+  // the window (a mini-map tooltip then stayed on screen): no pointer unless it is over this window.
+  if (SDL_GetMouseFocus() != window_) ImGui::GetIO().MousePos = ImVec2(-FLT_MAX, -FLT_MAX);
   ImGui::NewFrame();
 }
 

@@ -12,6 +12,9 @@ namespace panoptes::ui {
 
 /// How to open the window.
 struct SdlWindowOptions {
+  /// If > 0: scale width x height (up or down, aspect kept) so the window fills this fraction of the
+  /// display's usable area in its tighter dimension. Else the size is kept, only shrunk to fit.
+  double fill_display = 0;
   std::string title = "Panoptes";
   int width = 960, height = 720;
   bool fullscreen = false;

@@ -165,6 +165,7 @@ class WindowApp {
         texture_(window.renderer()),
         hud_(engine.manifest()) {
     hud_.show_panel = options.show_hud;
+    for (const auto& c : engine.manifest().cameras) shell_count_ = std::max(shell_count_, c.labels.shell + 1);
     hud_.show_help = options.show_help;
   }
 
@@ -175,6 +176,7 @@ class WindowApp {
   void run_due_script_commands();
   void handle_event(const SDL_Event& e);
   void do_action(player::Action action);
+  void explain_refused(player::Action action);
   void zoom_by(double factor);
   void apply_hud_requests(const HudRequests& req);
   HudInfo gather_hud_info(const player::ShownFrame& shown);
@@ -194,6 +196,7 @@ class WindowApp {
   ViewTransform view_;
   DragRotation drag_;
   Recorder recorder_;
+  int shell_count_ = 1;
 
   double t0_ = wall_seconds();
   bool quit_ = false;
@@ -266,9 +269,42 @@ void WindowApp::do_action(player::Action action) {
     case Action::screenshot: screenshot_pending_ = true; break;
     case Action::record: toggle_recording(); break;
     case Action::help: hud_.show_help = !hud_.show_help; break;
+    case Action::toggle_hud: hud_.show_panel = !hud_.show_panel; break;
     case Action::quit: quit_ = true; break;
     case Action::none: break;
-    default: engine_.apply(action); break;
+    default:
+      if (!engine_.apply(action)) {
+        explain_refused(action);
+      } else if (action == Action::speed_up || action == Action::speed_down || action == Action::speed_reset ||
+                 action == Action::faster || action == Action::slower) {
+        char text[64];
+        std::snprintf(text, sizeof text, "speed x%.2f (%.1f frames/s)", engine_.speed(), engine_.speed() * engine_.fps());
+        hud_.notify(text);
+      }
+      break;
+  }
+}
+
+// A key that changes nothing says why, instead of leaving the user to guess.
+void WindowApp::explain_refused(player::Action action) {
+  using player::Action;
+  switch (action) {
+    case Action::shell_in:
+    case Action::shell_out:
+      if (shell_count_ <= 1)
+        hud_.notify("Z / X move between camera shells, and this rig has only one (a rig spec like "
+                    "\"yinyang@2,3\" has two); use + / - or the wheel to magnify");
+      else
+        hud_.notify(action == Action::shell_in ? "no closer shell from this camera" : "no farther shell from this camera");
+      break;
+    case Action::camera_up: hud_.notify("no camera above this one"); break;
+    case Action::camera_down: hud_.notify("no camera below this one"); break;
+    case Action::camera_left:
+    case Action::camera_right: hud_.notify("no camera that way"); break;
+    case Action::axis_up:
+    case Action::axis_down:
+    case Action::next_axis: hud_.notify("this database has no parameter axis to step here"); break;
+    default: break;
   }
 }
 
@@ -286,10 +322,9 @@ void WindowApp::handle_event(const SDL_Event& e) {
         // Holding a key repeats navigation and frame steps, but not toggles.
         const bool toggle = *action == player::Action::play_pause || *action == player::Action::fullscreen ||
                             *action == player::Action::record || *action == player::Action::help ||
+                            *action == player::Action::toggle_hud ||
                             *action == player::Action::screenshot || *action == player::Action::toggle_loop;
         if (!(e.key.repeat && toggle)) do_action(*action);
-      } else if (e.key.keysym.sym == SDLK_i && !e.key.repeat) {
-        hud_.show_panel = !hud_.show_panel;  // front-end only, not in the shared key table
       }
       break;
     }
@@ -371,6 +406,7 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   h.recording_path = recorder_.path();
   h.renderer = window_.renderer_name();
   h.status = shown.status;
+  h.shell_count = shell_count_;
   h.status_message = shown.message;
   if (!m.graph.empty()) {
     const auto& n = m.graph.neighbours[std::size_t(shown.selection.camera)];
@@ -496,6 +532,7 @@ WindowResult WindowApp::run() {
       refresh_statistics();
       next_stats_ = wall + 0.5;
     }
+    ImGui::GetIO().FontGlobalScale = Hud::scale_for(float(win_w_), float(win_h_));
     window_.begin_imgui_frame();
     const HudRequests req = hud_.draw(gather_hud_info(shown), float(win_w_), float(win_h_));
     window_.render_imgui();
@@ -522,6 +559,8 @@ WindowResult WindowApp::run() {
     result.view_w = int(std::lround(fr.w));
     result.view_h = int(std::lround(fr.h));
     result.hud_drawn = hud_.panel_drawn();
+    result.window_w = out_w_;
+    result.window_h = out_h_;
     result.status = std::string(player::to_string(shown.status));
   }
   if (recorder_.active()) {
@@ -570,13 +609,24 @@ WindowResult run_window(const std::filesystem::path& db, const WindowOptions& op
   eo.frame = options.frame;
   if (options.virtual_time) eo.time_source = vclock.source();
   player::Engine engine(db, eo);
-  engine.set_speed(options.speed);
+  player::check_script(script, engine.manifest());
+  // A database without a preferred playback rate whose whole run would flash by in under ~4 s at its
+  // video rate (e.g. 24 snapshots at 30 fps) starts slower, so the eye can follow the waves.
+  double speed = options.speed > 0 ? options.speed : 1.0;
+  if (options.speed <= 0 && engine.manifest().playback_fps <= 0 && engine.frame_count() > 1) {
+    constexpr double kShortestRun = 4.0;  // seconds
+    speed = std::clamp(engine.frame_count() / (engine.fps() * kShortestRun), 0.25, 1.0);
+  }
+  engine.set_speed(speed);
 
   const auto& m = engine.manifest();
   SdlWindowOptions wo;
   wo.title = "Panoptes - " + (m.title.empty() ? db.filename().string() : m.title);
   wo.width = options.width > 0 ? options.width : m.image.width;
   wo.height = options.height > 0 ? options.height : m.image.height;
+  // Without an explicit size the window fills most of the display whatever the frame size (a 256-pixel
+  // database must not open as a stamp, a 4K one must fit), keeping the frame's aspect.
+  if (options.width <= 0 && options.height <= 0) wo.fill_display = 0.85;
   wo.fullscreen = options.fullscreen;
   wo.software_renderer = options.software_renderer;
   wo.vsync = options.vsync;

@@ -11,7 +11,7 @@ namespace panoptes::ui {
 
 /// Options of run_window(). Defaults suit an interactive session.
 struct WindowOptions {
-  /// Initial window size in pixels; 0 = the database's frame size (clamped to the screen).
+  /// Initial window size in pixels; 0 x 0 = the frame's aspect filling most (85 %) of the display.
   int width = 0, height = 0;
   bool fullscreen = false;
   /// Use SDL's software renderer even if an accelerated one exists (tests under Xvfb, remote X).
@@ -21,8 +21,10 @@ struct WindowOptions {
 
   /// Where playback starts.
   int camera = 0, task = 0, frame = 0;
-  /// Playback speed factor (¼ … 8) and whether playback starts running / loops at the end.
-  double speed = 1.0;
+  /// Playback speed factor (¼ … 8) and whether playback starts running / loops at the end. 0 = automatic:
+  /// ×1 of the database's playback rate, slowed down (to ×¼ at most) when the whole run would last
+  /// under 4 s.
+  double speed = 0;
   bool paused = false;
   bool loop = true;
   /// Frame cache cap for the engine in bytes; 0 = the engine's default for this machine.
@@ -58,6 +60,7 @@ struct WindowResult {
   int frame = -1;               ///< database frame shown last
   double zoom = 1.0;            ///< magnification at exit (1 = whole frame fitted to the window)
   int view_x = 0, view_y = 0, view_w = 0, view_h = 0;  ///< where the frame was drawn at exit (pixels)
+  int window_w = 0, window_h = 0;  ///< the window's drawing area at exit (pixels)
   bool hud_drawn = false;       ///< the HUD window was submitted to ImGui in the last frame
   std::string status = "ok";    ///< health of the frame shown last: "ok", "missing", "unreadable"
   std::string summary;          ///< one-paragraph statistics (switch latency, fps, cache hits)

@@ -14,6 +14,8 @@
 #include "core/error.hpp"
 #include "core/frame_stamp.hpp"
 #include "core/png.hpp"
+#include "camera/navigation.hpp"
+#include "camera/rig_spec.hpp"
 #include "store/database.hpp"
 #include "store/test_support.hpp"
 #include "ui/window_app.hpp"
@@ -134,6 +136,8 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   o.paused = true;
   o.virtual_time = true;
   o.script = script;
+  o.width = kW;  // a window of the frame's size shows it 1:1 at zoom 1
+  o.height = kH;
   o.max_frames = 40;  // 40 ticks of 1/30 s: the script ends at t = 1.0 s (tick 30)
   o.screenshot_on_exit = dir_->path / "window.png";
   o.output_dir = dir_->path;
@@ -234,6 +238,8 @@ TEST_F(WindowTest, MouseDragSnapsWheelZoomsAroundTheCursorRightDragPans) {
   o.vsync = false;
   o.paused = true;
   o.virtual_time = true;
+  o.width = kW;
+  o.height = kH;
   o.camera = 1;  // at longitude 90°, looking along -y with z up: screen right is -x
   o.max_frames = 30;
   o.before_frame = [&](int n) {
@@ -281,6 +287,9 @@ TEST_F(WindowTest, MissingStreamShowsThePlaceholderAndPlaybackGoesOn) {
   o.software_renderer = true;
   o.vsync = false;
   o.virtual_time = true;  // playing: 20 ticks of 1/30 s at 30 fps advance 19 frames (looping over 6)
+  o.width = kW;
+  o.height = kH;
+  o.speed = 1;  // not the automatic slow-down of a short run
   o.camera = 3;
   o.max_frames = 20;
   o.screenshot_on_exit = dir_->path / "missing.png";
@@ -323,6 +332,124 @@ TEST_F(WindowTest, MissingDisplayIsAClearError) {
 TEST_F(WindowTest, NotADatabaseIsReportedBeforeAnyWindowOpens) {
   WindowOptions o;
   EXPECT_THROW(run_window(dir_->path / "no-such-db", o), FileError);
+}
+
+// ---- First sight at 1280x1024 (registered as ui.window_demo under a 1280x1024 Xvfb screen) ----------
+
+// A demo-like database: the demo's frame size (528x512) and orientation (z is depth, the sky is −z),
+// a 16-camera Yin-Yang rig around the demo's domain laid out like the demo's, 3 frames. Frames are grey
+// with their stamp, so the picture is told apart from the window's clear colour and from the HUD.
+constexpr int kDemoW = 528, kDemoH = 512;
+void write_demo_like_database(const std::filesystem::path& dir) {
+  store::Manifest m;
+  m.title = "demo-like";
+  m.provenance.program = "ui_window_test";
+  m.image.width = kDemoW;
+  m.image.height = kDemoH;
+  m.video.gop = 1;
+  m.video.crf = 23;
+  m.domain.up_axis = "z_down";
+  m.playback_fps = 10;
+  camera::RigSpec spec = camera::RigSpec::parse("yinyang:2x4");
+  spec.up_axis = camera::UpAxis::z_down;
+  const camera::Rig rig = camera::make_rig(spec, camera::Domain{{0, 0, 0}, {25600, 51200, 16000}});
+  const camera::NavigationGraph g = camera::build_navigation_graph(rig);
+  for (int c = 0; c < rig.size(); ++c) {
+    const auto& rc = rig.cameras[std::size_t(c)];
+    store::CameraEntry e;
+    e.id = c;
+    e.position = rc.position;
+    e.look_at = rc.look_at;
+    e.up = rc.up;
+    e.fov_y_deg = rc.fov_y_degrees;
+    e.labels.patch = rc.patch;
+    e.labels.lat_deg = rc.latitude_deg;
+    e.labels.lon_deg = rc.longitude_deg;
+    m.cameras.push_back(e);
+    const auto& n = g.neighbours[std::size_t(c)];
+    m.graph.neighbours.push_back({n.left, n.right, n.up, n.down, n.in, n.out});
+  }
+  store::TaskEntry t;
+  t.name = "p+s";
+  t.method = "synthetic";
+  m.tasks.push_back(t);
+  auto writer = store::DatabaseWriter::create(dir, m, true);
+  Image img(kDemoW, kDemoH, 3);
+  for (int f = 0; f < 3; ++f) {
+    for (int c = 0; c < rig.size(); ++c) {
+      std::fill(img.pixels.begin(), img.pixels.end(), kGrey);
+      draw_frame_stamp(img, {std::uint32_t(c), 0, std::uint32_t(f)});
+      writer.append(c, 0, img);
+    }
+    writer.set_time(f, f);
+    writer.checkpoint();
+  }
+  writer.finalize();
+}
+
+bool demo_screen() {
+  SDL_Rect usable{};
+  if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) return false;
+  const bool ok = SDL_GetDisplayUsableBounds(0, &usable) == 0 && usable.w >= 1280 && usable.h >= 1024;
+  SDL_QuitSubSystem(SDL_INIT_VIDEO);
+  return ok;
+}
+
+TEST_F(WindowTest, DemoAt1280x1024FillsTheWindowTheHudStaysSmallAndUpGoesToTheSky) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  if (!demo_screen()) GTEST_SKIP() << "needs a 1280x1024 screen (ctest runs this as ui.window_demo)";
+  const auto db = dir_->path / "demo-like";
+  write_demo_like_database(db);
+  const store::Manifest man = store::Database::open(db).manifest();
+
+  // 1. Default window size, HUD shown, then hidden with I: the difference is what the HUD covers.
+  auto run = [&](const std::string& name, const std::string& script_text) {
+    const auto script = dir_->path / (name + ".txt");
+    std::ofstream(script) << script_text;
+    WindowOptions o;
+    o.software_renderer = true;
+    o.vsync = false;
+    o.paused = true;
+    o.virtual_time = true;
+    o.script = script;
+    o.max_frames = 8;
+    o.screenshot_on_exit = dir_->path / (name + ".png");
+    const WindowResult r = run_window(db, o);
+    keep_for_humans(o.screenshot_on_exit, "ui_window_demo_" + name + ".png");
+    return std::pair{r, read_png(o.screenshot_on_exit.string())};
+  };
+  const auto [with_hud, shot_hud] = run("hud", "t=0 camera=0\n");
+  const auto [no_hud, shot_plain] = run("plain", "t=0 key=I\n");
+  // The window opens filling most of the 1280x1024 screen (not at the 528x512 frame size).
+  EXPECT_GE(with_hud.window_h, 800) << with_hud.window_w << "x" << with_hud.window_h;
+  EXPECT_LE(with_hud.window_h, 1024);
+  const double window_area = double(with_hud.window_w) * with_hud.window_h;
+  // The picture (grey frame, aspect kept) occupies most of the window: count its pixels.
+  int picture = 0, hud = 0;
+  ASSERT_EQ(shot_hud.width, shot_plain.width);
+  ASSERT_EQ(shot_hud.height, shot_plain.height);
+  for (int y = 0; y < shot_plain.height; ++y)
+    for (int x = 0; x < shot_plain.width; ++x) {
+      const std::uint8_t* p = shot_plain.at(x, y);
+      const std::uint8_t* q = shot_hud.at(x, y);
+      if (std::abs(p[0] - kGrey) <= 24 && std::abs(p[1] - kGrey) <= 24 && std::abs(p[2] - kGrey) <= 24) ++picture;
+      if (std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) > 24) ++hud;
+    }
+  std::printf("window %dx%d: picture %.1f %% of it, HUD %.1f %%\n", with_hud.window_w, with_hud.window_h,
+              100 * picture / window_area, 100 * hud / window_area);
+  EXPECT_GT(picture, 0.7 * window_area) << "the picture should fill most of the window";
+  EXPECT_LE(hud, 0.15 * window_area) << "the HUD must not cover more than 15 % of the window";
+  EXPECT_GT(hud, 0.01 * window_area) << "the HUD was not drawn";
+
+  // 2. Up: the latitude shown rises and the camera moves to the sky side of the rig.
+  const auto [up, shot_up] = run("up", "t=0 key=Up\n");
+  const auto& from = man.cameras[0];
+  const auto& to = man.cameras[std::size_t(up.camera)];
+  EXPECT_NE(up.camera, 0);
+  EXPECT_GT(to.labels.lat_deg, from.labels.lat_deg) << "Up from camera 0 went to camera " << up.camera;
+  const Vec3 sky = man.domain.sky();
+  EXPECT_GT(dot(normalize(to.position - to.look_at), sky), dot(normalize(from.position - from.look_at), sky));
+  EXPECT_GT(from.labels.lat_deg, 0) << "the first camera looks from above the surface";
 }
 
 }  // namespace

@@ -56,4 +56,17 @@ expect_error "not a Panoptes database" "$panoptes" play notdb --headless
 printf 't=0.1 key=Nope\n' > bad.txt
 expect_error "bad.txt:1: unknown key \"Nope\"" "$panoptes" play db --headless --script bad.txt
 expect_error "camera 9 out of range" "$panoptes" play db --headless --camera 9
+# A script naming a camera or task that does not exist is an error, not silently ignored.
+printf 't=0 key=Right\nt=0.1 camera=999\n' > cam.txt
+expect_error "script line 2: camera 999 does not exist; the database has cameras 0..5" "$panoptes" play db --headless --script cam.txt
+printf 't=0 task=nosuch\n' > task.txt
+expect_error "no task named \"nosuch\"" "$panoptes" play db --headless --script task.txt
+# A command-line mistake is one line in the house style and status 1, like every other error.
+set +e
+"$panoptes" play > err.txt 2>&1
+status=$?
+set -e
+[ "$status" = 1 ] || { cat err.txt; echo "panoptes play without arguments exited $status; expected 1"; exit 1; }
+[ "$(wc -l < err.txt)" = 1 ] || { cat err.txt; echo "expected one line"; exit 1; }
+grep -q "^panoptes: error: .*db is required.*panoptes play --help" err.txt || { cat err.txt; echo "not the house style"; exit 1; }
 echo "play_headless: ok"

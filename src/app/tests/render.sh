@@ -27,7 +27,10 @@ fail() { echo "render.sh: $*" >&2; exit 1; }
 "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --task volume:hot --task iso:3 --task iso:2 \
   --task slice:z:0.5 --size 48x40 --out "$tmp/db" > "$tmp/out.txt" 2> "$tmp/err.txt"
 grep -q "4 cameras x 4 tasks = 16 streams, 1 frames of 48x40" "$tmp/out.txt" || fail "unexpected summary: $(cat "$tmp/out.txt")"
-[ ! -s "$tmp/err.txt" ] || fail "progress output although stderr is not a terminal: $(cat "$tmp/err.txt")"
+# Progress while it works, also when stderr is a log file (one line per tenth), none with -q.
+grep -q "render: 16/16 images (100%)" "$tmp/err.txt" || fail "no progress lines on a non-terminal: $(cat "$tmp/err.txt")"
+"$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:2 --size 32x24 -q --out "$tmp/quiet" > /dev/null 2> "$tmp/err.txt"
+[ ! -s "$tmp/err.txt" ] || fail "progress output despite -q: $(cat "$tmp/err.txt")"
 [ -f "$tmp/db/panoptes.json" ] || fail "no manifest"
 [ "$(find "$tmp/db" -name '*.mp4' | wc -l)" = 16 ] || fail "expected 16 movies"
 grep -q '"isovalue"' "$tmp/db/panoptes.json" || fail "no isovalue axis in the manifest"
@@ -61,6 +64,7 @@ for t in range(3):
 npy(f"{tmp}/flat.npy", (ny, nx), [0.0] * (nx * ny))
 npy(f"{tmp}/ints.npy", (nz, ny, nx), [0] * (nx * ny * nz), "<i4", "<i")
 npy(f"{tmp}/other.npy", (nz, ny, nx + 1), [0.0] * ((nx + 1) * ny * nz))
+npy(f"{tmp}/nan.npy", (nz, ny, nx), [float("nan")] * (nx * ny * nz))
 with open(f"{tmp}/bin.vtk", "wb") as f:
     f.write(b"# vtk DataFile Version 3.0\nbinary\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 12 10 8\n"
             b"ORIGIN 0 0 0\nSPACING 0.5 0.5 0.5\nPOINT_DATA 960\nSCALARS v double\nLOOKUP_TABLE default\n")
@@ -79,7 +83,33 @@ EOF
   expect_error "3-D volume" "$tmp/flat.npy" --rig fibonacci:2 --out "$tmp/e1"
   expect_error "float32" "$tmp/ints.npy" --rig fibonacci:2 --out "$tmp/e2"
   expect_error "expected 12x10x8" "$tmp/series_0.npy" "$tmp/other.npy" --rig fibonacci:2 --out "$tmp/e3"
+
+  # An all-NaN volume is rendered (empty frames) but not without a word.
+  "$panoptes" render "$tmp/nan.npy" --rig fibonacci:2 --size 32x24 -q --out "$tmp/nan" > /dev/null 2> "$tmp/err.txt"
+  grep -q "panoptes: warning: .*nan.npy: none of its 960 values is a finite number" "$tmp/err.txt" ||
+    fail "no warning for an all-NaN volume: $(cat "$tmp/err.txt")"
 fi
+
+# Provenance: the recorded command line holds every option that changes pixels, and running it again
+# reproduces the same frames.
+"$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:3 --task volume:hot:0:4 --size 40x32 --sample-distance 0.7 \
+  --no-outline --percentile 0.99 --spacing 1,1,2 --origin 0,0,-3 --background 0.2,0,0.1 --crf 30 --up-axis z_down \
+  -q --out "$tmp/prov" > /dev/null
+line=$("$panoptes" info --json "$tmp/prov" | sed -n 's/.*"command_line": *"\(.*\)",*$/\1/p')
+for opt in --sample-distance --no-outline --percentile --spacing --origin --background --crf --up-axis --size --task --rig; do
+  case "$line" in *"$opt"*) ;; *) fail "recorded command line lacks $opt: $line" ;; esac
+done
+again=${line/--out $tmp\/prov/--out $tmp/prov2}
+[ "$again" != "$line" ] || fail "cannot find --out in the recorded line: $line"
+eval "\"\$panoptes\"${again#panoptes} -q" > /dev/null || fail "the recorded line does not run: $again"
+printf 't=0 camera=1\nt=0.04 camera=2\n' > "$tmp/cams.txt"
+"$panoptes" play "$tmp/prov" --headless --script "$tmp/cams.txt" --paused --frames-out "$tmp/f1" > /dev/null
+"$panoptes" play "$tmp/prov2" --headless --script "$tmp/cams.txt" --paused --frames-out "$tmp/f2" > /dev/null
+for f in "$tmp"/f1/*.png; do cmp -s "$f" "$tmp/f2/$(basename "$f")" || fail "frame $(basename "$f") differs after re-running the recorded line"; done
+# ... and the options did matter: a default render of the same volume looks different.
+"$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:3 --task volume:hot:0:4 --size 40x32 -q --out "$tmp/plain" > /dev/null
+"$panoptes" play "$tmp/plain" --headless --script "$tmp/cams.txt" --paused --frames-out "$tmp/f3" > /dev/null
+! cmp -s "$tmp/f1/frame_000000.png" "$tmp/f3/frame_000000.png" || fail "non-default options changed nothing"
 
 echo "not a volume" > "$tmp/vol.txt"
 if "$panoptes" render "$tmp/vol.txt" --out "$tmp/e4" 2> "$tmp/err.txt"; then fail "accepted a .txt file"; fi

@@ -42,7 +42,7 @@ snapshot_fields = ["vz", "phi_p", "sxz", "phi_s"]
 snapshot_every = 20
 TOML
 "$panoptes" seismic --help | grep "receiver_line" >/dev/null
-"$panoptes" seismic "$dir/tiny.toml" -o "$dir/out" -q
+"$panoptes" seismic "$dir/tiny.toml" --out "$dir/out" -q
 for f in top line_000 line_001; do
   test -s "$dir/out/$f.csv" || { echo "missing $f.csv"; exit 1; }
 done
@@ -71,7 +71,7 @@ grep -q "2 cameras x 1 tasks = 2 streams, 2 frames of 32x24" "$dir/render.txt" \
 # Errors: unknown key, wrong type, CFL violation, receiver outside; each one line, exit 1.
 expect_error() {
   local pattern=$1
-  if "$panoptes" seismic "$dir/bad.toml" -o "$dir/bad" -q 2> "$dir/err"; then echo "accepted: $pattern"; exit 1; fi
+  if "$panoptes" seismic "$dir/bad.toml" --out "$dir/bad" -q 2> "$dir/err"; then echo "accepted: $pattern"; exit 1; fi
   grep -q "$pattern" "$dir/err" || { echo "expected '$pattern', got:"; cat "$dir/err"; exit 1; }
   test ! -e "$dir/bad/top.csv"
 }
@@ -86,7 +86,7 @@ if "$panoptes" seismic "$dir/missing.toml" 2>/dev/null; then echo "missing confi
 # Under MPI (when available), 2 ranks give the same seismograms.
 if command -v mpiexec >/dev/null && "$panoptes" version >/dev/null; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
-  if mpiexec --oversubscribe -np 2 "$panoptes" seismic "$dir/tiny.toml" -o "$dir/out2" -q; then
+  if mpiexec --oversubscribe -np 2 "$panoptes" seismic "$dir/tiny.toml" --out "$dir/out2" -q; then
     cmp "$dir/out/top.csv" "$dir/out2/top.csv" || { echo "2 ranks differ from 1"; exit 1; }
     for f in $snaps; do
       cmp "$dir/out/snapshots/$f.npy" "$dir/out2/snapshots/$f.npy" || { echo "2-rank snapshot $f differs"; exit 1; }
