@@ -831,6 +831,7 @@ SessionStats Session::stats() const {
   s.frames_encoded = m.frames_encoded;
   s.owned_cameras = int(m.owned.size());
   for (const auto& b : m.buffers) s.field_buffer_bytes += std::int64_t(b.capacity() * sizeof(float));
+  for (const auto& p : m.prepared) s.field_buffer_bytes += std::int64_t(p.corners.bytes());
   auto add = [&](const render::PartialImage& p) {
     s.partial_buffer_bytes += std::int64_t((p.rgba.capacity() + p.depth.capacity()) * sizeof(float));
   };

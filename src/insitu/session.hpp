@@ -75,7 +75,7 @@ struct SessionStats {
   int snapshots = 0;              ///< snapshots processed
   std::int64_t frames_encoded = 0;  ///< (camera, task) frames appended on this rank
   int owned_cameras = 0;          ///< cameras (hence encoders ×tasks) on this rank
-  std::int64_t field_buffer_bytes = 0;   ///< float32 copies of the brick's fields
+  std::int64_t field_buffer_bytes = 0;   ///< float32 copies of the brick's fields and their 16-bit corner copies
   std::int64_t partial_buffer_bytes = 0; ///< partial images and message buffers (capacity)
   std::int64_t peak_rss_bytes = 0;       ///< process peak resident set (getrusage), includes encoders
   Timings time;
