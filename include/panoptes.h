@@ -54,7 +54,9 @@ int panoptes_set_field(panoptes_session* s, const char* name, const void* data, 
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken);
 /** Renders and stores a snapshot now, whatever the schedule. */
 int panoptes_snapshot(panoptes_session* s, double time);
-/** Closes all movies and marks the database complete. */
+/** Closes all movies and marks the database complete (collective). The first call prints, on rank 0 to
+ * stderr, the in-situ overhead: visualization time as a multiple of the simulation time (the wall time
+ * outside the library's calls since panoptes_create), per rank. */
 int panoptes_finalize(panoptes_session* s);
 /** Frees the session (without finalize the database is left interrupted, its snapshots playable). */
 void panoptes_destroy(panoptes_session* s);

@@ -222,6 +222,7 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   }
   session.finalize();
   const insitu::SessionStats st = session.reduced_stats();
+  const std::vector<insitu::RankOverhead> overhead = session.overhead();
 #ifdef PANOPTES_HAVE_MPI
   MPI_Allreduce(MPI_IN_PLACE, &sim, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
 #endif
@@ -241,6 +242,7 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
                 "checkpoint %.1f s (slowest rank per phase); %.1f camera-frames/s; peak memory per rank %s\n",
                 el, solver.ranks(), sim, st.time.render + st.time.copy, st.time.composite, st.time.encode,
                 st.time.checkpoint, el > 0 ? frames / el : 0.0, human_bytes(double(st.peak_rss_bytes)).c_str());
+    std::fputs(insitu::overhead_report(overhead).c_str(), stdout);
     std::printf("open it with: panoptes play %s\n", cfg.output_dir.c_str());
   }
 }

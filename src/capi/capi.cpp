@@ -1,6 +1,7 @@
 // The C API over insitu::Session: errors become return codes + a thread-local message.
 #include "panoptes.h"
 
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <optional>
@@ -18,6 +19,7 @@ struct panoptes_session {
   std::optional<insitu::LocalBlock> block;
   std::map<std::string, insitu::FieldInput> fields;
   std::unique_ptr<insitu::Session> session;
+  bool finalized = false;  // the overhead report is printed by the first panoptes_finalize only
 };
 
 namespace {
@@ -173,7 +175,17 @@ int panoptes_snapshot(panoptes_session* s, double time) {
 }
 
 int panoptes_finalize(panoptes_session* s) {
-  return guarded([&] { session_of(s).finalize(); });
+  return guarded([&] {
+    insitu::Session& ss = session_of(s);
+    const bool first = !s->finalized;
+    ss.finalize();
+    s->finalized = true;
+    // The in-situ overhead, once, on rank 0 (stderr: the simulation's own output stays on stdout).
+    if (first) {
+      const std::string report = insitu::overhead_report(ss.overhead());
+      if (ss.rank() == 0) std::fprintf(stderr, "panoptes: %s", report.c_str());
+    }
+  });
 }
 
 void panoptes_destroy(panoptes_session* s) {

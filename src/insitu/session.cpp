@@ -157,9 +157,18 @@ struct Session::Impl {
   std::vector<char> recv_buf;
   std::vector<std::vector<render::PartialImage>> received;  // [rank][task]
   std::vector<render::PartialImage> composited;
-  std::vector<Image> images;
+  // Finished frames waiting to be encoded: batch[i][task] of camera batch_camera[i].
+  static constexpr int kEncodeBatch = 4;
+  std::vector<std::vector<Image>> batch;
+  std::vector<int> batch_camera;
+  int batch_n = 0;
   std::int64_t frames_encoded = 0;
   Timings time;
+  // The in-situ overhead: wall time inside the session's calls on this rank (construction,
+  // snapshots, finalize) against the time since construction began; the rest is the simulation's.
+  Clock::time_point created = Clock::now();
+  std::optional<Clock::time_point> finished;  // set by finalize: the run's end for the report
+  double inside = 0;
 
   int owner(int camera) const { return camera % size; }
   const BlockInfo& me() const { return blocks[std::size_t(rank)]; }
@@ -177,6 +186,7 @@ struct Session::Impl {
   void load_fields(const std::vector<FieldInput>& fields);
   double global_percentile(int field);
   void render_snapshot(int frame);
+  void encode_batch();
   void checkpoint(double time);
 };
 
@@ -272,7 +282,8 @@ void Session::Impl::init() {
   send_buf.resize(std::size_t(slots));
   received.assign(std::size_t(size), std::vector<render::PartialImage>(tasks.size()));
   composited.resize(tasks.size());
-  images.resize(tasks.size());
+  batch.assign(kEncodeBatch, std::vector<Image>(tasks.size()));
+  batch_camera.assign(kEncodeBatch, 0);
 }
 
 // Refuses, before the rig, the writers and the buffers exist, a session this rank cannot hold.
@@ -680,7 +691,9 @@ void Session::Impl::render_snapshot(int frame) {
 #endif
       }
       const camera::Camera& cam = cameras[std::size_t(mine)];
-#pragma omp parallel for schedule(dynamic)
+      // One task at a time: composite() and finish_image() are parallel over pixels, which keeps
+      // both cores busy for any K (a loop over K = 3 tasks on 2 threads left one idle a third of the time).
+      std::vector<Image>& images = batch[std::size_t(batch_n)];
       for (int t = 0; t < K; ++t) {
         render::PartialImage empty;
         if (parts[std::size_t(t)].empty()) {
@@ -696,12 +709,8 @@ void Session::Impl::render_snapshot(int frame) {
       time.composite += since(t0);
       if (observer)
         for (int t = 0; t < K; ++t) observer(mine, t, frame, images[std::size_t(t)]);
-      t0 = Clock::now();
-      store::DatabaseWriter& w = *writer;
-#pragma omp parallel for schedule(dynamic)
-      for (int t = 0; t < K; ++t) w.append(mine, t, images[std::size_t(t)]);
-      frames_encoded += K;
-      time.encode += since(t0);
+      batch_camera[std::size_t(batch_n)] = mine;
+      if (++batch_n == int(batch.size())) encode_batch();
     }
 #ifdef PANOPTES_HAVE_MPI
     if (!sends.empty()) {
@@ -711,6 +720,22 @@ void Session::Impl::render_snapshot(int frame) {
     }
 #endif
   }
+  encode_batch();
+}
+
+void Session::Impl::encode_batch() {
+  if (batch_n == 0) return;
+  const auto t0 = Clock::now();
+  const int K = int(tasks.size());
+  store::DatabaseWriter& w = *writer;
+  // Frames of several cameras in one parallel loop: appends to different streams may run
+  // concurrently, and batch_n × K frames share the threads evenly where K alone would not.
+#pragma omp parallel for schedule(dynamic)
+  for (int f = 0; f < batch_n * K; ++f)
+    w.append(batch_camera[std::size_t(f / K)], f % K, batch[std::size_t(f / K)][std::size_t(f % K)]);
+  frames_encoded += std::int64_t(batch_n) * K;
+  batch_n = 0;
+  time.encode += since(t0);
 }
 
 void Session::Impl::checkpoint(double t) {
@@ -743,6 +768,7 @@ Session::Session(const SessionConfig& config, const render::GridGeometry& grid, 
   }
 #endif
   impl_->init();
+  impl_->inside += since(impl_->created);
 }
 
 #ifdef PANOPTES_HAVE_MPI
@@ -755,6 +781,7 @@ Session::Session(const SessionConfig& config, const render::GridGeometry& grid, 
   MPI_Comm_rank(impl_->comm, &impl_->rank);
   MPI_Comm_size(impl_->comm, &impl_->size);
   impl_->init();
+  impl_->inside += since(impl_->created);
 }
 #endif
 
@@ -778,6 +805,12 @@ bool Session::due(std::int64_t step, double time) const {
 
 void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   Impl& m = *impl_;
+  const auto entered = Clock::now();
+  struct Inside {  // counts the call's wall time, also when it throws
+    Impl& m;
+    Clock::time_point t;
+    ~Inside() { m.inside += since(t); }
+  } inside{m, entered};
   if (m.finalized) throw Error("snapshot: the session is finalized");
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
@@ -825,6 +858,7 @@ void Session::finalize() {
   Impl& m = *impl_;
   if (m.finalized) return;
   m.finalized = true;
+  const auto entered = Clock::now();
   int frames = INT_MAX;
   if (m.writer && !m.owned.empty()) {
     m.writer->flush();
@@ -837,6 +871,8 @@ void Session::finalize() {
   m.barrier();
   if (m.rank == 0) m.writer->finalize(frames == INT_MAX ? m.snapshots : frames);
   m.barrier();
+  m.inside += since(entered);
+  m.finished = Clock::now();
 }
 
 void Session::set_frame_observer(FrameObserver observer) { impl_->observer = std::move(observer); }
@@ -855,6 +891,7 @@ SessionStats Session::stats() const {
   s.frames_encoded = m.frames_encoded;
   s.owned_cameras = int(m.owned.size());
   for (const auto& b : m.buffers) s.field_buffer_bytes += std::int64_t(b.capacity() * sizeof(float));
+  for (const auto& p : m.prepared) s.field_buffer_bytes += std::int64_t(p.corners.bytes());
   auto add = [&](const render::PartialImage& p) {
     s.partial_buffer_bytes += std::int64_t((p.rgba.capacity() + p.depth.capacity()) * sizeof(float));
   };
@@ -867,7 +904,64 @@ SessionStats Session::stats() const {
   s.partial_buffer_bytes += std::int64_t(m.recv_buf.capacity());
   s.peak_rss_bytes = peak_rss();
   s.time = m.time;
+  s.session_seconds = m.inside;
+  s.elapsed_seconds = std::chrono::duration<double>(m.finished.value_or(Clock::now()) - m.created).count();
   return s;
+}
+
+std::vector<RankOverhead> Session::overhead() const {
+  const SessionStats mine = stats();
+  std::vector<double> all{mine.session_seconds, mine.elapsed_seconds};
+#ifdef PANOPTES_HAVE_MPI
+  const Impl& m = *impl_;
+  if (m.size > 1) {
+    all.resize(2 * std::size_t(m.size));
+    const double two[2] = {mine.session_seconds, mine.elapsed_seconds};
+    MPI_Allgather(two, 2, MPI_DOUBLE, all.data(), 2, MPI_DOUBLE, m.comm);
+  }
+#endif
+  std::vector<RankOverhead> out;
+  for (std::size_t r = 0; r + 1 < all.size(); r += 2)
+    out.push_back({int(r / 2), all[r], std::max(0.0, all[r + 1] - all[r])});
+  return out;
+}
+
+std::string overhead_report(const std::vector<RankOverhead>& ranks) {
+  if (ranks.empty()) return "";
+  std::vector<double> x;
+  for (const RankOverhead& r : ranks) x.push_back(r.multiple());
+  std::vector<double> sorted = x;
+  std::sort(sorted.begin(), sorted.end());
+  char buf[512];
+  auto times = [](double v) {
+    char b[64];
+    if (!std::isfinite(v)) return std::string("n/a (no simulation time)");
+    std::snprintf(b, sizeof b, "%.2fx", v);
+    return std::string(b);
+  };
+  std::string out;
+  if (ranks.size() == 1) {
+    std::snprintf(buf, sizeof buf,
+                  "in-situ overhead: visualization took %s the simulation time (visualization %.1f s, simulation "
+                  "%.1f s)\n",
+                  times(x[0]).c_str(), ranks[0].visualization_s, ranks[0].simulation_s);
+    return buf;
+  }
+  const std::size_t n = sorted.size();
+  const double median = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+  std::snprintf(buf, sizeof buf,
+                "in-situ overhead: visualization time / simulation time per rank: min %s, median %s, max %s over %zu "
+                "ranks\n",
+                times(sorted.front()).c_str(), times(median).c_str(), times(sorted.back()).c_str(), n);
+  out = buf;
+  // Every rank when they fit on a screen; otherwise the extremes are in the line above.
+  if (ranks.size() <= 16)
+    for (const RankOverhead& r : ranks) {
+      std::snprintf(buf, sizeof buf, "  rank %3d: visualization %8.1f s, simulation %8.1f s -> %s\n", r.rank,
+                    r.visualization_s, r.simulation_s, times(r.multiple()).c_str());
+      out += buf;
+    }
+  return out;
 }
 
 SessionStats Session::reduced_stats() const {

@@ -14,6 +14,7 @@
 // flight per rank whatever the number of cameras.
 #include <array>
 #include <cstdint>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -74,11 +75,27 @@ struct SessionStats {
   int snapshots = 0;              ///< snapshots processed
   std::int64_t frames_encoded = 0;  ///< (camera, task) frames appended on this rank
   int owned_cameras = 0;          ///< cameras (hence encoders ×tasks) on this rank
-  std::int64_t field_buffer_bytes = 0;   ///< float32 copies of the brick's fields
+  std::int64_t field_buffer_bytes = 0;   ///< float32 copies of the brick's fields and their 16-bit corner copies
   std::int64_t partial_buffer_bytes = 0; ///< partial images and message buffers (capacity)
   std::int64_t peak_rss_bytes = 0;       ///< process peak resident set (getrusage), includes encoders
   Timings time;
+  double session_seconds = 0;  ///< wall time inside the session's calls (construction, snapshots, finalize)
+  double elapsed_seconds = 0;  ///< wall time from construction to finalize (or to now)
 };
+
+/// One rank's in-situ overhead: wall time spent visualizing (inside the session's calls) and the rest
+/// of the run since the session was created (the simulation's time, as the session sees it).
+struct RankOverhead {
+  int rank = 0;
+  double visualization_s = 0;
+  double simulation_s = 0;
+  /// Visualization time as a multiple of simulation time (+inf without simulation time).
+  double multiple() const { return simulation_s > 0 ? visualization_s / simulation_s : INFINITY; }
+};
+
+/// The end-of-run lines printed by `panoptes run` and the C API: visualization time as a multiple of
+/// simulation time, one line for one rank; min / median / max and (up to 16 ranks) a row per rank.
+std::string overhead_report(const std::vector<RankOverhead>& ranks);
 
 /// A running in-situ visualization. Not copyable; all public calls except the accessors are
 /// collective over the communicator and must be made by every rank in the same order.
@@ -124,6 +141,8 @@ class Session {
   SessionStats stats() const;
   /// The element-wise maximum over ranks of the per-rank times, and sums of the counters (collective).
   SessionStats reduced_stats() const;
+  /// Every rank's in-situ overhead, in rank order (collective; call after finalize() for the whole run).
+  std::vector<RankOverhead> overhead() const;
 
  private:
   struct Impl;

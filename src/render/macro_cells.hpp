@@ -2,6 +2,7 @@
 // Min/max macro-cells of a field on a brick: the data structure behind empty-space skipping.
 #include <vector>
 
+#include "render/corner_field.hpp"
 #include "render/field_view.hpp"
 
 namespace panoptes::render {
@@ -30,16 +31,25 @@ class MacroCells {
   std::vector<float> min_, max_;
 };
 
-/// A field view together with its macro-cells: what the renderer takes. Build one per field per
-/// snapshot (the macro-cell pass reads the brick once) and reuse it for every camera.
+/// Whether PreparedField builds the march's 16-bit corner copy of the field (CornerField).
+enum class FieldCopy { corners16, none };
+
+/// A field view together with its macro-cells and (by default) its 16-bit corner copy: what the
+/// renderer takes. Build one per field per snapshot (the passes read the brick once) and reuse it
+/// for every camera. Volume tasks classify samples from the corner copy (images within PSNR ≥ 45 dB
+/// of the float field's, see docs/rendering.md); isosurfaces, slices and shading read the float field.
 struct PreparedField {
   FieldView view;
   MacroCells cells;
+  CornerField corners;
 
   PreparedField() = default;
-  /// Validates the view and builds its macro-cells.
-  explicit PreparedField(const FieldView& v, int macro_cell_size = MacroCells::kDefaultSize)
-      : view((v.validate(), v)), cells(v, macro_cell_size) {}
+  /// Validates the view and builds its macro-cells and, with FieldCopy::corners16, the corner copy.
+  explicit PreparedField(const FieldView& v, int macro_cell_size = MacroCells::kDefaultSize,
+                         FieldCopy copy = FieldCopy::corners16)
+      : view((v.validate(), v)), cells(v, macro_cell_size) {
+    if (copy == FieldCopy::corners16) corners = CornerField(v);
+  }
 };
 
 }  // namespace panoptes::render

@@ -71,6 +71,11 @@ struct FieldAcc {
   // Every element offset from the point points.lo fits a signed 32-bit lane and strides are
   // non-negative: the vectorized interpolation may gather with 32-bit indices.
   bool gather32 = false;
+  // The field's CornerField (nullptr without one): volume classification reads it; isosurfaces,
+  // slices and shading read the float field.
+  const std::uint16_t* corners = nullptr;
+  std::int32_t ccx = 0, ccxy = 0;  // corner records per row / per slice
+  float qoff = 0, qscale = 0;      // value = qoff + qscale·q
 };
 
 FieldAcc make_acc(const FieldView& v) {
@@ -136,6 +141,7 @@ enum class RtKind : std::uint8_t { volume1, volume2, iso, slice };
 struct TaskRt {
   RtKind kind;
   int s1 = 0, s2 = 0;  // slots in the march's field list
+  std::uint32_t slots = 0;  // bit mask of the slots the march reads for this task
   const LutEntry* lut1 = nullptr;
   const LutEntry* lut2 = nullptr;
   float lo1 = 0, sc1 = 1, last1 = 0, lo2 = 0, sc2 = 1, last2 = 0;
@@ -282,6 +288,77 @@ inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
   }
 }
 
+// The same block from the field's CornerField: per sample one 16-byte load of the cell's eight
+// quantized corners, weighted by the trilinear weights (1 − f or f per axis) and summed. Lanes
+// l ≥ n repeat sample k0 + n − 1, as in interp_block().
+inline void interp_block_corners(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, float* v) {
+#ifdef PANOPTES_RENDER_AVX2
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i kk =
+      _mm256_min_epi32(_mm256_add_epi32(_mm256_set1_epi32(int(k0)), lane), _mm256_set1_epi32(int(k0) + n - 1));
+  const __m256 fk = _mm256_cvtepi32_ps(kk);
+  const __m256 x = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sx), _mm256_set1_ps(P.bx));
+  const __m256 y = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sy), _mm256_set1_ps(P.by));
+  const __m256 z = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sz), _mm256_set1_ps(P.bz));
+  auto cell = [](__m256 p, int lo, int hi) {
+    return _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(p), _mm256_set1_epi32(lo)), _mm256_set1_epi32(hi));
+  };
+  const __m256i i = cell(x, f.ilo[0], f.ihi[0]), j = cell(y, f.ilo[1], f.ihi[1]), k = cell(z, f.ilo[2], f.ihi[2]);
+  alignas(32) float fx[kBlock], fy[kBlock], fz[kBlock];
+  alignas(32) std::int32_t id[kBlock];
+  _mm256_store_ps(fx, _mm256_sub_ps(x, _mm256_cvtepi32_ps(i)));
+  _mm256_store_ps(fy, _mm256_sub_ps(y, _mm256_cvtepi32_ps(j)));
+  _mm256_store_ps(fz, _mm256_sub_ps(z, _mm256_cvtepi32_ps(k)));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(id),
+                     _mm256_add_epi32(_mm256_sub_epi32(i, _mm256_set1_epi32(f.ilo[0])),
+                                      _mm256_add_epi32(_mm256_mullo_epi32(_mm256_sub_epi32(j, _mm256_set1_epi32(f.ilo[1])),
+                                                                          _mm256_set1_epi32(f.ccx)),
+                                                       _mm256_mullo_epi32(_mm256_sub_epi32(k, _mm256_set1_epi32(f.ilo[2])),
+                                                                          _mm256_set1_epi32(f.ccxy)))));
+  // Weight of corner c = wx·wy·wz with w = 1 − f or f: sign·f + offset per lane.
+  const __m256 sx = _mm256_setr_ps(-1, 1, -1, 1, -1, 1, -1, 1), ox = _mm256_setr_ps(1, 0, 1, 0, 1, 0, 1, 0);
+  const __m256 sy = _mm256_setr_ps(-1, -1, 1, 1, -1, -1, 1, 1), oy = _mm256_setr_ps(1, 1, 0, 0, 1, 1, 0, 0);
+  const __m256 sz = _mm256_setr_ps(-1, -1, -1, -1, 1, 1, 1, 1), oz = _mm256_setr_ps(1, 1, 1, 1, 0, 0, 0, 0);
+  __m256 p[kBlock];
+  for (int l = 0; l < kBlock; ++l) {
+    const __m128i q = _mm_loadu_si128(reinterpret_cast<const __m128i*>(f.corners + 8 * std::int64_t(id[l])));
+    const __m256 c = _mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q));
+    const __m256 wx = _mm256_fmadd_ps(_mm256_broadcast_ss(&fx[l]), sx, ox);
+    const __m256 wy = _mm256_fmadd_ps(_mm256_broadcast_ss(&fy[l]), sy, oy);
+    const __m256 wz = _mm256_fmadd_ps(_mm256_broadcast_ss(&fz[l]), sz, oz);
+    p[l] = _mm256_mul_ps(_mm256_mul_ps(c, wx), _mm256_mul_ps(wy, wz));
+  }
+  // Eight horizontal sums at once: lanes of a = samples 0–3 (corners 0–3 | 4–7), of b = samples 4–7.
+  const __m256 a = _mm256_hadd_ps(_mm256_hadd_ps(p[0], p[1]), _mm256_hadd_ps(p[2], p[3]));
+  const __m256 b = _mm256_hadd_ps(_mm256_hadd_ps(p[4], p[5]), _mm256_hadd_ps(p[6], p[7]));
+  const __m256 t = _mm256_add_ps(_mm256_permute2f128_ps(a, b, 0x20), _mm256_permute2f128_ps(a, b, 0x31));
+  _mm256_storeu_ps(v, _mm256_fmadd_ps(t, _mm256_set1_ps(f.qscale), _mm256_set1_ps(f.qoff)));
+#else
+  for (int l = 0; l < kBlock; ++l) {
+    const float fk = float(k0 + std::min(l, n - 1));
+    const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
+    const int i = std::min(std::max(int(x), f.ilo[0]), f.ihi[0]);
+    const int j = std::min(std::max(int(y), f.ilo[1]), f.ihi[1]);
+    const int k = std::min(std::max(int(z), f.ilo[2]), f.ihi[2]);
+    const float fx = x - float(i), fy = y - float(j), fz = z - float(k);
+    const std::uint16_t* c =
+        f.corners + 8 * (std::int64_t(i - f.ilo[0]) + std::int64_t(j - f.ilo[1]) * f.ccx + std::int64_t(k - f.ilo[2]) * f.ccxy);
+    const float c00 = c[0] + fx * (c[1] - c[0]), c10 = c[2] + fx * (c[3] - c[2]);
+    const float c01 = c[4] + fx * (c[5] - c[4]), c11 = c[6] + fx * (c[7] - c[6]);
+    const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+    v[l] = f.qoff + f.qscale * (c0 + fz * (c1 - c0));
+  }
+#endif
+}
+
+// Volume classification's values: from the corner copy when the field has one.
+inline void volume_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, bool safe, float* v) {
+  if (f.corners)
+    interp_block_corners(f, P, k0, n, v);
+  else
+    interp_block(f, P, k0, n, safe, v);
+}
+
 // LUT bins of a block of values: lut_bin() lane by lane (same operations, so the same bins).
 inline void lut_bin_block(const float* v, float lo, float sc, float last, bool absv, int* bin) {
 #ifdef PANOPTES_RENDER_AVX2
@@ -296,12 +373,60 @@ inline void lut_bin_block(const float* v, float lo, float sc, float last, bool a
 #endif
 }
 
+// Composites lanes 0 … n−1 of a block (sample k0 + l, LUT bins `bin`) of one single-field volume
+// task into the accumulator (colour c0..c2, transmittance tr). Returns the lane where the ray became
+// opaque, or −1. Shared by the fast path and the general path, so both give the same bits.
+inline int composite_volume1(const LutEntry* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
+                             float partial, float tr_stop, float& c0, float& c1, float& c2, float& tr) {
+  for (int l = 0; l < n; ++l) {
+    const LutEntry& e = lut[bin[l]];
+    float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
+    if (k0 + l == k_partial) [[unlikely]] {
+      const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
+      const float sf = al > 0 ? an / al : 0.0f;
+      pr *= sf, pg *= sf, pb *= sf, al = an;
+    }
+    c0 += tr * pr;
+    c1 += tr * pg;
+    c2 += tr * pb;
+    tr *= 1.0f - al;
+    if (tr <= tr_stop) [[unlikely]]
+      return l;
+  }
+  return -1;
+}
+
+// The same for a two-field volume task (extinctions add, colours mix by extinction).
+inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const int* bin1, const int* bin2, int n,
+                             std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop, float* a) {
+  float c0 = a[0], c1 = a[1], c2 = a[2], tr = a[3];
+  int stop = -1;
+  for (int l = 0; l < n; ++l) {
+    const LutEntry& e1 = lut1[bin1[l]];
+    const LutEntry& e2 = lut2[bin2[l]];
+    const float tau = e1.tau + e2.tau;
+    if (tau <= 0) continue;
+    float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
+    if (k0 + l == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
+    const float s = tr * al / tau;
+    c0 += s * (e1.tau * e1.r + e2.tau * e2.r);
+    c1 += s * (e1.tau * e1.g + e2.tau * e2.g);
+    c2 += s * (e1.tau * e1.b + e2.tau * e2.b);
+    tr = tr * (1.0f - al);
+    if (tr <= tr_stop) [[unlikely]] {
+      stop = l;
+      break;
+    }
+  }
+  a[0] = c0, a[1] = c1, a[2] = c2, a[3] = tr;
+  return stop;
+}
+
 // The single-volume-task loop over samples kb … kend with field, LUT and accumulator in registers.
 // Returns one past the last sample marched (< kend + 1 when the ray became opaque).
 std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::int64_t kb, std::int64_t kend,
                            const RayPos& P, bool safe, std::int64_t k_partial, float partial, float tr_stop,
                            bool& opaque) {
-  const LutEntry* lut = T.lut1;
   // Transmittance form: the loop-carried chain is one multiply (T ← T·(1 − α)) instead of
   // α ← α + (1 − α)·α_s, which shortens the per-sample latency.
   float a0 = a[0], a1 = a[1], a2 = a[2], tr = a[3];
@@ -309,25 +434,13 @@ std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::in
   alignas(32) int bin[kBlock];
   for (std::int64_t k0 = kb; k0 <= kend; k0 += kBlock) {
     const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
-    interp_block(f, P, k0, n, safe, v);
+    volume_block(f, P, k0, n, safe, v);
     lut_bin_block(v, T.lo1, T.sc1, T.last1, T.abs1, bin);
-    for (int l = 0; l < n; ++l) {
-      const LutEntry& e = lut[bin[l]];
-      float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
-      if (k0 + l == k_partial) [[unlikely]] {
-        const float an = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
-        const float sf = al > 0 ? an / al : 0.0f;
-        pr *= sf, pg *= sf, pb *= sf, al = an;
-      }
-      a0 += tr * pr;
-      a1 += tr * pg;
-      a2 += tr * pb;
-      tr *= 1.0f - al;
-      if (tr <= tr_stop) [[unlikely]] {
-        opaque = true;
-        a[0] = a0, a[1] = a1, a[2] = a2, a[3] = tr;
-        return k0 + l + 1;
-      }
+    const int stop = composite_volume1(T.lut1, bin, n, k0, k_partial, partial, tr_stop, a0, a1, a2, tr);
+    if (stop >= 0) [[unlikely]] {
+      opaque = true;
+      a[0] = a0, a[1] = a1, a[2] = a2, a[3] = tr;
+      return k0 + stop + 1;
     }
   }
   a[0] = a0, a[1] = a1, a[2] = a2, a[3] = tr;
@@ -374,10 +487,12 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     }
   }
 
-  const int nslots = int(S.acc.size());
   std::uint64_t live = S.march_mask;
-  float prev[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  bool have_prev = false;
+  // vb[s][0] holds slot s's value at the sample before the current block, vb[s][1 + l] the block's
+  // values; prev_valid: slots whose vb[s][0] is that previous sample (isosurface crossings need it).
+  alignas(32) float vb[8][2 * kBlock];
+  alignas(32) float vq[8][kBlock];
+  std::uint32_t prev_valid = 0, vq_from_vb = 0;
   const RayPos P{float(O[0] + t0 * D[0]), float(O[1] + t0 * D[1]), float(O[2] + t0 * D[2]),
                  float(dt * D[0]),        float(dt * D[1]),        float(dt * D[2])};
   const float tr_stop = 1.0f - S.termination;
@@ -385,93 +500,87 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   auto single_volume = [&](std::uint64_t m) {
     return m && !(m & (m - 1)) && S.rt[std::size_t(std::countr_zero(m))].kind == RtKind::volume1;
   };
-  // Marches samples kb … kend, all in one macro-cell whose live tasks are `mask` (or in consecutive
-  // cells of one single volume task, see the walk below); `safe`: the cells lie inside the data with
-  // a one-cell margin, so interpolation needs no clamps.
+  // Marches samples kb … kend, in consecutive macro-cells whose live tasks are all `mask`; `safe`:
+  // the cells lie inside the data with a one-cell margin, so interpolation needs no clamps.
   auto run = [&](std::int64_t kb, std::int64_t kend, std::uint64_t mask, bool safe) {
-    if (!have_prev && (live & S.iso_mask) && kb > 0) {
-      // The sample before this run (maybe in the previous brick: within the ghost layers).
-      const float fk = float(kb - 1);
-      for (int s = 0; s < nslots; ++s)
-        prev[s] = interp_clamped(fa[s], P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
-      have_prev = true;
-    }
-    if (single_volume(mask)) {
-      // Fast path: one volume task in this macro-cell (or queued run of them).
-      const int i = std::countr_zero(mask);
-      const TaskRt& T = S.rt[std::size_t(i)];
-      bool opaque = false;
-      const std::int64_t kk =
-          march_volume1(fa[T.s1], T, acc[i], kb, kend, P, safe, k_partial, partial, tr_stop, opaque);
-      if (opaque) live &= ~(std::uint64_t(1) << i);
-      marched += std::uint64_t(kk - kb);
-      have_prev = false;  // prev values were not tracked (no isosurface task is live here)
-      return;
-    }
-    std::int64_t kk = kb;
-    alignas(32) float vb[8][kBlock];  // per march slot: the block's interpolated values
-    alignas(32) int bins[kMaxTasksPerMarch][2][kBlock];
-    bool done = false;
-    for (std::int64_t k0 = kb; k0 <= kend && !done; k0 += kBlock) {
+    for (std::int64_t k0 = kb; k0 <= kend; k0 += kBlock) {
+      const std::uint64_t lm = mask & live;
+      if (!lm) break;
+      if (single_volume(lm)) {
+        // Fast path: one volume task left (from the start, or the others terminated).
+        const int i = std::countr_zero(lm);
+        const TaskRt& T = S.rt[std::size_t(i)];
+        bool opaque = false;
+        const std::int64_t kk =
+            march_volume1(fa[T.s1], T, acc[i], k0, kend, P, safe, k_partial, partial, tr_stop, opaque);
+        if (opaque) live &= ~(std::uint64_t(1) << i);
+        marched += std::uint64_t(kk - k0);
+        prev_valid = 0;  // values were not kept (no isosurface task is live here)
+        return;
+      }
+      // General path, task-outer: the block's values of every field a live task reads, then each
+      // live task consumes the whole block with its own accumulator in registers. Per task these are
+      // the operations of a one-task march in the same sample order, so one march for K tasks gives
+      // every task's image bit for bit.
       const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
-      for (int s = 0; s < nslots; ++s) interp_block(fa[s], P, k0, n, safe, vb[s]);
-      // LUT bins of the block per volume task, vectorized (the same bins lut_bin() gives).
-      for (std::uint64_t m = mask & live; m; m &= m - 1) {
+      // Slots read by live volume tasks (values for classification: vq) and by live isosurface
+      // tasks (float values with the previous sample: vb).
+      std::uint32_t vmask = 0, smask = 0;
+      for (std::uint64_t m = lm; m; m &= m - 1) {
+        const TaskRt& T = S.rt[std::size_t(std::countr_zero(m))];
+        (T.kind == RtKind::iso ? smask : vmask) |= T.slots;
+      }
+      for (std::uint32_t m = vmask; m; m &= m - 1) {
+        const int s = std::countr_zero(m);
+        if (fa[s].corners)
+          interp_block_corners(fa[s], P, k0, n, vq[s]);
+        else if (smask >> s & 1)
+          vq_from_vb |= 1u << s;  // the same float values as the isosurface's: copied below
+        else
+          interp_block(fa[s], P, k0, n, safe, vq[s]);
+      }
+      for (std::uint32_t m = smask; m; m &= m - 1) {
+        const int s = std::countr_zero(m);
+        if (!(prev_valid >> s & 1) && k0 > 0) {
+          // The sample before this block (maybe in the previous brick: within the ghost layers).
+          const float fk = float(k0 - 1);
+          vb[s][0] = interp_clamped(fa[s], P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
+          prev_valid |= 1u << s;
+        }
+        interp_block(fa[s], P, k0, n, safe, &vb[s][1]);
+      }
+      for (std::uint32_t m = vq_from_vb; m; m &= m - 1) {
+        const int s = std::countr_zero(m);
+        std::copy_n(&vb[s][1], kBlock, vq[s]);
+      }
+      vq_from_vb = 0;
+      int used = 0;  // lanes consumed by the task that went furthest
+      for (std::uint64_t m = lm; m; m &= m - 1) {
         const int i = std::countr_zero(m);
         const TaskRt& T = S.rt[std::size_t(i)];
-        if (T.kind != RtKind::volume1 && T.kind != RtKind::volume2) continue;
-        lut_bin_block(vb[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bins[i][0]);
-        if (T.kind == RtKind::volume2) lut_bin_block(vb[T.s2], T.lo2, T.sc2, T.last2, T.abs2, bins[i][1]);
-      }
-      for (int l = 0; l < n; ++l) {
-        kk = k0 + l;
-        float v[8];
-        for (int s = 0; s < nslots; ++s) v[s] = vb[s][l];
-        std::uint64_t m = mask & live;
-        while (m) {
-          const int i = std::countr_zero(m);
-          m &= m - 1;
-          const TaskRt& T = S.rt[std::size_t(i)];
-          float* a = acc[i];
-          switch (T.kind) {
-            case RtKind::volume1: {
-              const LutEntry& e = T.lut1[bins[i][0][l]];
-              float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
-              if (kk == k_partial) [[unlikely]] {
-                const float a2 = al > 0 ? 1.0f - std::pow(1.0f - al, partial) : 0.0f;
-                const float s = al > 0 ? a2 / al : 0.0f;
-                pr *= s, pg *= s, pb *= s, al = a2;
-              }
-              const float tr = a[3];
-              a[0] += tr * pr;
-              a[1] += tr * pg;
-              a[2] += tr * pb;
-              a[3] = tr * (1.0f - al);
-              if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
-              break;
-            }
-            case RtKind::volume2: {
-              const LutEntry& e1 = T.lut1[bins[i][0][l]];
-              const LutEntry& e2 = T.lut2[bins[i][1][l]];
-              const float tau = e1.tau + e2.tau;
-              if (tau <= 0) break;
-              float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
-              if (kk == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
-              const float tr = a[3];
-              const float s = tr * al / tau;
-              a[0] += s * (e1.tau * e1.r + e2.tau * e2.r);
-              a[1] += s * (e1.tau * e1.g + e2.tau * e2.g);
-              a[2] += s * (e1.tau * e1.b + e2.tau * e2.b);
-              a[3] = tr * (1.0f - al);
-              if (a[3] <= tr_stop) live &= ~(std::uint64_t(1) << i);
-              break;
-            }
-            case RtKind::iso: {
-              const float d = v[T.s1] - T.iso;
-              if (!have_prev) break;
-              float dp = prev[T.s1] - T.iso;
-              if ((dp < 0) == (d < 0)) break;
-              // First crossing between samples kk−1 and kk: linear estimate, one regula-falsi step.
+        float* a = acc[i];
+        int stop = -1;
+        switch (T.kind) {
+          case RtKind::volume1: {
+            alignas(32) int bin[kBlock];
+            lut_bin_block(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin);
+            stop = composite_volume1(T.lut1, bin, n, k0, k_partial, partial, tr_stop, a[0], a[1], a[2], a[3]);
+            break;
+          }
+          case RtKind::volume2: {
+            alignas(32) int bin1[kBlock], bin2[kBlock];
+            lut_bin_block(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin1);
+            lut_bin_block(vq[T.s2], T.lo2, T.sc2, T.last2, T.abs2, bin2);
+            stop = composite_volume2(T.lut1, T.lut2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
+            break;
+          }
+          case RtKind::iso: {
+            const float* v = vb[T.s1];
+            for (int l = (prev_valid >> T.s1 & 1) ? 0 : 1; l < n; ++l) {
+              const float d = v[l + 1] - T.iso, dp = v[l] - T.iso;
+              if ((dp < 0) == (d < 0)) continue;
+              // First crossing between samples kk − 1 and kk: linear estimate, one regula-falsi step.
+              const std::int64_t kk = k0 + l;
               const FieldAcc& f = fa[T.s1];
               double ta = t0 + double(kk - 1) * dt, tb = ta + dt;
               double dpa = dp, dpb = d;
@@ -483,22 +592,28 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
               const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
               shade_hit(S, f, ph, dir, T, a);
               a[3] = 0;  // opaque: transmittance 0
-              live &= ~(std::uint64_t(1) << i);
+              stop = l;
               break;
             }
-            case RtKind::slice:
-              break;
+            break;
           }
+          case RtKind::slice:
+            break;
         }
-        for (int s = 0; s < nslots; ++s) prev[s] = v[s];
-        have_prev = true;
-        if (!live) {
-          done = true;
-          break;
+        if (stop >= 0) {
+          live &= ~(std::uint64_t(1) << i);
+          used = std::max(used, stop + 1);
+        } else {
+          used = n;
         }
       }
+      marched += std::uint64_t(used);
+      for (std::uint32_t m = smask; m; m &= m - 1) {
+        const int s = std::countr_zero(m);
+        vb[s][0] = vb[s][n];
+      }
+      prev_valid = smask;
     }
-    marched += std::uint64_t(kk + 1 - kb);
   };
 
   // 3-D DDA over the macro-cells (Amanatides–Woo): per cell only a compare, an add and a mask load;
@@ -535,48 +650,53 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   const std::uint64_t* active = S.active.data();
   std::int64_t k = ks;      // first sample not yet marched, queued or skipped
   double tenter = t0 - dt;  // the first cell starts before sample ks
-  // Consecutive visible macro-cells whose only task is the same volume task are merged into one
-  // queued run [rb, re] for the fast path: fewer, longer runs waste fewer lanes of the 8-sample
-  // blocks and less per-run setup. The samples and their order are the same, so merging cannot
-  // change an image. (Merging general runs measured slower with K = 3 and 10 tasks: a merged run
-  // keeps the general path after the other tasks terminated; so those run cell by cell.)
+  // Consecutive visible macro-cells with the same live tasks are merged into one queued run
+  // [rb, re]: fewer, longer runs waste fewer lanes of the 8-sample blocks and less per-run setup.
+  // The samples and their order are the same, so merging cannot change an image. A merged general
+  // run drops to the fast path as soon as one volume task is left (see run()).
+  // The queued run's last sample is computed only when it ends (from the exit of its last cell),
+  // so a dense stretch of visible cells costs the walk a compare and a mask load per cell.
   bool queued = false;
-  std::int64_t rb = 0, re = -1;
+  std::int64_t rb = 0;
+  double rexit = 0;
+  bool rlast = false, rsafe = true;
   std::uint64_t rmask = 0;
-  bool rsafe = true;
+  auto flush = [&](bool to_end) {
+    // Samples rounded past the last macro-cell's exit stay with it (its margin covers them).
+    const std::int64_t re =
+        to_end || rlast ? ke : std::min(ke, ceil_index(std::min((rexit - t0) * inv_dt, q_max)) - 1);
+    queued = false;
+    if (rb <= re) {
+      run(rb, re, rmask, rsafe);
+      k = re + 1;
+    }
+  };
   for (;;) {
     const int a = tmax[0] < tmax[1] ? (tmax[0] < tmax[2] ? 0 : 2) : (tmax[1] < tmax[2] ? 1 : 2);
     const double texit = tmax[a];
+    const bool last_cell = unsigned(mi[a] + dstep[a]) >= unsigned(S.mcount[a]);
     std::uint64_t mask = active[idx] & live;
     if (queued && mask != rmask) {  // the queued run ends here: march it (live may shrink)
-      run(rb, re, rmask, rsafe);
-      queued = false;
-      if (!live) break;
+      flush(false);
+      if (!live || k > ke) break;
       mask = active[idx] & live;
     }
-    const bool last_cell = unsigned(mi[a] + dstep[a]) >= unsigned(S.mcount[a]);
     if (mask) {
-      const std::int64_t kb = std::max(k, ceil_index(std::min((tenter - t0) * inv_dt, q_max)));
-      // Samples rounded past the last macro-cell's exit stay with it (its margin covers them).
-      const std::int64_t kend =
-          last_cell ? ke : std::min(ke, ceil_index(std::min((texit - t0) * inv_dt, q_max)) - 1);
-      if (kb <= kend) {
-        const bool safe = mi[0] >= S.safe_lo[0] && mi[0] <= S.safe_hi[0] && mi[1] >= S.safe_lo[1] &&
-                          mi[1] <= S.safe_hi[1] && mi[2] >= S.safe_lo[2] && mi[2] <= S.safe_hi[2];
-        if (queued) {  // same mask, and kb == re + 1: the samples continue the queued run
-          re = kend;
-          rsafe = rsafe && safe;
-        } else if (single_volume(mask)) {
-          queued = true, rb = kb, re = kend, rmask = mask, rsafe = safe;
-        } else {
-          run(kb, kend, mask, safe);
-          if (!live) break;
-        }
-        k = kend + 1;
-        if (k > ke) break;
+      const bool safe = mi[0] >= S.safe_lo[0] && mi[0] <= S.safe_hi[0] && mi[1] >= S.safe_lo[1] &&
+                        mi[1] <= S.safe_hi[1] && mi[2] >= S.safe_lo[2] && mi[2] <= S.safe_hi[2];
+      if (queued) {  // same tasks: the cell's samples continue the queued run
+        rsafe = rsafe && safe;
+      } else {
+        queued = true, rmask = mask, rsafe = safe;
+        rb = std::max(k, ceil_index(std::min((tenter - t0) * inv_dt, q_max)));
+      }
+      rexit = texit, rlast = last_cell;
+      if (texit > t_ke) {  // every remaining sample lies in this cell
+        flush(true);
+        break;
       }
     } else {
-      have_prev = false;
+      prev_valid = 0;  // the samples of this cell are skipped
       if (texit > t_ke) break;  // every remaining sample lies in this empty cell
     }
     if (last_cell) break;
@@ -585,7 +705,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     tenter = texit;
     tmax[a] += tdelta[a];
   }
-  if (queued) run(rb, re, rmask, rsafe);
+  if (queued) flush(false);
   for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
@@ -644,7 +764,16 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     if (slot_of[std::size_t(f)] < 0) {
       slot_of[std::size_t(f)] = int(field_of_slot.size());
       field_of_slot.push_back(f);
-      S.acc.push_back(make_acc(fields[std::size_t(f)].view));
+      FieldAcc acc = make_acc(fields[std::size_t(f)].view);
+      const CornerField& cf = fields[std::size_t(f)].corners;
+      if (!cf.empty() && cf.lo() == fields[std::size_t(f)].view.points.lo) {
+        acc.corners = cf.data();
+        acc.ccx = cf.counts()[0];
+        acc.ccxy = cf.counts()[0] * cf.counts()[1];
+        acc.qoff = cf.offset();
+        acc.qscale = cf.scale();
+      }
+      S.acc.push_back(acc);
       S.cells.push_back(&fields[std::size_t(f)].cells);
     }
     return slot_of[std::size_t(f)];
@@ -664,11 +793,13 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       case TaskKind::volume: {
         r.kind = t.field2 >= 0 ? RtKind::volume2 : RtKind::volume1;
         r.s1 = slot(t.field);
+        r.slots = 1u << r.s1;
         const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
         r.lut1 = &l1.entry(0);
         r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
         if (t.field2 >= 0) {
           r.s2 = slot(t.field2);
+          r.slots |= 1u << r.s2;
           const TransferLut& l2 = bake(t.tf2, t.window2, t.reference2, 1);
           r.lut2 = &l2.entry(0);
           r.lo2 = l2.lo(), r.sc2 = l2.scale(), r.last2 = float(l2.bins() - 1), r.abs2 = l2.absolute_value();
@@ -680,6 +811,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
         if (!std::isfinite(t.isovalue)) throw Error("render: isovalue is not finite");
         r.kind = RtKind::iso;
         r.s1 = slot(t.field);
+        r.slots = 1u << r.s1;
         r.iso = t.isovalue;
         r.colour[0] = t.surface_colour.r, r.colour[1] = t.surface_colour.g, r.colour[2] = t.surface_colour.b;
         S.march_mask |= bit;
@@ -737,10 +869,13 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       if (r.kind == RtKind::iso) {
         if (c1.min(m) <= r.iso && r.iso <= c1.max(m)) bits |= bit;
       } else {
-        bool vis = luts[2 * i].visible(c1.min(m), c1.max(m));
+        // Quantized values may stray half a step outside the cell's float range.
+        const float e1 = S.acc[std::size_t(r.s1)].qscale;
+        bool vis = luts[2 * i].visible(c1.min(m) - e1, c1.max(m) + e1);
         if (!vis && r.kind == RtKind::volume2) {
           const MacroCells& c2 = *S.cells[std::size_t(r.s2)];
-          vis = luts[2 * i + 1].visible(c2.min(m), c2.max(m));
+          const float e2 = S.acc[std::size_t(r.s2)].qscale;
+          vis = luts[2 * i + 1].visible(c2.min(m) - e2, c2.max(m) + e2);
         }
         if (vis) bits |= bit;
       }

@@ -1,0 +1,69 @@
+#include "render/corner_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace panoptes::render {
+
+CornerField::CornerField(const FieldView& f) {
+  f.validate();
+  const PointRange& pr = f.points;
+  std::int64_t cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    lo_[a] = pr.lo[a];
+    counts_[a] = std::max(1, pr.hi[a] - pr.lo[a] - 1);
+    cells *= counts_[a];
+  }
+  if (cells > std::numeric_limits<std::int32_t>::max()) {
+    counts_ = {0, 0, 0};
+    return;
+  }
+  const int nx = pr.hi[0] - pr.lo[0], ny = pr.hi[1] - pr.lo[1], nz = pr.hi[2] - pr.lo[2];
+  auto at = [&](int i, int j, int k) {
+    return f.data[std::int64_t(i) * f.stride[0] + std::int64_t(j) * f.stride[1] + std::int64_t(k) * f.stride[2]];
+  };
+  // The value range (NaNs are left out; they quantize to q = 0).
+  float vmin = std::numeric_limits<float>::infinity(), vmax = -vmin;
+#pragma omp parallel for reduction(min : vmin) reduction(max : vmax) schedule(static)
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const float v = at(i, j, k);
+        if (v < vmin) vmin = v;
+        if (v > vmax) vmax = v;
+      }
+  if (!(vmin <= vmax)) vmin = vmax = 0;  // all NaN
+  offset_ = vmin;
+  scale_ = (vmax - vmin) / 65535.0f;
+  const float inv = scale_ > 0 ? 1.0f / scale_ : 0.0f;
+  // Points first (each is read by up to eight cells), then the corner records.
+  std::vector<std::uint16_t> pq(std::size_t(nx) * ny * nz);
+#pragma omp parallel for schedule(static)
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const float u = (at(i, j, k) - vmin) * inv + 0.5f;
+        pq[std::size_t(i + std::int64_t(nx) * (j + std::int64_t(ny) * k))] =
+            u >= 0 ? std::uint16_t(std::min(u, 65535.0f)) : std::uint16_t(0);  // also NaN → 0
+      }
+  q_.resize(std::size_t(cells) * 8);
+  const int cx = counts_[0], cy = counts_[1], cz = counts_[2];
+#pragma omp parallel for schedule(static)
+  for (int k = 0; k < cz; ++k)
+    for (int j = 0; j < cy; ++j) {
+      const int k1 = std::min(k + 1, nz - 1), j1 = std::min(j + 1, ny - 1);
+      const std::uint16_t* r00 = &pq[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k))];
+      const std::uint16_t* r10 = &pq[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k))];
+      const std::uint16_t* r01 = &pq[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k1))];
+      const std::uint16_t* r11 = &pq[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k1))];
+      std::uint16_t* out = &q_[std::size_t(8 * (std::int64_t(cx) * (j + std::int64_t(cy) * k)))];
+      for (int i = 0; i < cx; ++i, out += 8) {
+        const int i1 = std::min(i + 1, nx - 1);
+        out[0] = r00[i], out[1] = r00[i1], out[2] = r10[i], out[3] = r10[i1];
+        out[4] = r01[i], out[5] = r01[i1], out[6] = r11[i], out[7] = r11[i1];
+      }
+    }
+}
+
+}  // namespace panoptes::render
