@@ -119,6 +119,6 @@ spec = "fibonacci:2"
 name = "p"
 field = "phi_p"
 TOML
-OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 expect_error "steps = 0" "$bin" run zero.toml
+OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 expect_error "time.steps: 0 is out of range" "$bin" run zero.toml
 [ ! -e zero_db ] || fail "steps = 0 wrote a database"
 echo "hostile_db.sh: ok"
