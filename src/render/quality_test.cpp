@@ -1,6 +1,7 @@
 // Every optimisation of the march keeps images within PSNR >= 45 dB of the plain reference path
 // (render/reference_renderer.hpp: the sampling and compositing rules written directly, as the
-// renderer computed them before the optimisations of issue 10) on a small dense scene.
+// renderer computed them before the optimisations of issue 10, at its default sample distance of
+// 0.5 voxel) on a small dense scene.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -46,17 +47,28 @@ TEST(Quality, DenseSceneMatchesTheReferencePathWithin45dB) {
   const camera::Domain domain{sc.grid.domain_lo(), sc.grid.domain_hi() - sc.grid.domain_lo()};
   const camera::Rig rig = camera::make_rig("yinyang", domain);
   std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
-  double worst = 99;
+  // The yardstick is the renderer before issue 10 at its default sample distance, 0.5 voxel. The
+  // paper's configurations (examples/paper*.toml, volume tasks only) march at 1.0 voxel, which must
+  // stay within 45 dB of it. At equal sample distance the only difference is the 16-bit corner copy,
+  // far below that (≈ 80 dB measured): 60 dB catches a broken copy.
+  RenderOptions old_default, paper;
+  old_default.sample_distance = 0.5;
+  paper.sample_distance = 1.0;
+  double worst = 99, worst_same_step = 99;
   for (int c : {0, 37, 71, 118}) {
     const camera::Camera cam = rig.camera(c, 96, 92);
-    std::vector<PartialImage> fast(sc.tasks.size()), ref(sc.tasks.size());
-    render_brick(cam, fields, sc.tasks, fast);
-    render_reference(cam, sc.views, sc.tasks, ref);
+    std::vector<PartialImage> fast(sc.tasks.size()), ref(sc.tasks.size()), fast_half(sc.tasks.size());
+    render_brick(cam, fields, sc.tasks, fast, paper);
+    render_brick(cam, fields, sc.tasks, fast_half, old_default);
+    render_reference(cam, sc.views, sc.tasks, ref, old_default);
     for (std::size_t t = 0; t < sc.tasks.size(); ++t) {
       const Image a = finish_image(fast[t], cam, sc.grid), b = finish_image(ref[t], cam, sc.grid);
       const double p = psnr(a, b);
       worst = std::min(worst, p);
       EXPECT_GE(p, 45.0) << "camera " << c << " task " << t;
+      const double ps = psnr(finish_image(fast_half[t], cam, sc.grid), b);
+      worst_same_step = std::min(worst_same_step, ps);
+      EXPECT_GE(ps, 60.0) << "camera " << c << " task " << t << " (both at 0.5 voxel)";
       // And the images are not empty: the test would pass trivially on two blank frames.
       double alpha = 0;
       for (std::size_t i = 3; i < ref[t].rgba.size(); i += 4) alpha += ref[t].rgba[i];
@@ -64,5 +76,6 @@ TEST(Quality, DenseSceneMatchesTheReferencePathWithin45dB) {
     }
   }
   RecordProperty("worst_psnr_db", std::to_string(worst));
-  std::printf("worst PSNR against the reference path: %.1f dB\n", worst);
+  std::printf("worst PSNR against the reference path at 0.5 voxel: %.1f dB (render_brick at 1.0 voxel), %.1f dB (at 0.5)\n",
+              worst, worst_same_step);
 }
