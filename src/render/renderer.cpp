@@ -671,10 +671,27 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       k = re + 1;
     }
   };
+  // The walk's state per axis in scalars (tx, ty, tz; cells left nx, ny, nz), not in arrays indexed
+  // by the axis: indexed arrays live on the stack, and every cell paid store-to-load round trips.
+  double tx = tmax[0], ty = tmax[1], tz = tmax[2];
+  const double dx = tdelta[0], dy = tdelta[1], dz = tdelta[2];
+  const std::int64_t lx = lstep[0], ly = lstep[1], lz = lstep[2];
+  // Cells left to enter along each axis after the current one (a zero direction never steps).
+  auto left = [&](int a) { return dstep[a] > 0 ? S.mcount[a] - 1 - mi[a] : dstep[a] < 0 ? mi[a] : 0; };
+  int nx = left(0), ny = left(1), nz = left(2);
+  int mx = mi[0], my = mi[1], mz = mi[2];
+  const int sx = dstep[0], sy = dstep[1], sz = dstep[2];
   for (;;) {
-    const int a = tmax[0] < tmax[1] ? (tmax[0] < tmax[2] ? 0 : 2) : (tmax[1] < tmax[2] ? 1 : 2);
-    const double texit = tmax[a];
-    const bool last_cell = unsigned(mi[a] + dstep[a]) >= unsigned(S.mcount[a]);
+    double texit;
+    bool last_cell;
+    int a;
+    if (tx < ty) {
+      if (tx < tz) a = 0, texit = tx, last_cell = nx == 0;
+      else a = 2, texit = tz, last_cell = nz == 0;
+    } else {
+      if (ty < tz) a = 1, texit = ty, last_cell = ny == 0;
+      else a = 2, texit = tz, last_cell = nz == 0;
+    }
     std::uint64_t mask = active[idx] & live;
     if (queued && mask != rmask) {  // the queued run ends here: march it (live may shrink)
       flush(false);
@@ -682,8 +699,8 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       mask = active[idx] & live;
     }
     if (mask) {
-      const bool safe = mi[0] >= S.safe_lo[0] && mi[0] <= S.safe_hi[0] && mi[1] >= S.safe_lo[1] &&
-                        mi[1] <= S.safe_hi[1] && mi[2] >= S.safe_lo[2] && mi[2] <= S.safe_hi[2];
+      const bool safe = mx >= S.safe_lo[0] && mx <= S.safe_hi[0] && my >= S.safe_lo[1] && my <= S.safe_hi[1] &&
+                        mz >= S.safe_lo[2] && mz <= S.safe_hi[2];
       if (queued) {  // same tasks: the cell's samples continue the queued run
         rsafe = rsafe && safe;
       } else {
@@ -700,10 +717,10 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       if (texit > t_ke) break;  // every remaining sample lies in this empty cell
     }
     if (last_cell) break;
-    mi[a] += dstep[a];
-    idx += lstep[a];
+    if (a == 0) --nx, mx += sx, idx += lx, tx += dx;
+    else if (a == 1) --ny, my += sy, idx += ly, ty += dy;
+    else --nz, mz += sz, idx += lz, tz += dz;
     tenter = texit;
-    tmax[a] += tdelta[a];
   }
   if (queued) flush(false);
   for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
