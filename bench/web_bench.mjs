@@ -31,6 +31,12 @@ async function run(browser, prefetch) {
   const after = await page.evaluate(() => window.panoptes.traffic());
   const switches = await page.evaluate(() => window.panoptes.switches());
   await page.close();
+  if (process.env.WEB_BENCH_VERBOSE) {
+    const d = (k) => after[k] - before[k], b = Math.max(1, d("batches"));
+    console.error(`batches ${d("batches")} frames ${d("frames")} per request: fetch ${(d("fetchMs") / Math.max(1, d("requests"))).toFixed(1)} ms; per batch: decode ${(d("decodeMs") / b).toFixed(1)} ms`);
+  }
+  if (process.env.WEB_BENCH_VERBOSE)
+    for (const s of switches) if (!s.hit) console.error(`miss ${s.command} ${s.from}->${s.to} ms=${s.ms === null ? "superseded" : s.ms.toFixed(1)} lag=${s.lag} ${JSON.stringify(s.diag)}`);
   // A switch overtaken by the next key before it was shown took longer than the 330 ms between keys:
   // it counts as +Infinity in the percentiles (printed as "> 330").
   const shown = switches.filter((s) => s.ms !== null), ms = switches.map((s) => (s.ms === null ? Infinity : s.ms));
@@ -45,7 +51,7 @@ async function run(browser, prefetch) {
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox", "--disable-dev-shm-usage"] });
 const db = await (await fetch(url + "api/database.json")).json();
 const rows = [];
-for (const prefetch of [true, false]) {
+for (const prefetch of (process.env.WEB_BENCH_ONLY_ON ? [true] : [true, false])) {
   const runs = [];
   for (let r = 0; r < reps; r++) runs.push(await run(browser, prefetch));
   const m = (k) => median(runs.map((x) => x[k]));

@@ -3,14 +3,18 @@
 // WebCodecs VideoDecoder. Decoded frames go to a bounded LRU cache of VideoFrames.
 import { createFile, DataStream, Endianness, MP4BoxBuffer } from "./vendor/mp4box/mp4box.all.mjs";
 
+const MAX_FRAGMENTS_PER_STREAM = 256;
+
 /// Byte and request counters (the benchmark reports bytes fetched per switch).
-export const traffic = { bytes: 0, requests: 0 };
+export const traffic = { bytes: 0, requests: 0, batches: 0, fetchMs: 0, demuxMs: 0, decodeMs: 0, frames: 0 };
 
 async function fetchBytes(url, range) {
+  const t0 = performance.now();
   const headers = range ? { Range: `bytes=${range[0]}-${range[1] - 1}` } : {};
   const res = await fetch(url, { headers, cache: "no-store" });
   if (!res.ok) throw Object.assign(new Error(`${url}: HTTP ${res.status}`), { status: res.status });
   let buf = await res.arrayBuffer();
+  traffic.fetchMs += performance.now() - t0;
   traffic.bytes += buf.byteLength;
   traffic.requests++;
   // A static server without range support answers 200 with the whole file: cut the range out.
@@ -93,7 +97,9 @@ export class Stream {
     this.message = "";
     this.opening = null;
     this.chain = Promise.resolve();
-    this.inflight = new Map();  // fragment number → promise
+    this.inflight = new Map();  // fragment number → promise of its decode
+    this.samples = new Map();  // fragment number → [{data, key}], compressed, fetched ahead
+    this.fetching = new Map();  // fragment number → promise of its range fetch
     this.decoder = null;
     this.frameCount = db.frames;
   }
@@ -141,10 +147,68 @@ export class Stream {
     return f.length && frame >= f[lo][2] && frame < f[lo][2] + f[lo][3] ? lo : -1;
   }
 
+  /// Frames from `frame` on whose compressed samples are in memory or on their way (at most `limit`).
+  bytesAhead(frame, limit) {
+    const f = this.index.fragments;
+    let k = this.fragmentOf(frame), covered = 0;
+    while (k >= 0 && k < f.length && covered < limit && (this.samples.has(k) || this.fetching.has(k))) {
+      covered = f[k][2] + f[k][3] - frame;
+      k++;
+    }
+    return { covered, atEnd: k >= f.length };
+  }
+
+  /// Keeps the compressed samples of [frame, frame + frames) in memory, fetched ahead of decoding so
+  /// that a decode never waits for the network: when less than half of that window is there, the
+  /// missing run is fetched with one range request (a window slides a frame at a time; fetching at
+  /// half of it makes one request per frames/2 frames, not one per frame). Resolves when the
+  /// fragment holding `frame` is in memory (or the stream turned out unreadable).
+  async fetchAhead(frame, frames) {
+    await this.open();
+    if (this.status !== "ok") return;
+    const n = this.fragmentOf(frame);
+    if (n < 0) return;
+    const { covered, atEnd } = this.bytesAhead(frame, frames);
+    if (covered < (this.samples.has(n) ? frames / 2 : 1) && !atEnd) {
+      const f = this.index.fragments;
+      let a = n;
+      while (this.samples.has(a) || this.fetching.has(a)) a++;
+      let b = a + 1;
+      while (b < f.length && !this.samples.has(b) && !this.fetching.has(b) && f[b][2] < frame + frames) b++;
+      const p = this._fetch(a, b);
+      for (let k = a; k < b; k++) this.fetching.set(k, p);
+      p.finally(() => { for (let k = a; k < b; k++) if (this.fetching.get(k) === p) this.fetching.delete(k); });
+    }
+    if (!this.samples.has(n)) await this.fetching.get(n);
+  }
+
+  /// Fragments [a, b): contiguous in the file, so one range; init + those fragments is itself a valid
+  /// fragmented MP4 for mp4box.js (offsets are relative to each moof).
+  async _fetch(a, b) {
+    const f = this.index.fragments;
+    try {
+      const bytes = await fetchBytes(this.url, [f[a][0], f[b - 1][0] + f[b - 1][1]]);
+      const { samples } = await demux(this.init, bytes);
+      let i = 0;
+      for (let k = a; k < b; k++) {
+        this.samples.set(k, samples.slice(i, i + f[k][3]).map((x) => ({ data: x.data, key: x.is_sync })));
+        i += f[k][3];
+      }
+      // Bounded memory: the oldest fetched fragments go first.
+      for (const k of this.samples.keys()) {
+        if (this.samples.size <= MAX_FRAGMENTS_PER_STREAM) break;
+        this.samples.delete(k);
+      }
+    } catch (e) {
+      this.status = "unreadable";
+      this.message = `${this.url}: fragments ${a}..${b - 1}: ${e.message || e}`;
+    }
+  }
+
   /// Decodes the fragment holding `frame`, and the following ones up to `batchFrames` frames, into
-  /// the cache: one range request and one decoder flush for the lot (with intra-only movies a
-  /// fragment is one frame, and a request per frame costs more than the decode). Resolves when done.
-  async ensure(frame, cache, batchFrames = 4) {
+  /// the cache with one decoder flush (every fragment starts with a keyframe); their samples are
+  /// fetched first if they are not in memory yet (`fetchFrames` ahead). Resolves when done.
+  async ensure(frame, cache, batchFrames = 4, fetchFrames = 16) {
     await this.open();
     if (this.status !== "ok") return;
     const n = this.fragmentOf(frame);
@@ -154,24 +218,20 @@ export class Stream {
       let m = n + 1;
       while (m < f.length && f[m][2] + f[m][3] - f[n][2] <= batchFrames && !this.inflight.has(m) &&
              !cache.has(`${this.camera}/${this.task}/${f[m][2]}`)) m++;
-      const p = (this.chain = this.chain.then(() => this._decodeFragments(n, m, cache)));
-      for (let k = n; k < m; k++) {
-        this.inflight.set(k, p);
-      }
+      const p = (this.chain = this.chain.then(() => this._decodeFragments(n, m, cache, fetchFrames)));
+      for (let k = n; k < m; k++) this.inflight.set(k, p);
       p.finally(() => { for (let k = n; k < m; k++) if (this.inflight.get(k) === p) this.inflight.delete(k); });
     }
     return this.inflight.get(n);
   }
 
-  /// Fragments [n, m): contiguous in the file, so one range; init + those fragments is itself a valid
-  /// fragmented MP4 for mp4box.js (offsets are relative to each moof).
-  async _decodeFragments(n, m, cache) {
+  async _decodeFragments(n, m, cache, fetchFrames) {
     const f = this.index.fragments;
-    const first = f[n][2];
-    if (cache.has(`${this.camera}/${this.task}/${first}`) && m === n + 1) return;  // decoded meanwhile
+    if (cache.has(`${this.camera}/${this.task}/${f[n][2]}`) && m === n + 1) return;  // decoded meanwhile
+    for (let k = n; k < m && this.status === "ok"; k++) if (!this.samples.has(k)) await this.fetchAhead(f[k][2], fetchFrames);
+    if (this.status !== "ok") return;
     try {
-      const bytes = await fetchBytes(this.url, [f[n][0], f[m - 1][0] + f[m - 1][1]]);
-      const { samples } = await demux(this.init, bytes);
+      const t0 = performance.now();
       if (!this.decoder || this.decoder.state === "closed") {
         this.decoder = new VideoDecoder({
           output: (vf) => cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf),
@@ -179,10 +239,17 @@ export class Stream {
         });
         this.decoder.configure(this.config);
       }
-      samples.forEach((s, i) => {
-        this.decoder.decode(new EncodedVideoChunk({ type: s.is_sync ? "key" : "delta", timestamp: first + i, data: s.data }));
-      });
+      let count = 0;
+      for (let k = n; k < m; k++) {
+        const samples = this.samples.get(k);
+        if (!samples) break;  // evicted meanwhile: the pump asks again
+        samples.forEach((s, i) => {
+          this.decoder.decode(new EncodedVideoChunk({ type: s.key ? "key" : "delta", timestamp: f[k][2] + i, data: s.data }));
+        });
+        count += samples.length;
+      }
       await this.decoder.flush();
+      traffic.batches++; traffic.frames += count; traffic.decodeMs += performance.now() - t0;
       if (this.decodeError) throw this.decodeError;
     } catch (e) {
       this.status = "unreadable";

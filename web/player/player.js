@@ -1,8 +1,7 @@
 // The Panoptes web player: the same navigation as the desktop player (docs/player.md, docs/ui.md)
 // over `panoptes serve` or a static export. Decoding: WebCodecs + mp4box.js (movies.js). Prefetch:
-// after every change of selection the queue is replaced by, in this order, the current stream's
-// next frame, every neighbour at the next frame, the current stream's read-ahead, every neighbour at
-// the current frame — the engine's order — so a switch finds its frame decoded.
+// the current stream and every neighbour are kept decoded a few frames past the playhead, in step
+// with playback (pump() below), so a switch finds its frame decoded.
 import { FrameCache, Stream, traffic } from "./movies.js";
 import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
@@ -13,10 +12,12 @@ const options = {
   prefetch: params.get("prefetch") !== "0",
   autoplay: params.get("play") !== "0",
   cacheFrames: Number(params.get("cache") || 240),
-  workers: Number(params.get("workers") || 4),
+  connections: Number(params.get("connections") || 6),  // pump fetches at once (a browser's per-host limit)
   batch: Number(params.get("batch") || 8),  // frames fetched and decoded per range request
-  nbBatch: Number(params.get("nbbatch") || 8),  // the same for a neighbour's prefetch
-  readAhead: 2,
+  nbBatch: Number(params.get("nbbatch") || 4),  // the same for a neighbour's prefetch
+  ahead: Number(params.get("ahead") || 6),  // frames past the playhead kept decoded, current stream
+  nbAhead: Number(params.get("nbahead") || 3),  // the same for every neighbour
+  fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
 };
 
 const canvas = document.getElementById("view");
@@ -28,7 +29,7 @@ const mapCtx = minimap.getContext("2d");
 
 const cache = new FrameCache(options.cacheFrames);
 const streams = new Map();  // "c/t" → Stream, LRU
-const MAX_STREAMS = 48;
+const MAX_STREAMS = 96;  // the neighbours and their neighbours (opened ahead) stay open
 const drag = new DragRotation();
 
 const S = {
@@ -118,44 +119,88 @@ function select(camera, task, command) {
   if (camera < 0 || task < 0 || camera >= S.db.cameras.count || task >= S.db.tasks.length) return false;
   if (camera === S.camera && task === S.task) return false;
   // A switch not yet on screen when the next one comes is recorded as superseded (never shown).
-  if (S.pending) S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: null, hit: false, superseded: true });
-  S.pending = { t0: performance.now(), command, from: [S.camera, S.task] };
+  if (S.pending) S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: null, hit: false, superseded: true, diag: S.pending.diag });
+  // Why a switch waits (benchmark diagnostics): the target stream's state when the key came.
+  const f = currentFrame(), st = streams.get(`${camera}/${task}`);
+  const diag = {
+    stream: st ? st.status : "closed",
+    frameReady: cache.has(`${camera}/${task}/${f}`),
+    nextReady: cache.has(`${camera}/${task}/${(f + 1) % S.db.frames}`),
+    inflight: st ? st.inflight.size : 0,
+    maxTickGap: 0,
+  };
+  S.pending = { t0: performance.now(), command, from: [S.camera, S.task], diag };
   S.camera = camera;
   S.task = task;
-  schedulePrefetch(true);
+  pump();
   return true;
 }
 
-// ---- prefetch -----------------------------------------------------------------------------------
-let queue = [];
-let lastScheduled = "";
-let activeWorkers = 0;
-function schedulePrefetch(force = false) {
-  if (!options.prefetch) return;
-  const f = currentFrame(), n = S.db.frames;
-  const next = S.playing ? (f + 1) % n : f;
-  const key = `${S.camera}/${S.task}/${f}`;
-  if (!force && key === lastScheduled) return;
-  lastScheduled = key;
-  const nb = neighbourSelections(S.camera, S.task);
-  // The current stream is decoded in batches of options.batch frames; a neighbour only needs its next
-  // frame or two until the user switches, so it gets batches of nbBatch (less decoding per tick).
-  const B = options.batch, nbB = options.nbBatch;
-  const jobs = [[S.camera, S.task, next, B]];
-  for (const [c, t] of nb) jobs.push([c, t, next, nbB]);
-  if (S.playing) for (let k = 2; k <= options.readAhead + 1; k++) jobs.push([S.camera, S.task, (f + k) % n, B]);
-  for (const [c, t] of nb) jobs.push([c, t, f, nbB]);
-  queue = jobs.filter(([c, t, fr]) => !cache.has(`${c}/${t}/${fr}`));  // replaced, not appended
-  while (activeWorkers < options.workers && queue.length) runWorker();
+// ---- prefetch: a pump, not a queue ------------------------------------------------------------
+// Every display frame (and at once after a key) the pump looks at the streams a switch can reach:
+// the current one first, then every neighbour. A stream whose decoded frames do not reach `ahead`
+// frames past the playhead gets its next batch started — unless it already has one in flight (its
+// decodes are chained on one VideoDecoder anyway). No job ever waits for another's work, which was
+// round 1's tail: workers blocked on batches already in flight while other neighbours went unopened.
+// With spare connections the streams two steps away are opened (fragment index + init segment) so a
+// switch's new neighbours start decoding without two round trips first.
+let inflight = 0;  // batches, fetches and opens started by the pump, not yet done
+/// Keeps the stream's compressed samples `fetchAhead` frames past f in memory (wrapping when looping).
+function fetchAhead(st, f) {
+  const n = S.db.frames, W = options.fetchAhead;
+  const key = `fetch ${st.camera}/${st.task}`;
+  if (busy.has(key)) return;
+  const run = (from, frames) => {
+    const { covered, atEnd } = st.bytesAhead(from, frames);
+    if (covered >= frames / 2 || atEnd) return false;
+    busy.add(key);
+    inflight++;
+    st.fetchAhead(from, frames).finally(() => { busy.delete(key); inflight--; });
+    return true;
+  };
+  if (!run(f, Math.min(W, n - f)) && S.loop && f + W > n) run(0, f + W - n);
 }
-async function runWorker() {
-  activeWorkers++;
-  while (queue.length) {
-    const [c, t, f, batch] = queue.shift();
-    if (cache.has(`${c}/${t}/${f}`)) continue;
-    await stream(c, t).ensure(f, cache, batch);
+const busy = new Set();  // "c/t" with a pump batch in flight
+/// The first frame in [f, f + ahead) of the stream that is neither decoded nor being decoded; -1 if none.
+function firstMissing(c, t, f, ahead) {
+  const n = S.db.frames;
+  for (let k = 0; k < ahead; k++) {
+    const g = S.playing ? (f + k) % n : Math.min(f + k, n - 1);
+    if (!cache.has(`${c}/${t}/${g}`)) return g;
   }
-  activeWorkers--;
+  return -1;
+}
+function startBatch(c, t, g, batch) {
+  const key = `${c}/${t}`;
+  busy.add(key);
+  inflight++;
+  stream(c, t).ensure(g, cache, batch, options.fetchAhead).finally(() => { busy.delete(key); inflight--; pump(); });
+}
+function pump() {
+  if (!S.db) return;
+  const f = currentFrame();
+  const hot = [[S.camera, S.task, S.playing ? options.ahead : 1, options.batch]];
+  // Until the first frame is on screen the current stream has the connections and the decoder to itself.
+  const nb = options.prefetch && S.firstFrameMs !== null ? neighbourSelections(S.camera, S.task) : [];
+  for (const [c, t] of nb) hot.push([c, t, S.playing ? options.nbAhead : 1, options.nbBatch]);
+  for (const [c, t, ahead, batch] of hot) {
+    if (inflight >= options.connections && c !== S.camera) return;  // the current stream may exceed it
+    if (busy.has(`${c}/${t}`)) continue;
+    const st = streams.get(`${c}/${t}`);
+    if (st && (st.status === "missing" || st.status === "unreadable")) continue;
+    const g = firstMissing(c, t, f, ahead);
+    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, batch);
+    else if (g < 0 && st && st.status === "ok" && S.playing) fetchAhead(st, f);
+  }
+  for (const [c0, t0] of nb)
+    for (const [c, t] of neighbourSelections(c0, t0)) {
+      if (inflight >= options.connections - 1) return;  // keep a connection for the hot streams
+      const key = `${c}/${t}`;
+      if (busy.has(key) || (streams.has(key) && streams.get(key).status !== "new")) continue;
+      busy.add(key);
+      inflight++;
+      stream(c, t).open().finally(() => { busy.delete(key); inflight--; });
+    }
 }
 
 // ---- drawing ------------------------------------------------------------------------------------
@@ -186,10 +231,12 @@ function drawFrame(vf) {
   ctx.setTransform(1, 0, 0, 1, 0, 0);
 }
 
-let demanded = "";
-function tick() {
+let lastTick = 0;
+function tick(now) {
   requestAnimationFrame(tick);
   if (!S.db) return;
+  if (S.pending && lastTick) S.pending.diag.maxTickGap = Math.max(S.pending.diag.maxTickGap, now - lastTick);
+  lastTick = now;
   const frame = currentFrame();
   const st = stream(S.camera, S.task);
   const key = `${S.camera}/${S.task}/${frame}`;
@@ -213,10 +260,6 @@ function tick() {
       drawPlaceholder(S.camera, S.task, status, `${st.url}: truncated before frame ${frame}`);
       drawn = true;
     } else {
-      if (demanded !== key) {
-        demanded = key;  // decode on demand, ahead of the prefetch queue
-        st.ensure(frame, cache, options.batch);
-      }
       // The engine waits for the frame it needs; here the clock runs on meanwhile, so when a frame of
       // this stream decoded on demand arrives late, show it rather than keep the old stream on screen.
       if (S.playing) {
@@ -239,12 +282,13 @@ function tick() {
     S.shown = { camera: S.camera, task: S.task, frame: shownFrame, status };
     if (S.firstFrameMs === null) S.firstFrameMs = now;
     if (S.pending) {
-      S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit: firstTickAfterSwitch });
+      S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit: firstTickAfterSwitch,
+                        lag: (frame - shownFrame + S.db.frames) % S.db.frames, diag: S.pending.diag });
       S.pending = null;
     }
     drawMinimap();
   }
-  schedulePrefetch();
+  pump();
   updateHud(frame);
 }
 
@@ -253,14 +297,16 @@ function updateHud(frame) {
   const last = S.switches.findLast((w) => w.ms !== null);
   const axes = task.axes.map((a) => `${a.axis}=${db.axes.find((x) => x.name === a.axis)?.values[a.index]}`).join(" ");
   const active = db.axes[S.axis] ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
-  hud.textContent =
+  const text =
     `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
     `camera ${c}  lat ${db.cameras.lat_deg[c].toFixed(1)}°  lon ${db.cameras.lon_deg[c].toFixed(1)}°  shell ${db.cameras.shell[c]}\n` +
     `task ${S.task} "${task.name}" ${axes}  ${active}\n` +
     `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (next frame)" : " (waited for a decode)") : "—"}` +
     `  zoom ${S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
-  statusLine.textContent = S.message;
+  if (text !== lastHud) hud.textContent = lastHud = text;  // a DOM write per display frame costs a layout
+  if (statusLine.textContent !== S.message) statusLine.textContent = S.message;
 }
+let lastHud = "";
 
 // ---- mini-map: cameras by longitude (x) and latitude (y); click picks the nearest -------------
 function mapXY(i) {
