@@ -9,10 +9,13 @@
 namespace panoptes::web {
 
 /// Everything the player needs to open a database: title, status, frame count, fps, image size,
-/// times, tasks and parameter axes, the movie file-name pattern, and per camera (column-wise, so
-/// 10^5 cameras stay a few MB) latitude, longitude, shell, position, look-at and up, plus the
-/// navigation graph as rows [left, right, up, down, in, out] (-1 = none; empty without a graph).
-nlohmann::json database_json(const store::Database& db);
+/// times, tasks and parameter axes, the movie file-name pattern, and the cameras: for a database with
+/// a binary camera table (schema 2) `cameras` is {count, table: file name in the database, bytes} and
+/// the player reads that file itself; for inline cameras (schema 1) it holds the columns latitude,
+/// longitude, shell, position, look-at and up, and `graph` the navigation rows [left, right, up, down,
+/// in, out] (-1 = none; empty without a graph). `inline_cameras` forces the inline form (small
+/// databases, tools, and the test that checks the player's table parser against it).
+nlohmann::json database_json(const store::Database& db, bool inline_cameras = false);
 
 /// The fragment index of one movie as JSON: {"file_size", "init_size", "fragments": [[offset, size,
 /// first_frame, frames], ...]}.

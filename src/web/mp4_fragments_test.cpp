@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 
 #include "core/error.hpp"
+#include "web/database_json.hpp"
+#include "web/fragment_index_cache.hpp"
 #include "store/database.hpp"
 #include "store/synthetic.hpp"
 #include "store/test_support.hpp"
@@ -64,6 +67,41 @@ TEST(Mp4Fragments, RefusesFilesThatAreNotMovies) {
   std::ofstream(junk) << "this is not a movie, just some text long enough to look like boxes";
   EXPECT_THROW(index_fragments(junk), FileError);
   EXPECT_THROW(index_fragments(tmp.path / "missing.mp4"), FileError);
+}
+
+TEST(FragmentIndexCache, ReindexesOnlyWhenSizeOrMtimeChange) {
+  store::testing::TempDir tmp("web-frag");
+  const fs::path movie = make_db(tmp.path / "db", 4, 1);
+  FragmentIndexCache cache;
+  const auto first = cache.json(movie);
+  EXPECT_EQ(*first, fragment_index_json(index_fragments(movie)).dump());
+  EXPECT_EQ(cache.json(movie), first);  // the same text, not rebuilt
+  EXPECT_EQ(cache.hits(), 1u);
+  EXPECT_EQ(cache.misses(), 1u);
+  // A movie being written grows: the next request sees its new fragment count.
+  const FragmentIndex whole = index_fragments(movie);
+  fs::resize_file(movie, whole.fragments[3].offset + whole.fragments[3].size / 2);
+  const auto cut = cache.json(movie);
+  EXPECT_EQ(cache.misses(), 2u);
+  EXPECT_NE(*cut, *first);
+  EXPECT_EQ(*cut, fragment_index_json(index_fragments(movie)).dump());
+  // Same size, other mtime (a rewrite in place): rebuilt too.
+  fs::last_write_time(movie, fs::last_write_time(movie) - std::chrono::seconds(10));
+  cache.json(movie);
+  EXPECT_EQ(cache.misses(), 3u);
+  EXPECT_THROW(cache.json(tmp.path / "missing.mp4"), FileError);
+}
+
+TEST(FragmentIndexCache, StaysWithinItsByteBound) {
+  store::testing::TempDir tmp("web-frag");
+  make_db(tmp.path / "db", 4, 1);
+  const fs::path a = tmp.path / "db" / "movies" / "c0" / "t0.mp4", b = tmp.path / "db" / "movies" / "c1" / "t0.mp4";
+  FragmentIndexCache cache(1);  // room for one entry only
+  cache.json(a);
+  cache.json(b);  // evicts a
+  cache.json(a);
+  EXPECT_EQ(cache.misses(), 3u);
+  EXPECT_EQ(cache.hits(), 0u);
 }
 
 }  // namespace

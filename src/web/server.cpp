@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "store/database.hpp"
 #include "web/database_json.hpp"
+#include "web/fragment_index_cache.hpp"
 #include "web/mp4_fragments.hpp"
 #include "web/safe_path.hpp"
 
@@ -102,6 +103,7 @@ struct Server::Impl {
   int port = 0;
   std::mutex db_mutex;
   std::shared_ptr<const store::Database> db;
+  FragmentIndexCache indexes;  // per movie, checked against size + mtime per request
 
   explicit Impl(ServerOptions o)
       : options(std::move(o)), db_root(options.database), player_root(options.player_dir) {
@@ -159,9 +161,10 @@ struct Server::Impl {
 
   void routes() {
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) { return authorize(req, res); });
-    http.Get("/api/database.json", [this](const httplib::Request&, httplib::Response& res) {
+    http.Get("/api/database.json", [this](const httplib::Request& req, httplib::Response& res) {
       res.set_header("Cache-Control", "no-cache");
-      res.set_content(database_json(*database(true)).dump(), "application/json");
+      const bool inline_cameras = req.has_param("cameras") && req.get_param_value("cameras") == "inline";
+      res.set_content(database_json(*database(true), inline_cameras).dump(), "application/json");
     });
     http.Get(R"(/api/index/(\d{1,9})/(\d{1,9})\.json)", [this](const httplib::Request& req, httplib::Response& res) {
       const auto d = database(false);
@@ -177,7 +180,7 @@ struct Server::Impl {
       }
       try {
         res.set_header("Cache-Control", "no-cache");
-        res.set_content(fragment_index_json(index_fragments(*file)).dump(), "application/json");
+        res.set_content(*indexes.json(*file), "application/json");
       } catch (const Error& e) {
         log(req.remote_addr + " GET " + req.path + " 422 " + e.what());
         send_error(res, 422, e.what());

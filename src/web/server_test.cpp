@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "store/manifest.hpp"
 #include "store/synthetic.hpp"
 #include "store/test_support.hpp"
 
@@ -92,8 +93,20 @@ TEST(Server, ServesDatabaseJsonIndexAndByteRanges) {
   EXPECT_EQ(db["frames"], 5);
   EXPECT_EQ(db["cameras"]["count"], 3);
   EXPECT_EQ(db["tasks"].size(), 2u);
-  EXPECT_EQ(db["graph"].size(), 3u);
-  EXPECT_EQ(db["cameras"]["position"].size(), 9u);
+  // The cameras are in the database's binary table, which the player fetches as it is.
+  EXPECT_FALSE(db.contains("graph"));
+  const std::string table = db["cameras"]["table"];
+  EXPECT_EQ(table, store::referenced_camera_table(o.database / store::kManifestFileName));
+  res = c.Get("/db/" + table);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  EXPECT_EQ(std::uint64_t(res->body.size()), db["cameras"]["bytes"].get<std::uint64_t>());
+  EXPECT_EQ(res->body.substr(0, 8), "PNPTCAMS");
+  res = c.Get("/api/database.json?cameras=inline");
+  ASSERT_TRUE(res);
+  const auto inline_db = nlohmann::json::parse(res->body);
+  EXPECT_EQ(inline_db["graph"].size(), 3u);
+  EXPECT_EQ(inline_db["cameras"]["position"].size(), 9u);
 
   res = c.Get("/api/index/2/1.json");
   ASSERT_TRUE(res);

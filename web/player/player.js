@@ -5,6 +5,7 @@
 import { FrameCache, Stream, traffic } from "./movies.js";
 import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
+import { camerasFromJson, parseCameraTable } from "./cameras.js";
 
 const params = new URLSearchParams(location.search);
 const base = new URL(".", location.href).href.split("?")[0];
@@ -33,7 +34,7 @@ const MAX_STREAMS = 96;  // the neighbours and their neighbours (opened ahead) s
 const drag = new DragRotation();
 
 const S = {
-  db: null, camera: 0, task: 0, axis: 0,
+  db: null, cams: null, camera: 0, task: 0, axis: 0,
   playing: options.autoplay, loop: true, speed: 1,
   anchorFrame: 0, anchorTime: 0,
   zoom: 1, panX: 0, panY: 0,
@@ -82,8 +83,8 @@ function setPlaying(p) {
 // ---- navigation ---------------------------------------------------------------------------------
 const COLUMNS = ["left", "right", "up", "down", "in", "out"];
 function graphNeighbour(camera, direction) {
-  const row = S.db.graph[camera];
-  return row ? row[COLUMNS.indexOf(direction)] : -1;
+  const g = S.cams && S.cams.neighbours;  // null until the camera table is loaded, or without a graph
+  return g && camera >= 0 && camera < S.cams.count ? g[6 * camera + COLUMNS.indexOf(direction)] : -1;
 }
 /// The task at the same positions as `task` on every axis but `axis`, moved by delta there; -1 if none.
 function stepTaskOnAxis(task, axisName, delta) {
@@ -299,7 +300,8 @@ function updateHud(frame) {
   const active = db.axes[S.axis] ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
   const text =
     `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
-    `camera ${c}  lat ${db.cameras.lat_deg[c].toFixed(1)}°  lon ${db.cameras.lon_deg[c].toFixed(1)}°  shell ${db.cameras.shell[c]}\n` +
+    (S.cams ? `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°  shell ${S.cams.shell[c]}\n`
+            : `camera ${c}  (loading the camera table…)\n`) +
     `task ${S.task} "${task.name}" ${axes}  ${active}\n` +
     `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (next frame)" : " (waited for a decode)") : "—"}` +
     `  zoom ${S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
@@ -311,22 +313,23 @@ let lastHud = "";
 // ---- mini-map: cameras by longitude (x) and latitude (y); click picks the nearest -------------
 function mapXY(i) {
   const w = minimap.width, h = minimap.height;
-  return [((S.db.cameras.lon_deg[i] + 180) / 360) * w, ((90 - S.db.cameras.lat_deg[i]) / 180) * h];
+  return [((S.cams.lon_deg[i] + 180) / 360) * w, ((90 - S.cams.lat_deg[i]) / 180) * h];
 }
 function drawMinimap() {
-  const w = minimap.width, h = minimap.height, n = S.db.cameras.count;
+  if (!S.cams) return;
+  const w = minimap.width, h = minimap.height, n = S.cams.count;
   mapCtx.fillStyle = "rgba(10,14,22,0.85)";
   mapCtx.fillRect(0, 0, w, h);
   mapCtx.strokeStyle = "#334";
   mapCtx.beginPath();
   mapCtx.moveTo(0, h / 2); mapCtx.lineTo(w, h / 2); mapCtx.moveTo(w / 2, 0); mapCtx.lineTo(w / 2, h);
   mapCtx.stroke();
-  const shell = S.db.cameras.shell[S.camera];
+  const shell = S.cams.shell[S.camera];
   const nb = new Set(COLUMNS.map((d) => graphNeighbour(S.camera, d)));
   const radius = n > 2000 ? 1 : n > 300 ? 2 : 3;
   for (let i = 0; i < n; i++) {
     const [x, y] = mapXY(i);
-    mapCtx.fillStyle = S.db.cameras.shell[i] !== shell ? "#445" : nb.has(i) ? "#6cf" : "#9aa";
+    mapCtx.fillStyle = S.cams.shell[i] !== shell ? "#445" : nb.has(i) ? "#6cf" : "#9aa";
     mapCtx.fillRect(x - radius / 2, y - radius / 2, radius, radius);
   }
   const [x, y] = mapXY(S.camera);
@@ -340,7 +343,8 @@ minimap.addEventListener("click", (e) => {
   const r = minimap.getBoundingClientRect();
   const px = ((e.clientX - r.left) / r.width) * minimap.width, py = ((e.clientY - r.top) / r.height) * minimap.height;
   let best = -1, bestD = Infinity;
-  for (let i = 0; i < S.db.cameras.count; i++) {
+  if (!S.cams) return;
+  for (let i = 0; i < S.cams.count; i++) {
     const [x, y] = mapXY(i);
     const d = (x - px) ** 2 + (y - py) ** 2;
     if (d < bestD) { bestD = d; best = i; }
@@ -400,10 +404,10 @@ canvas.addEventListener("wheel", (e) => {
 }, { passive: false });
 
 let dragLast = null;
-const dirs = () => S._dirs ?? (S._dirs = cameraDirections(S.db.cameras));
-function cameraVec(col, c) { return [0, 1, 2].map((k) => S.db.cameras[col][3 * c + k]); }
+const dirs = () => S._dirs ?? (S._dirs = cameraDirections(S.cams));
+function cameraVec(col, c) { return [0, 1, 2].map((k) => S.cams[col][3 * c + k]); }
 canvas.addEventListener("pointerdown", (e) => {
-  if (e.button !== 0 || !S.db) return;
+  if (e.button !== 0 || !S.db || !S.cams) return;
   canvas.setPointerCapture(e.pointerId);
   drag.begin(cameraVec("position", S.camera), cameraVec("up", S.camera), cameraVec("look_at", S.camera));
   dragLast = [e.clientX, e.clientY];
@@ -412,7 +416,7 @@ canvas.addEventListener("pointermove", (e) => {
   if (!drag.active || !dragLast) return;
   drag.move(e.clientX - dragLast[0], e.clientY - dragLast[1], canvas.getBoundingClientRect().height);
   dragLast = [e.clientX, e.clientY];
-  const c = nearestCamera(dirs(), S.db.cameras.shell, drag.dir, S.db.cameras.shell[S.camera]);
+  const c = nearestCamera(dirs(), S.cams.shell, drag.dir, S.cams.shell[S.camera]);
   if (c >= 0) select(c, S.task, "drag");
 });
 const endDrag = () => { drag.end(); dragLast = null; };
@@ -450,6 +454,24 @@ async function main() {
   S.anchorTime = performance.now();
   S.db = db;
   requestAnimationFrame(tick);
+  // The first frame does not need the cameras: it is fetched meanwhile. Navigation by the graph, the
+  // mini-map and drag start when the table is in (at 10^6 cameras it is tens of MB).
+  if (db.cameras.table) {
+    const url = base + "db/" + db.cameras.table;
+    fetch(url, { cache: "no-store" })
+      .then((r) => { if (!r.ok) throw new Error(`HTTP ${r.status}`); return r.arrayBuffer(); })
+      .then((buf) => {
+        const t0 = performance.now();
+        const cams = parseCameraTable(buf, url);
+        if (cams.count !== db.cameras.count) throw new Error(`${cams.count} cameras, the manifest says ${db.cameras.count}`);
+        S.cameraTableMs = { loaded: t0, parsed: performance.now(), bytes: buf.byteLength };
+        S.cams = cams;
+        drawMinimap();
+      })
+      .catch((e) => { S.message = `${url}: ${e.message}`; });
+  } else {
+    S.cams = camerasFromJson(db.cameras, db.graph);
+  }
   // A database still being written grows: re-read its manifest every 2 s and re-open the streams
   // (their fragment indexes) when the frame count moved on.
   const refresh = setInterval(async () => {
@@ -476,6 +498,11 @@ window.panoptes = {
   switches: () => S.switches,
   traffic: () => ({ ...traffic }),
   firstFrameMs: () => S.firstFrameMs,
+  /// When the camera table was in and parsed (performance.now() ms) and its size; null before.
+  cameraTable: () => S.cameraTableMs ?? null,
+  /// Camera c's neighbour in a direction ("left", ...), -1 if none or the cameras are not loaded yet.
+  neighbour: (c, direction) => graphNeighbour(c, direction),
+  camerasLoaded: () => S.cams !== null,
   options,
   /// The stamp in the canvas pixels (zoom 1 only), or null.
   readStamp: () => {

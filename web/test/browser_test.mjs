@@ -50,7 +50,7 @@ async function open(url) {
   // Fetches of the missing and corrupt movies' indexes fail by design (404/422): not an error here.
   page.on("console", (m) => m.type() === "error" && !/status of 40[4]|status of 422/.test(m.text()) && errors.push(m.text()));
   await page.goto(url);
-  await page.waitForFunction(() => window.panoptes && window.panoptes.shown(), { timeout: 20000 });
+  await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded(), { timeout: 20000 });
   return { page, errors };
 }
 
@@ -74,7 +74,19 @@ async function expectShown(page, camera, task, frame, what) {
 
 const db = await (await fetch(serveBase + "api/database.json", { headers: { Authorization: "Bearer t0k3n" } })).json();
 const [L, R, U, D] = [0, 1, 2, 3];
-const graph = db.graph;
+// The cameras come from the database's binary camera table (served as it is), read with the player's
+// parser, checked here against the server's inline JSON form of the same cameras.
+const { parseCameraTable } = await import(path.join(siteDir, "cameras.js"));
+assert.ok(db.cameras.table, "database.json names the camera table");
+assert.equal(db.graph, undefined, "no per-camera rows in database.json for a database with a camera table");
+db.cameras = parseCameraTable(await (await fetch(serveBase + "db/" + db.cameras.table, { headers: { Authorization: "Bearer t0k3n" } })).arrayBuffer());
+const graph = Array.from({ length: db.cameras.count }, (_, i) => Array.from(db.cameras.neighbours.subarray(6 * i, 6 * i + 6)));
+{
+  const inline = await (await fetch(serveBase + "api/database.json?cameras=inline", { headers: { Authorization: "Bearer t0k3n" } })).json();
+  assert.deepEqual(graph, inline.graph, "camera table graph = inline graph");
+  for (const col of ["lat_deg", "lon_deg", "shell", "position", "look_at", "up"])
+    assert.deepEqual(Array.from(db.cameras[col]), inline.cameras[col], `camera table column ${col}`);
+}
 
 await check("keys: every command shows the expected stamp", async () => {
   const { page, errors } = await open(serveUrl + "&play=0");

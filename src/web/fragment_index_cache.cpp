@@ -1,0 +1,64 @@
+#include "web/fragment_index_cache.hpp"
+
+#include "core/error.hpp"
+#include "web/database_json.hpp"
+#include "web/mp4_fragments.hpp"
+
+namespace panoptes::web {
+
+namespace fs = std::filesystem;
+
+FragmentIndexCache::FragmentIndexCache(std::size_t max_bytes) : max_bytes_(max_bytes) {}
+
+std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movie) {
+  std::error_code ec;
+  const auto size = fs::file_size(movie, ec);
+  if (ec) throw FileError(movie.string(), "cannot read: " + ec.message());
+  const auto mtime = fs::last_write_time(movie, ec);
+  if (ec) throw FileError(movie.string(), "cannot read: " + ec.message());
+  const std::string key = movie.string();
+  {
+    std::lock_guard lock(mutex_);
+    if (const auto it = by_path_.find(key); it != by_path_.end()) {
+      if (it->second->size == size && it->second->mtime == mtime) {
+        lru_.splice(lru_.begin(), lru_, it->second);
+        ++hits_;
+        return it->second->json;
+      }
+      bytes_ -= it->second->json->size();
+      lru_.erase(it->second);
+      by_path_.erase(it);
+    }
+    ++misses_;
+  }
+  // Built outside the lock: other streams are served meanwhile. Two requests for the same new movie
+  // may both build it; the second insert just replaces the first.
+  auto text = std::make_shared<const std::string>(fragment_index_json(index_fragments(movie)).dump());
+  std::lock_guard lock(mutex_);
+  if (const auto it = by_path_.find(key); it != by_path_.end()) {
+    bytes_ -= it->second->json->size();
+    lru_.erase(it->second);
+    by_path_.erase(it);
+  }
+  lru_.push_front(Entry{key, size, mtime, text});
+  by_path_[key] = lru_.begin();
+  bytes_ += text->size();
+  while (bytes_ > max_bytes_ && lru_.size() > 1) {
+    bytes_ -= lru_.back().json->size();
+    by_path_.erase(lru_.back().path);
+    lru_.pop_back();
+  }
+  return text;
+}
+
+std::uint64_t FragmentIndexCache::hits() const {
+  std::lock_guard lock(mutex_);
+  return hits_;
+}
+
+std::uint64_t FragmentIndexCache::misses() const {
+  std::lock_guard lock(mutex_);
+  return misses_;
+}
+
+}  // namespace panoptes::web

@@ -1,0 +1,46 @@
+#pragma once
+// The fragment indexes `panoptes serve` hands out, kept per movie so that a player asking for the
+// same stream again (every switch back, every page load) costs one stat() instead of reading every
+// box header of the movie. An entry is valid while the file's size and modification time are those
+// it was built from: a movie still being written grows, so its next request re-indexes it.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+
+namespace panoptes::web {
+
+/// A thread-safe LRU of fragment indexes as JSON text, keyed by path and checked against size and
+/// modification time, bounded by the bytes of JSON it holds.
+class FragmentIndexCache {
+ public:
+  /// `max_bytes`: the JSON text kept at most (an index is ~30 bytes per fragment).
+  explicit FragmentIndexCache(std::size_t max_bytes = std::size_t(64) << 20);
+
+  /// The index of `movie` as JSON (web::fragment_index_json), from the cache when the file's size and
+  /// mtime are unchanged, else built (index_fragments) and kept. Throws what index_fragments throws.
+  std::shared_ptr<const std::string> json(const std::filesystem::path& movie);
+
+  /// Counters for tests and logs.
+  std::uint64_t hits() const;
+  std::uint64_t misses() const;
+
+ private:
+  struct Entry {
+    std::string path;
+    std::uintmax_t size = 0;
+    std::filesystem::file_time_type mtime;
+    std::shared_ptr<const std::string> json;
+  };
+  mutable std::mutex mutex_;
+  std::list<Entry> lru_;  // front = most recently used
+  std::unordered_map<std::string, std::list<Entry>::iterator> by_path_;
+  std::size_t bytes_ = 0, max_bytes_;
+  std::uint64_t hits_ = 0, misses_ = 0;
+};
+
+}  // namespace panoptes::web
