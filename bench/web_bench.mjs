@@ -4,9 +4,10 @@
 // the rAF callback that drew the new stream's frame (the player's own record). Bytes per switch =
 // bytes fetched during the switching phase / switches (includes the playback's own read-ahead).
 import { createRequire } from "node:module";
+import fs from "node:fs";
 import os from "node:os";
 
-const [url, chromium, nodeModules, dbPath, repsArg] = process.argv.slice(2);
+const [url, chromium, nodeModules, dbPath, repsArg, bigUrl, bigPid, bigPath] = process.argv.slice(2);
 const require = createRequire(nodeModules + "/");
 const puppeteer = require("puppeteer-core");
 const reps = Number(repsArg || 3);
@@ -60,6 +61,29 @@ for (const prefetch of (process.env.WEB_BENCH_ONLY_ON ? [true] : [true, false]))
   rows.push(`| ${prefetch ? "on" : "off"} | ${runs[0].n} | ${m("superseded")} | ${f(m("p50"))} | ${f(m("p99"))} (${range("p99")}) | ${f(m("max"))} | ` +
             `${(100 * m("hits")).toFixed(0)} % | ${m("firstFrame").toFixed(0)} | ${(m("bytesPerSwitch") / 1024).toFixed(1)} | ${m("requestsPerSwitch").toFixed(1)} |`);
 }
+
+// Opening a database of 10^6 cameras (no movies: every stream is a "missing" placeholder): time to
+// the first drawn frame and to the camera table parsed (navigation ready), the table's size, the
+// page's JS heap, and the server's peak memory (VmHWM of `panoptes serve` after the runs).
+const big = [];
+if (bigUrl) {
+  for (let r = 0; r < reps; r++) {
+    const page = await browser.newPage();
+    await page.goto(bigUrl + "?play=1");
+    await page.waitForFunction(() => window.panoptes && window.panoptes.cameraTable() && window.panoptes.firstFrameMs() !== null, { timeout: 180000, polling: 50 });
+    const t = await page.evaluate(() => ({ first: window.panoptes.firstFrameMs(), table: window.panoptes.cameraTable() }));
+    // Navigation works at that size: Right follows the graph.
+    const before = await page.evaluate(() => window.panoptes.state().camera);
+    const want = await page.evaluate((c) => window.panoptes.neighbour(c, "right"), before);
+    await page.keyboard.press("ArrowRight");
+    await page.waitForFunction((c) => window.panoptes.state().camera === c, { timeout: 10000 }, want);
+    const heap = (await page.metrics()).JSHeapUsedSize;
+    await page.close();
+    big.push({ first: t.first, fetched: t.table.loaded, parsed: t.table.parsed, bytes: t.table.bytes, heap });
+  }
+}
+const serverPeakMB = bigPid ? Number((fs.readFileSync(`/proc/${bigPid}/status`, "utf8").match(/VmHWM:\s+(\d+)/) || [0, 0])[1]) / 1024 : NaN;
+
 const version = await browser.version();
 await browser.close();
 console.log(`Database \`${dbPath}\`: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames of ` +
@@ -69,3 +93,12 @@ console.log("");
 console.log("| prefetch | switches/run | not shown before the next switch | p50 ms | p99 ms | max ms | shown on the next frame | first frame ms | kB fetched/switch | requests/switch |");
 console.log("|---|---|---|---|---|---|---|---|---|---|");
 for (const r of rows) console.log(r);
+if (big.length) {
+  const m = (k) => median(big.map((x) => x[k]));
+  console.log("");
+  console.log(`Opening \`${bigPath}\` (${bigPath.match(/\d+$/)[0]} cameras, no movies; ${reps} runs, medians):`);
+  console.log("");
+  console.log("| first frame ms | camera table fetched ms | parsed, navigation ready ms | table MB | page JS heap MB | serve peak RSS MB |");
+  console.log("|---|---|---|---|---|---|");
+  console.log(`| ${m("first").toFixed(0)} | ${m("fetched").toFixed(0)} | ${m("parsed").toFixed(0)} | ${(m("bytes") / 1e6).toFixed(1)} | ${(m("heap") / 1e6).toFixed(0)} | ${serverPeakMB.toFixed(0)} |`);
+}

@@ -107,6 +107,9 @@ struct Server::Impl {
 
   explicit Impl(ServerOptions o)
       : options(std::move(o)), db_root(options.database), player_root(options.player_dir) {
+    std::error_code ec;  // stat first: a manifest replaced meanwhile is then re-read on the first request
+    manifest_size = fs::file_size(db_root.dir() / store::kManifestFileName, ec);
+    manifest_mtime = fs::last_write_time(db_root.dir() / store::kManifestFileName, ec);
     db = std::make_shared<const store::Database>(store::Database::open(db_root.dir()));
     if (!fs::is_regular_file(player_root.dir() / "index.html"))
       throw FileError(player_root.dir().string(), "no index.html: not the web player's directory");
@@ -116,13 +119,28 @@ struct Server::Impl {
     if (options.log) options.log(utc_now() + " " + line);
   }
 
+  /// The manifest's size and mtime when `db` was opened: database.json re-opens the database only
+  /// when they changed (a running simulation's checkpoint), since an open reads and checks the whole
+  /// camera table (64 MB, about a second at 10^6 cameras).
+  std::uintmax_t manifest_size = 0;
+  fs::file_time_type manifest_mtime{};
+
   std::shared_ptr<const store::Database> database(bool reopen) {
     std::lock_guard lock(db_mutex);
     if (reopen) {
-      try {
-        db = std::make_shared<const store::Database>(store::Database::open(db_root.dir()));
-      } catch (const Error& e) {
-        log(std::string("reopen failed, keeping the previous manifest: ") + e.what());
+      std::error_code ec;
+      const fs::path manifest = db_root.dir() / store::kManifestFileName;
+      const auto size = fs::file_size(manifest, ec);
+      const auto mtime = fs::last_write_time(manifest, ec);
+      // A running database's status also depends on its writer being alive (store::Database::open):
+      // re-read it every time while it says running.
+      if (ec || size != manifest_size || mtime != manifest_mtime || db->status() == store::Status::running) {
+        try {
+          db = std::make_shared<const store::Database>(store::Database::open(db_root.dir()));
+          if (!ec) manifest_size = size, manifest_mtime = mtime;
+        } catch (const Error& e) {
+          log(std::string("reopen failed, keeping the previous manifest: ") + e.what());
+        }
       }
     }
     return db;

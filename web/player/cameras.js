@@ -42,7 +42,8 @@ export function parseCameraTable(buf, source = "camera table") {
     }
     if (rows === 1 && n !== 1) {  // one value shared by every camera (rigs share look_at, up, shell)
       const full = new T(n * comps);
-      for (let i = 0; i < n; i++) full.set(a, i * comps);
+      full.set(a, 0);
+      for (let len = comps; len < full.length; len *= 2) full.copyWithin(len, 0, Math.min(len, full.length - len));
       a = full;
     }
     out[name] = a;
