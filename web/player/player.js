@@ -516,7 +516,8 @@ async function main() {
 
 /// For tests and the benchmark (headless Chromium through puppeteer).
 window.panoptes = {
-  state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, playing: S.playing, zoom: S.zoom }),
+  state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, frames: S.db ? S.db.frames : 0, playing: S.playing, zoom: S.zoom }),
+  pause: () => setPlaying(false),
   shown: () => S.shown,
   switches: () => S.switches,
   traffic: () => ({ ...traffic }),

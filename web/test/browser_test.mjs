@@ -6,7 +6,7 @@ import fs from "node:fs";
 import http from "node:http";
 import path from "node:path";
 
-const [serveArg, siteDir, chromium, nodeModules] = process.argv.slice(2);
+const [serveArg, siteDir, chromium, nodeModules, liveUrl, liveDir] = process.argv.slice(2);
 const serveBase = serveArg.replace(/\?.*/, "");  // the URL printed by serve, without ?token=
 const serveUrl = serveArg;
 const require = createRequire(nodeModules + "/");
@@ -237,6 +237,32 @@ await check("export-web on a static server (no byte ranges) plays the same stamp
   await expectShown(page, graph[0][R], 0, 0, "ArrowRight");
   await page.keyboard.press("Tab");
   await expectShown(page, graph[0][R], 1, 0, "Tab");
+  await page.close();
+});
+
+await check("live database: new frames of a running simulation play without a reload", async () => {
+  // browser_test.sh holds the writer lock, so serve reports the database as running; a checkpoint is
+  // simulated by rewriting panoptes.json (atomically, as the writer does) with more frames written.
+  const manifestPath = path.join(liveDir, "panoptes.json");
+  const checkpoint = (frames) => {
+    const m = JSON.parse(fs.readFileSync(manifestPath, "utf8"));
+    m.status = "running";
+    m.frames_written = frames;
+    fs.writeFileSync(manifestPath + ".tmp", JSON.stringify(m));
+    fs.renameSync(manifestPath + ".tmp", manifestPath);
+  };
+  checkpoint(8);
+  const { page, errors } = await open(liveUrl + "?play=1");
+  assert.equal(await page.evaluate(() => window.panoptes.state().frames), 8);
+  await expectShown(page, 0, 0, null, "live, 8 frames");
+  checkpoint(16);
+  await page.waitForFunction(() => window.panoptes.state().frames === 16, { timeout: 8000 });
+  await page.waitForFunction(() => window.panoptes.shown().frame >= 8, { timeout: 5000 });
+  // Frame 8 on is there for sure only now: its stamp must be in the pixels.
+  await page.evaluate(() => window.panoptes.pause());
+  const shown = await page.evaluate(() => window.panoptes.shown());
+  await expectShown(page, 0, 0, shown.frame, "a frame of the new checkpoint");
+  assert.deepEqual(errors, []);
   await page.close();
 });
 

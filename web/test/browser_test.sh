@@ -32,8 +32,22 @@ done
 
 "$panoptes" export-web "$tmp/db" "$tmp/site" >/dev/null
 
+# A "running" database: this script holds its writer lock (fd 9) until it exits.
+"$panoptes" synth-db "$tmp/live" --cameras 2 --tasks 1 --frames 16 --size 160x120 --gop 4 >/dev/null
+exec 9>"$tmp/live/.panoptes.lock"
+flock -x 9
+"$panoptes" serve "$tmp/live" --port 0 > "$tmp/live.log" 2>&1 &
+pids+=($!)
+live_url=""
+for _ in $(seq 100); do
+  live_url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$tmp/live.log")
+  [ -n "$live_url" ] && break
+  sleep 0.1
+done
+[ -n "$live_url" ] || { echo "serve (live) did not start:"; cat "$tmp/live.log"; exit 1; }
+
 export NODE_PATH=$node_modules
-if ! node "$here/browser_test.mjs" "$url" "$tmp/site" "$chromium" "$node_modules"; then
+if ! node "$here/browser_test.mjs" "$url" "$tmp/site" "$chromium" "$node_modules" "$live_url" "$tmp/live"; then
   echo "--- serve log (last 30 lines)"; tail -30 "$tmp/serve.log"
   exit 1
 fi
