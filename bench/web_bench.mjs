@@ -42,7 +42,7 @@ async function run(browser, prefetch) {
   // it counts as +Infinity in the percentiles (printed as "> 330").
   const shown = switches.filter((s) => s.ms !== null), ms = switches.map((s) => (s.ms === null ? Infinity : s.ms));
   return {
-    n: switches.length, superseded: switches.length - shown.length, p50: median(ms), p99: pct(ms, 99), max: Math.max(...ms),
+    all: ms, n: switches.length, superseded: switches.length - shown.length, p50: median(ms), p99: pct(ms, 99), max: Math.max(...ms),
     hits: shown.filter((s) => s.hit).length / Math.max(1, switches.length),
     firstFrame, bytesPerSwitch: (after.bytes - before.bytes) / Math.max(1, switches.length),
     requestsPerSwitch: (after.requests - before.requests) / Math.max(1, switches.length),
@@ -56,10 +56,13 @@ for (const prefetch of (process.env.WEB_BENCH_ONLY_ON ? [true] : [true, false]))
   const runs = [];
   for (let r = 0; r < reps; r++) runs.push(await run(browser, prefetch));
   const m = (k) => median(runs.map((x) => x[k]));
-  rowsData.push({ p50: m("p50"), p99: m("p99"), firstFrame: m("firstFrame"), bytesPerSwitch: m("bytesPerSwitch") });
+  // p99 of one run of 40 switches is its worst switch; pooled over the runs it is the 99th percentile
+  // of all their switches (120 for 3 runs: the second worst).
+  const pooled = pct(runs.flatMap((x) => x.all), 99);
+  rowsData.push({ pooled, p50: m("p50"), p99: m("p99"), firstFrame: m("firstFrame"), bytesPerSwitch: m("bytesPerSwitch") });
   const f = (v, d = 1) => (Number.isFinite(v) ? v.toFixed(d) : "> 330");
   const range = (k) => `${f(Math.min(...runs.map((x) => x[k])))}–${f(Math.max(...runs.map((x) => x[k])))}`;
-  rows.push(`| ${prefetch ? "on" : "off"} | ${runs[0].n} | ${m("superseded")} | ${f(m("p50"))} | ${f(m("p99"))} (${range("p99")}) | ${f(m("max"))} | ` +
+  rows.push(`| ${prefetch ? "on" : "off"} | ${runs[0].n} | ${m("superseded")} | ${f(m("p50"))} | ${f(m("p99"))} (${range("p99")}) | ${f(pooled)} | ${f(m("max"))} | ` +
             `${(100 * m("hits")).toFixed(0)} % | ${m("firstFrame").toFixed(0)} | ${(m("bytesPerSwitch") / 1024).toFixed(1)} | ${m("requestsPerSwitch").toFixed(1)} |`);
 }
 
@@ -91,15 +94,16 @@ console.log(`Database \`${dbPath}\`: ${db.cameras.count} cameras × ${db.tasks.l
             `${db.image.width}×${db.image.height} at ${db.fps} fps (gop ${db.gop}); ${version} headless, ${reps} runs per row ` +
             `(medians; p99 range over runs); ${os.cpus()[0].model}, ${os.cpus().length} cores, load average at the end ${os.loadavg().map((x) => x.toFixed(1)).join(" ")}.`);
 console.log("");
-console.log("| prefetch | switches/run | not shown before the next switch | p50 ms | p99 ms | max ms | shown on the next frame | first frame ms | kB fetched/switch | requests/switch |");
-console.log("|---|---|---|---|---|---|---|---|---|---|");
+console.log("| prefetch | switches/run | not shown before the next switch | p50 ms | p99 ms (range over runs) | p99 ms, all runs pooled | max ms | shown on the next frame | first frame ms | kB fetched/switch | requests/switch |");
+console.log("|---|---|---|---|---|---|---|---|---|---|---|");
 for (const r of rows) console.log(r);
 // Next to the targets of issue 13 (the prefetch-on row's medians).
 const on = rowsData[0];
 if (on) {
   const verdict = (ok) => (ok ? "met" : "NOT met");
   console.log("");
-  console.log(`Targets: switch p99 with prefetch < 33 ms: ${Number.isFinite(on.p99) ? on.p99.toFixed(1) + " ms" : "> 330 ms"} (${verdict(on.p99 < 33)}); ` +
+  const ms = (v) => (Number.isFinite(v) ? v.toFixed(1) + " ms" : "> 330 ms");
+  console.log(`Targets: switch p99 with prefetch < 33 ms: ${ms(on.p99)} median of runs, ${ms(on.pooled)} pooled (${verdict(on.pooled < 33)}); ` +
               `p50 ${on.p50.toFixed(1)} ms; time to first frame ${on.firstFrame.toFixed(0)} ms; ${(on.bytesPerSwitch / 1024).toFixed(1)} kB fetched per switch. ` +
               `Load average during the run: ${os.loadavg()[0].toFixed(1)} (on a loaded machine the tail measures the scheduler, not the player).`);
 }

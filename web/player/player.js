@@ -133,6 +133,7 @@ function select(camera, task, command) {
   S.pending = { t0: performance.now(), command, from: [S.camera, S.task], diag };
   S.camera = camera;
   S.task = task;
+  releaseDecoders();
   pump();
   return true;
 }
@@ -176,6 +177,13 @@ function startBatch(c, t, g, batch) {
   busy.add(key);
   inflight++;
   stream(c, t).ensure(g, cache, batch, options.fetchAhead).finally(() => { busy.delete(key); inflight--; pump(); });
+}
+/// Closes the VideoDecoder of every stream that is neither current nor a neighbour any more and has
+/// no decode in flight (a decoder holds threads and buffers; 96 streams may be open). A stream that
+/// becomes hot again configures a new one.
+function releaseDecoders() {
+  const hot = new Set([`${S.camera}/${S.task}`, ...neighbourSelections(S.camera, S.task).map(([c, t]) => `${c}/${t}`)]);
+  for (const [key, st] of streams) if (!hot.has(key) && st.decoder && st.inflight.size === 0) st.close();
 }
 function pump() {
   if (!S.db) return;
