@@ -8,7 +8,7 @@ const browser = await puppeteer.launch({ executablePath: chromium, headless: tru
 const page = await browser.newPage();
 await page.setViewport({ width: 1000, height: 860 });
 await page.goto(url + "?play=1&camera=30&task=2&frame=11");
-await page.waitForFunction(() => window.panoptes && window.panoptes.shown(), { timeout: 30000 });
+await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded(), { timeout: 30000 });
 for (const key of ["ArrowRight", "ArrowRight", "ArrowUp"]) {
   await new Promise((r) => setTimeout(r, 700));
   await page.keyboard.press(key);
