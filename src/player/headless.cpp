@@ -78,16 +78,7 @@ bool apply(Engine& engine, const ScriptCommand& c, Look& look) {
   using K = ScriptCommand::Kind;
   switch (c.kind) {
     case K::look: look = clamped(c.look); return true;
-    case K::walk: {
-      // The world view direction is kept across the walk: re-express it in the new camera's frame.
-      const store::Manifest& m = engine.manifest();
-      const int from = engine.selection().camera;
-      const int to = walk_target(m, from, look, c.walk);
-      if (to < 0 || !engine.jump_to_camera(to)) return false;
-      const ViewBasis view = look_basis(camera_basis(m.cameras[std::size_t(from)]), look);
-      look = look_towards(camera_basis(m.cameras[std::size_t(to)]), view.forward, look.fov_deg);
-      return true;
-    }
+    case K::walk: return walk_keeping_view(engine, look, c.walk);
     case K::key: return engine.apply(c.action);
     case K::seek: engine.seek(c.value); return c.value >= 0 && c.value < engine.frame_count();
     case K::camera: return engine.jump_to_camera(c.value);

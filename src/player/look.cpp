@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "player/engine.hpp"
+
 namespace panoptes::player {
 
 namespace {
@@ -103,6 +105,16 @@ int walk_target(const store::Manifest& m, int camera, const Look& look, Walk wal
     if (c > best_cos) best_cos = c, best = id;
   }
   return best;
+}
+
+bool walk_keeping_view(Engine& engine, Look& look, Walk walk) {
+  const store::Manifest& m = engine.manifest();
+  const int from = engine.selection().camera;
+  const int to = walk_target(m, from, look, walk);
+  if (to < 0 || !engine.jump_to_camera(to)) return false;
+  const ViewBasis view = look_basis(camera_basis(m.cameras[std::size_t(from)]), look);
+  look = look_towards(camera_basis(m.cameras[std::size_t(to)]), view.forward, look.fov_deg);
+  return true;
 }
 
 void perspective_cutout(const Image& src, const ViewBasis& cam, const Look& look, Image& out) {

@@ -11,6 +11,8 @@
 
 namespace panoptes::player {
 
+class Engine;
+
 /// Where the viewer looks inside a 360° frame: yaw (degrees, positive to the camera's right), pitch
 /// (degrees, positive up) relative to the camera's forward direction, and the cut-out's vertical field
 /// of view (degrees).
@@ -47,6 +49,10 @@ enum class Walk { forward, back, left, right, up, down };
 /// aligned with the walk's world direction (angle below 60°), or −1. Lattice graphs have their
 /// neighbours on the world axes, so facing roughly along an axis walks along it.
 int walk_target(const store::Manifest& manifest, int camera, const Look& look, Walk walk);
+
+/// Walks to walk_target() and keeps the world view direction (the look is re-expressed in the new
+/// camera's frame). False (nothing changes) when there is no camera that way.
+bool walk_keeping_view(Engine& engine, Look& look, Walk walk);
 
 /// Renders the perspective view `look` (square pixels, vertical field of view look.fov_deg) out of an
 /// equirectangular RGB(A) frame seen from a camera with frame `camera`, into `out` (its size and channel

@@ -99,6 +99,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       ImGui::Text("camera %d%s%s   lat %+.0f  lon %+.0f%s", sel.camera, cam.labels.patch.empty() ? "" : " ",
                   cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg,
                   info.shell_count > 1 ? ("   shell " + std::to_string(cam.labels.shell)).c_str() : "");
+      if (!info.look_label.empty()) ImGui::TextUnformatted(info.look_label.c_str());
       const std::string params = format_parameters(m, task);
       ImGui::Text("task %d of %d: %s%s%s", sel.task, int(m.tasks.size()), task.name.c_str(),
                   params.empty() ? "" : "   ", params.c_str());

@@ -35,6 +35,7 @@ struct HudInfo {
   std::string status_message;
   std::vector<int> neighbours;    ///< graph neighbours of the current camera (mini-map)
   int shell_count = 1;            ///< camera shells of the rig (the shell is shown only if > 1)
+  std::string look_label;         ///< 360° streams: lattice position and view (empty otherwise)
 };
 
 /// What the user did in the HUD this frame.
