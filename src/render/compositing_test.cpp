@@ -154,10 +154,10 @@ TEST(Compositing, RejectsInconsistentInput) {
 TEST(Compositing, CamerasInsideTheDomainMatchTheSingleBrickImage) {
   const Scene sc;
   const camera::Camera inside[] = {
-      camera::Camera({-3, 2, 1}, {10, 4, 0}, {0, 0, 1}, 90, 48, 40),
-      camera::Camera({4, -6, -2}, {4, 10, -2}, {0, 0, 1}, 60, 40, 40, camera::Projection::equirectangular),
+      camera::Camera({-3, 2, 1}, {10, 4, 0}, {0, 0, 1}, 90, 36, 30),
+      camera::Camera({4, -6, -2}, {4, 10, -2}, {0, 0, 1}, 60, 48, 24, camera::Projection::equirectangular),
       // On a brick face of the 2- and 4-slab decompositions along z (z = 0 is point 16 of 33).
-      camera::Camera({1, 1, 0}, {-5, 1, 3}, {0, 0, 1}, 60, 64, 32, camera::Projection::equirectangular),
+      camera::Camera({1, 1, 0}, {-5, 1, 3}, {0, 0, 1}, 60, 48, 24, camera::Projection::equirectangular),
   };
   for (std::size_t ci = 0; ci < std::size(inside); ++ci) {
     const camera::Camera& cam = inside[ci];

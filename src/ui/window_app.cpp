@@ -458,6 +458,11 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   h.status = shown.status;
   h.shell_count = shell_count_;
   h.status_message = shown.message;
+  // The lattice mini-map's arrow: where the viewer looks (the camera's forward outside 360° streams).
+  h.view_direction =
+      player::look_basis(player::camera_basis(engine_.manifest().cameras[std::size_t(shown.selection.camera)]),
+                         equirect_ ? look_ : player::Look{})
+          .forward;
   if (equirect_) {
     char text[160];
     const auto node = player::lattice_node(lattice_, shown.selection.camera);
