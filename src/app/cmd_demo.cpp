@@ -72,6 +72,11 @@ height = 512
 [rig]
 spec = "yinyang"       # the paper's 130 cameras: 5 x 13 cells per patch
 up_axis = "z_down"     # z is depth: the sky is -z (poles, latitudes, image up and the Up key follow it)
+# Cameras INSIDE the volume instead (docs/cameras.md): a 4x4x3 lattice of 360-degree cameras; the player
+# then shows a look-around (left-drag, wheel) and the arrows / PgUp / PgDn walk between lattice nodes.
+# Use a 2:1 image (e.g. width = 1024, height = 512). Full example: examples/lattice_inside.toml.
+# spec = "lattice:4x4x3@0.05"
+# projection = "equirectangular"
 
 [schedule]
 every_steps = 10       # 48 snapshots

@@ -9,6 +9,7 @@
 #include "app/command.hpp"
 #include "core/error.hpp"
 #include "player/headless.hpp"
+#include "player/look.hpp"
 #include "video/movie_writer.hpp"
 
 namespace {
@@ -19,6 +20,7 @@ struct ExportArgs {
   int camera = 0, task = 0, frame = 0;
   int crf = -1;
   bool paused = false;
+  std::string view_size = "1280x720";
 };
 
 void run_export(const ExportArgs& a) {
@@ -45,8 +47,20 @@ void run_export(const ExportArgs& a) {
   const auto parent = std::filesystem::path(a.out).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent))
     throw panoptes::FileError(a.out, "the output directory does not exist");
+  // 360-degree databases: the movie shows the script's look (look=) cut out of each frame, as the window does.
+  const bool equirect = player::is_equirectangular(manifest);
+  int view_w = 0, view_h = 0;
+  if (equirect && (std::sscanf(a.view_size.c_str(), "%dx%d", &view_w, &view_h) != 2 || view_w < 16 || view_h < 16 ||
+                   view_w > 8192 || view_h > 8192 || view_w % 2 || view_h % 2))
+    throw panoptes::Error("--view-size \"" + a.view_size + "\": expected an even WIDTHxHEIGHT between 16 and 8192, e.g. 1280x720");
   o.on_frame = [&](const player::DisplayedFrame& f) {
-    const auto image = panoptes::video::MovieReader::to_rgba(*f.shown.frame);
+    auto image = panoptes::video::MovieReader::to_rgba(*f.shown.frame);
+    if (equirect) {
+      panoptes::Image view(view_w, view_h, image.channels);
+      player::perspective_cutout(image, player::camera_basis(manifest.cameras[std::size_t(f.shown.selection.camera)]),
+                                 f.look, view);
+      image = std::move(view);
+    }
     if (!writer)
       writer = std::make_unique<panoptes::video::MovieWriter>(a.out, image.width, image.height, settings);
     writer->append(image);
@@ -74,6 +88,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--task", args->task, "Start task id")->check(CLI::NonNegativeNumber);
   sub->add_option("--frame", args->frame, "Start frame")->check(CLI::NonNegativeNumber);
   sub->add_flag("--paused", args->paused, "Start paused (the script's Space starts playback)");
+  sub->add_option("--view-size", args->view_size,
+                  "360-degree databases: size of the perspective view cut out of each frame (the script's look=)")
+      ->capture_default_str();
   sub->add_option("--crf", args->crf, "x264 constant rate factor 0..51 (default: the database's)")
       ->check(CLI::Range(0, 51));
   sub->callback([args] { run_export(*args); });

@@ -50,6 +50,7 @@ struct Args {
   int crf = -1;
   bool force = false;
   std::string up_axis = "z_up";
+  std::string projection = "perspective";
   bool quiet = false;
 };
 
@@ -86,6 +87,7 @@ std::string recorded_command_line(const Args& a) {
   if (a.no_outline) cl += " --no-outline";
   if (a.crf >= 0) cl += " --crf " + std::to_string(a.crf);
   cl += " --up-axis " + a.up_axis;
+  if (a.projection != "perspective") cl += " --projection " + a.projection;
   if (!a.title.empty()) cl += " --title " + shell_word(a.title);
   cl += " --out " + shell_word(a.out);
   return cl;
@@ -281,10 +283,15 @@ void run(const Args& a, const std::string& command_line) {
   if (a.crf >= 0) man.video.crf = a.crf;
   man.rig.kind = rig.spec;
   man.rig.parameters = {{"spec", rig.spec}, {"shells", rig.shell_count}};
+  // Additive (issue 14): players read the projection and the lattice shape from here; older readers ignore them.
+  const camera::Projection projection = camera::parse_projection(a.projection);
+  if (projection != camera::Projection::perspective) man.rig.parameters["projection"] = a.projection;
+  if (rig.is_lattice()) man.rig.parameters["lattice"] = rig.lattice;
+  if (rig.path) man.rig.parameters["path"] = true;
   std::vector<camera::Camera> cams;
   for (int c = 0; c < rig.size(); ++c) {
     const camera::RigCamera& rc = rig.cameras[std::size_t(c)];
-    cams.push_back(rig.camera(c, width, height));
+    cams.push_back(rig.camera(c, width, height, projection));
     store::CameraEntry e;
     e.id = c;
     e.position = rc.position;
@@ -336,7 +343,7 @@ void run(const Args& a, const std::string& command_line) {
   render::RenderOptions opt;
   opt.sample_distance = a.sample_distance;
   render::OutlineStyle outline;
-  outline.enabled = !a.no_outline;
+  outline.enabled = !a.no_outline && projection == camera::Projection::perspective;  // box edges curve in 360° frames
   const render::Rgb background{float(bg[0]), float(bg[1]), float(bg[2])};
   render::RunningMax reference;
   std::vector<render::PartialImage> partials(tasks.size());
@@ -413,7 +420,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("VOLUME", args->inputs, "Volume file(s) or glob pattern(s), one frame each, in order")->required();
   sub->add_option("--rig", args->rig,
                   "Camera rig: yinyang[:NTxNP], latlon[:NLATxNLON[+poles]], fibonacci[:N], file:PATH; "
-                  "optional @R1,R2,... shell radii in bounding-sphere radii")
+                  "optional @R1,R2,... shell radii in bounding-sphere radii; or cameras inside the volume: "
+                  "lattice:NXxNYxNZ[@MARGIN] (lattice nodes, walk along world axes) or path:FILE (x y z per line)")
       ->capture_default_str();
   sub->add_option("--task", args->tasks,
                   "Visualization task (repeatable): volume:PRESET[:LO:HI], iso:VALUE, slice:x|y|z:FRACTION[:PRESET[:LO:HI]]. "
@@ -438,6 +446,11 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                   "Which way is up in the volume: z_up, or z_down (z is depth, as in seismology); the rig's poles, "
                   "latitudes, the images' up and the player's Up key follow it")
       ->check(CLI::IsMember({"z_up", "z_down"}))
+      ->capture_default_str();
+  sub->add_option("--projection", args->projection,
+                  "perspective, or equirectangular: 360x180-degree frames (use a 2:1 --size, e.g. 1920x960) that the "
+                  "player looks around in; no outline box is drawn then")
+      ->check(CLI::IsMember({"perspective", "equirectangular"}))
       ->capture_default_str();
   sub->add_flag("-q,--quiet", args->quiet, "No progress output");
   sub->callback([args] {

@@ -28,6 +28,7 @@ struct Args {
   int gop = 10, crf = -1, threads = 0;
   std::string preset, title = "synthetic database";
   bool force = false;
+  std::string lattice, projection = "perspective";
 };
 
 void run(const Args& a, const std::string& command_line) {
@@ -43,6 +44,14 @@ void run(const Args& a, const std::string& command_line) {
   o.width = std::stoi(m[1]);
   o.height = std::stoi(m[2]);
   o.overwrite = a.overwrite;
+  if (!a.lattice.empty()) {
+    static const std::regex lattice_re(R"((\d{1,4})x(\d{1,4})x(\d{1,4}))");
+    std::smatch l;
+    if (!std::regex_match(a.lattice, l, lattice_re) || std::stoi(l[1]) < 1 || std::stoi(l[2]) < 1 || std::stoi(l[3]) < 1)
+      throw Error("--lattice \"" + a.lattice + "\": expected NXxNYxNZ with positive counts, e.g. 4x4x3");
+    o.lattice = {std::stoi(l[1]), std::stoi(l[2]), std::stoi(l[3])};
+  }
+  o.projection = a.projection;
   o.threads = a.threads;
   o.title = a.title;
   o.command_line = command_line;
@@ -50,7 +59,8 @@ void run(const Args& a, const std::string& command_line) {
   if (a.crf >= 0) o.video.crf = a.crf;
   if (!a.preset.empty()) o.video.preset = a.preset;
   o.video.validate();
-  const long long streams = checked_product(a.cameras, a.tasks, "--cameras x --tasks (movies)", INT_MAX);
+  const long long cameras = o.lattice[0] > 0 ? (long long)o.lattice[0] * o.lattice[1] * o.lattice[2] : a.cameras;
+  const long long streams = checked_product(cameras, a.tasks, "--cameras x --tasks (movies)", INT_MAX);
   if (o.width > 16384 || o.height > 16384)
     throw Error("--size \"" + a.size + "\": expected at most 16384 pixels per side");
   if (!a.force) {
@@ -61,7 +71,7 @@ void run(const Args& a, const std::string& command_line) {
     MemoryEstimate e;
     e.add("encoders", std::max(parallel, 1) * (video::open_writer_bytes(px, o.video.gop) +
                                                video::live_encoder_bytes(px) + px * 3));
-    e.add("manifest", double(a.cameras) * 1500 + double(streams) * 16);
+    e.add("manifest", double(cameras) * 1500 + double(streams) * 16);
     check_memory(e, available_memory(), 1, "this synthetic database", "pass --force");
   }
 
@@ -76,7 +86,7 @@ void run(const Args& a, const std::string& command_line) {
   if (tty) std::fprintf(stderr, "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("wrote %s: %d cameras x %d tasks = %lld streams, %d frames of %dx%d each, in %.2f s (%.0f streams/s)\n",
-              a.out.c_str(), a.cameras, a.tasks, streams, a.frames, o.width, o.height, seconds, streams / seconds);
+              a.out.c_str(), int(cameras), a.tasks, streams, a.frames, o.width, o.height, seconds, streams / seconds);
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
@@ -100,12 +110,19 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--preset", args->preset, "x264 preset (default: the video default)");
   sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->capture_default_str();
   sub->add_option("--title", args->title, "Title stored in the manifest")->capture_default_str();
+  sub->add_option("--lattice", args->lattice,
+                  "Cameras on an NXxNYxNZ lattice inside the domain with world-axis navigation (replaces --cameras)");
+  sub->add_option("--projection", args->projection, "Projection recorded in the manifest: perspective or equirectangular")
+      ->check(CLI::IsMember({"perspective", "equirectangular"}))
+      ->capture_default_str();
   sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
   sub->callback([args] {
     panoptes::install_stop_handlers();
     // The effective settings, so the provenance reproduces the database.
     const std::string command_line = "panoptes synth-db " + args->out + " --cameras " + std::to_string(args->cameras) + " --tasks " +
-                   std::to_string(args->tasks) + " --frames " + std::to_string(args->frames) + " --size " + args->size;
+                   std::to_string(args->tasks) + " --frames " + std::to_string(args->frames) + " --size " + args->size +
+                   (args->lattice.empty() ? "" : " --lattice " + args->lattice) +
+                   (args->projection == "perspective" ? "" : " --projection " + args->projection);
     run(*args, command_line);
   });
 });

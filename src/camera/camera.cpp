@@ -8,6 +8,16 @@
 
 namespace panoptes::camera {
 
+std::string_view to_string(Projection projection) {
+  return projection == Projection::equirectangular ? "equirectangular" : "perspective";
+}
+
+Projection parse_projection(std::string_view text) {
+  if (text == "perspective") return Projection::perspective;
+  if (text == "equirectangular") return Projection::equirectangular;
+  throw Error("projection \"" + std::string(text) + "\"; expected \"perspective\" or \"equirectangular\"");
+}
+
 Vec3 Camera::fallback_up(const Vec3& forward) {
   // Choose the world axis least aligned with the view direction: deterministic and never parallel.
   const double ax = std::abs(forward.x), ay = std::abs(forward.y), az = std::abs(forward.z);
@@ -16,8 +26,10 @@ Vec3 Camera::fallback_up(const Vec3& forward) {
   return {1, 0, 0};
 }
 
-Camera::Camera(Vec3 position, Vec3 look_at, Vec3 up, double fov_y_degrees, int width, int height)
-    : position_(position), look_at_(look_at), fov_y_deg_(fov_y_degrees), width_(width), height_(height) {
+Camera::Camera(Vec3 position, Vec3 look_at, Vec3 up, double fov_y_degrees, int width, int height,
+               Projection projection)
+    : position_(position), look_at_(look_at), fov_y_deg_(fov_y_degrees), width_(width), height_(height),
+      projection_(projection) {
   const Vec3 d = look_at - position;
   if (norm(d) <= 0) throw Error("camera: position equals look-at point; expected distinct points");
   if (!(fov_y_degrees > 0 && fov_y_degrees < 180))
@@ -35,6 +47,12 @@ Camera::Camera(Vec3 position, Vec3 look_at, Vec3 up, double fov_y_degrees, int w
 }
 
 Ray Camera::ray(double px, double py) const {
+  if (projection_ == Projection::equirectangular) {
+    const double lon = (2.0 * px / width_ - 1.0) * std::numbers::pi;
+    const double lat = (0.5 - py / height_) * std::numbers::pi;
+    const double c = std::cos(lat);
+    return {position_, forward_ * (c * std::cos(lon)) + right_ * (c * std::sin(lon)) + up_ * std::sin(lat)};
+  }
   const double aspect = double(width_) / height_;
   const double sx = (2.0 * px / width_ - 1.0) * tan_half_ * aspect;
   const double sy = (1.0 - 2.0 * py / height_) * tan_half_;
@@ -44,6 +62,14 @@ Ray Camera::ray(double px, double py) const {
 bool Camera::project(const Vec3& p, double& px, double& py) const {
   const Vec3 d = p - position_;
   const double z = dot(d, forward_);
+  if (projection_ == Projection::equirectangular) {
+    const double x = dot(d, right_), y = dot(d, up_);
+    const double h = std::hypot(x, z);
+    if (h == 0 && y == 0) return false;
+    px = (std::atan2(x, z) / std::numbers::pi + 1.0) * 0.5 * width_;
+    py = (0.5 - std::atan2(y, h) / std::numbers::pi) * height_;
+    return true;
+  }
   if (z <= 0) return false;
   const double aspect = double(width_) / height_;
   const double sx = dot(d, right_) / z, sy = dot(d, up_) / z;

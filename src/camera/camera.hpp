@@ -1,8 +1,20 @@
 #pragma once
 // The pinhole camera: position, look-at, up, vertical field of view and image size.
+#include <string_view>
+
 #include "core/vec3.hpp"
 
 namespace panoptes::camera {
+
+/// How image points map to ray directions.
+enum class Projection {
+  perspective,      ///< pinhole: fov_y over the image height
+  equirectangular,  ///< 360° x 180°: column → longitude, row → latitude in the camera's frame
+};
+/// "perspective" / "equirectangular".
+std::string_view to_string(Projection projection);
+/// Parses "perspective" or "equirectangular"; throws panoptes::Error naming the text otherwise.
+Projection parse_projection(std::string_view text);
 
 /// A ray with unit direction.
 struct Ray {
@@ -22,8 +34,11 @@ class Camera {
  public:
   Camera() = default;
   /// Throws panoptes::Error if position == look_at, fov is not in (0, 180) degrees or the
-  /// image size is not positive.
-  Camera(Vec3 position, Vec3 look_at, Vec3 up, double fov_y_degrees, int width, int height);
+  /// image size is not positive. An equirectangular camera ignores the field of view (it sees all
+  /// directions): longitude 0 (the forward direction) is the image's centre column, longitude grows
+  /// to the right (towards right()), latitude +90° (up()) is the top row.
+  Camera(Vec3 position, Vec3 look_at, Vec3 up, double fov_y_degrees, int width, int height,
+         Projection projection = Projection::perspective);
 
   const Vec3& position() const { return position_; }
   const Vec3& look_at() const { return look_at_; }
@@ -33,10 +48,14 @@ class Camera {
   double fov_y_degrees() const { return fov_y_deg_; }
   int width() const { return width_; }
   int height() const { return height_; }
+  Projection projection() const { return projection_; }
 
   /// The ray through image point (px, py) in pixel coordinates (pixel centre of column i is i + 0.5).
+  /// The single source of rays: renderers march whatever it returns, whatever the projection.
+  /// Equirectangular: longitude = 360°·px/width − 180°, latitude = 90° − 180°·py/height.
   Ray ray(double px, double py) const;
-  /// Projects a world point to pixel coordinates; returns false if it is behind the camera.
+  /// Projects a world point to pixel coordinates; returns false if it is behind a perspective camera
+  /// (or, equirectangular, at the camera's position).
   bool project(const Vec3& p, double& px, double& py) const;
 
   /// The axis used when the requested up is parallel to the viewing direction.
@@ -48,6 +67,7 @@ class Camera {
   double fov_y_deg_ = 45;
   double tan_half_ = 0.41421356237309503;  // tan(fov/2)
   int width_ = 1, height_ = 1;
+  Projection projection_ = Projection::perspective;
 };
 
 }  // namespace panoptes::camera

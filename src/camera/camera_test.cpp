@@ -36,3 +36,27 @@ TEST(Camera, RejectsBadParameters) {
   EXPECT_THROW(Camera({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 180, 16, 16), Error);
   EXPECT_THROW(Camera({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 45, 0, 16), Error);
 }
+
+TEST(Equirectangular, RaysAndProjectionAgreeAndCoverTheSphere) {
+  const Camera cam({1, 2, 3}, {1, 12, 3}, {0, 0, 1}, 45, 360, 180, Projection::equirectangular);
+  // The centre column looks forward, the right quarter to the right, the top row up, the edges behind.
+  EXPECT_NEAR(cam.ray(180, 90).direction.y, 1, 1e-12);
+  EXPECT_NEAR(cam.ray(270, 90).direction.x, 1, 1e-12);
+  EXPECT_NEAR(cam.ray(90, 90).direction.x, -1, 1e-12);
+  EXPECT_NEAR(cam.ray(0, 90).direction.y, -1, 1e-12);
+  EXPECT_NEAR(cam.ray(123, 0).direction.z, 1, 1e-12);
+  for (double px : {0.5, 17.25, 180.0, 300.5, 359.5})
+    for (double py : {0.5, 45.0, 90.5, 179.5}) {
+      const Ray r = cam.ray(px, py);
+      EXPECT_NEAR(norm(r.direction), 1, 1e-12);
+      double qx = 0, qy = 0;
+      ASSERT_TRUE(cam.project(r.origin + r.direction * 7.5, qx, qy));
+      EXPECT_NEAR(qx, px, 1e-9);
+      EXPECT_NEAR(qy, py, 1e-9);
+    }
+  double qx, qy;
+  EXPECT_FALSE(cam.project({1, 2, 3}, qx, qy));
+  EXPECT_EQ(parse_projection("equirectangular"), Projection::equirectangular);
+  EXPECT_EQ(to_string(Projection::perspective), "perspective");
+  EXPECT_THROW(parse_projection("fisheye"), Error);
+}

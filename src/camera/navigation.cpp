@@ -7,6 +7,7 @@
 #include <numbers>
 #include <string>
 
+#include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 
 namespace panoptes::camera {
@@ -190,6 +191,8 @@ NavigationGraph build_navigation_graph(const Rig& rig, const GraphOptions& optio
   if (!(options.reversible_tolerance >= 0))
     throw Error("navigation graph: reversible tolerance " + std::to_string(options.reversible_tolerance) +
                 "; expected >= 0");
+  if (rig.is_lattice()) return build_lattice_graph(rig);
+  if (rig.path) return build_path_graph(rig);
   const int n = rig.size();
   NavigationGraph graph;
   graph.neighbours.resize(n);

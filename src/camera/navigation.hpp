@@ -74,6 +74,7 @@ class CameraLocator {
   std::vector<Shell> shells_;
 };
 
+/// Lattice and path rigs (Rig::is_lattice, Rig::path) get their world-axis graph (camera/volume_rigs.hpp).
 /// Builds the graph in O(N · cameras per query cap): each camera searches only cameras of its own
 /// shell in a growing cap around it. Cameras at (numerically) the same direction as camera i are
 /// never its neighbours, and no camera is its own neighbour.

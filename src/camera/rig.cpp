@@ -143,13 +143,14 @@ Rig place_on_shells(const std::vector<PatternPoint>& pattern, const Domain& doma
   return rig;
 }
 
-Camera Rig::camera(int id, int width, int height) const {
+Camera Rig::camera(int id, int width, int height, Projection projection) const {
   if (id < 0 || id >= size())
     throw Error("rig: camera id " + std::to_string(id) + " out of range; expected 0.." + std::to_string(size() - 1));
   if (width <= 0 || height <= 0)
     throw Error("rig: image size " + std::to_string(width) + "x" + std::to_string(height) + "; expected positive");
   const RigCamera& c = cameras[id];
-  return Camera(c.position, c.look_at, c.up, fov_y_for_aspect(c.fov_y_degrees, double(width) / height), width, height);
+  return Camera(c.position, c.look_at, c.up, fov_y_for_aspect(c.fov_y_degrees, double(width) / height), width, height,
+                projection);
 }
 
 Vec3 Rig::direction(int id) const { return normalize(cameras[id].position - center); }

@@ -12,6 +12,7 @@
 //     south, each from longitude −180° eastwards, then the south pole.
 //   - fibonacci N: k = 0..N−1 from the north (z = 1 − (2k+1)/N) southwards.
 //   - file: the order of the file.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -71,11 +72,17 @@ struct Rig {
   std::vector<RigCamera> cameras;
   int shell_count = 1;
   UpAxis up_axis = UpAxis::z_up;  ///< the domain's sky: poles, latitudes and up vectors follow it
+  /// Lattice rigs (camera/volume_rigs.hpp): nodes along world x, y, z; all zero for other rigs.
+  std::array<int, 3> lattice{0, 0, 0};
+  bool path = false;  ///< a path rig (cameras along a polyline; graph in = next, out = previous)
+
+  bool is_lattice() const { return lattice[0] > 0; }
 
   int size() const { return int(cameras.size()); }
   /// A pinhole camera for camera `id` rendering width x height pixels; the field of view is widened
   /// for portrait images (fov_y_for_aspect). Throws panoptes::Error for a bad id or size.
-  Camera camera(int id, int width, int height) const;
+  /// An equirectangular camera keeps the position and orientation (the field of view does not apply).
+  Camera camera(int id, int width, int height, Projection projection = Projection::perspective) const;
   /// Unit direction from the centre to camera `id`.
   Vec3 direction(int id) const;
 };

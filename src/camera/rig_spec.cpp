@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 #include "core/file_read.hpp"
 
@@ -21,7 +22,8 @@ constexpr long long kMaxCameras = 10'000'000;          // over all shells
 constexpr std::size_t kMaxShells = 1000;
 const char* const kSyntax =
     "expected yinyang[:NTxNP], latlon[:NLATxNLON[+poles]], fibonacci[:N], file:PATH or the path of an existing "
-    "camera file, optionally followed by @R1,R2,... (shell radii in bounding-sphere radii)";
+    "camera file, optionally followed by @R1,R2,... (shell radii in bounding-sphere radii), or lattice:NXxNYxNZ[@MARGIN] "
+    "or path:FILE (cameras inside the volume)";
 
 [[noreturn]] void bad_spec(std::string_view text, const std::string& why) {
   throw Error("rig spec '" + std::string(text) + "': " + why + "; " + kSyntax);
@@ -64,6 +66,38 @@ RigSpec RigSpec::parse(std::string_view text) {
   RigSpec spec;
   std::string_view s = text;
   if (s.empty()) bad_spec(text, "empty");
+  if (s.starts_with("lattice")) {
+    spec.kind = Kind::lattice;
+    spec.radii.clear();
+    std::string_view rest = s.substr(7);
+    if (const auto at = rest.find('@'); at != std::string_view::npos) {
+      spec.margin = parse_double(text, rest.substr(at + 1), "lattice margin");
+      if (!(spec.margin >= 0 && spec.margin < 0.5))
+        bad_spec(text, "lattice margin " + format_double(spec.margin) + " is not in [0, 0.5)");
+      rest = rest.substr(0, at);
+    }
+    if (rest.empty()) return spec;
+    if (!rest.starts_with(":") || rest.size() == 1) bad_spec(text, "expected lattice:NXxNYxNZ");
+    rest.remove_prefix(1);
+    const auto x1 = rest.find('x');
+    const auto x2 = x1 == std::string_view::npos ? x1 : rest.find('x', x1 + 1);
+    if (x2 == std::string_view::npos) bad_spec(text, "lattice size '" + std::string(rest) + "' is not of the form NXxNYxNZ");
+    spec.lattice = {parse_int(text, rest.substr(0, x1), "lattice count"),
+                    parse_int(text, rest.substr(x1 + 1, x2 - x1 - 1), "lattice count"),
+                    parse_int(text, rest.substr(x2 + 1), "lattice count")};
+    const long long plane = 1LL * spec.lattice[0] * spec.lattice[1];  // checked first: the triple product may overflow
+    const long long total = plane > kMaxCameras ? plane : plane * spec.lattice[2];
+    if (total > kMaxCameras)
+      bad_spec(text, std::to_string(total) + " cameras is more than the limit of " + std::to_string(kMaxCameras));
+    return spec;
+  }
+  if (s.starts_with("path:")) {
+    spec.kind = Kind::path;
+    spec.radii.clear();
+    spec.path = std::string(s.substr(5));
+    if (spec.path.empty()) bad_spec(text, "no file name after 'path:'");
+    return spec;
+  }
   const bool shells_prefix = s.starts_with("shells:");
   if (shells_prefix) s.remove_prefix(7);
   if (s.starts_with("file:") || !(s.starts_with("yinyang") || s.starts_with("latlon") || s.starts_with("fibonacci"))) {
@@ -151,6 +185,8 @@ long long RigSpec::cameras_per_shell() const {
     case Kind::latlon: return 1LL * rows * columns + (poles ? 2 : 0);
     case Kind::fibonacci: return count;
     case Kind::file: return 0;
+    case Kind::lattice: return 1LL * lattice[0] * lattice[1] * lattice[2];
+    case Kind::path: return 0;
   }
   return 0;
 }
@@ -164,6 +200,10 @@ std::string RigSpec::to_string() const {
       break;
     case Kind::fibonacci: s = "fibonacci:" + std::to_string(count); break;
     case Kind::file: return "file:" + path;
+    case Kind::path: return "path:" + path;
+    case Kind::lattice:
+      return "lattice:" + std::to_string(lattice[0]) + "x" + std::to_string(lattice[1]) + "x" +
+             std::to_string(lattice[2]) + "@" + format_double(margin);
   }
   s += '@';
   for (std::size_t k = 0; k < radii.size(); ++k) {
@@ -186,6 +226,16 @@ Rig make_rig(const RigSpec& spec, const Domain& domain) {
     case RigSpec::Kind::fibonacci: pattern = fibonacci_pattern(spec.count); break;
     case RigSpec::Kind::file: {
       Rig rig = read_rig_file(spec.path, domain, spec.up_axis);
+      rig.spec = spec.to_string();
+      return rig;
+    }
+    case RigSpec::Kind::lattice: {
+      Rig rig = make_lattice_rig(domain, spec.lattice, spec.margin, spec.fov_y_degrees, spec.up_axis);
+      rig.spec = spec.to_string();
+      return rig;
+    }
+    case RigSpec::Kind::path: {
+      Rig rig = read_path_rig(spec.path, domain, spec.fov_y_degrees, spec.up_axis);
       rig.spec = spec.to_string();
       return rig;
     }

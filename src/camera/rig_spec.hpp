@@ -9,9 +9,14 @@
 //                              (default 8x16+poles = 130 cameras)
 //   fibonacci[:N]              N-point golden-angle spiral (default 130)
 //   file:PATH, or just PATH    explicit cameras from a text or JSON file (see read_rig_file)
+//   lattice:NXxNYxNZ[@M]       cameras inside the volume at the nodes of an NX x NY x NZ lattice (cell
+//                              centres of the domain shrunk by the fraction M at each face, default 0);
+//                              world-axis navigation (camera/volume_rigs.hpp)
+//   path:FILE                  cameras along a polyline read from FILE (camera/volume_rigs.hpp)
 // Any built-in kind may end with "@R1,R2,..." — shell radii in units of the domain's bounding-sphere
 // radius (default @3); several radii repeat the pattern on shells, outermost = shell 0. A leading
 // "shells:" is accepted for readability: "shells:yinyang@1.5,2.5,4".
+#include <array>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -27,13 +32,15 @@ inline constexpr std::uint64_t kMaxRigFileBytes = 1ull << 30;
 
 /// The kind and parameters of a rig.
 struct RigSpec {
-  enum class Kind { yinyang, latlon, fibonacci, file };
+  enum class Kind { yinyang, latlon, fibonacci, file, lattice, path };
   Kind kind = Kind::yinyang;
   int rows = 5;        ///< yinyang: n_theta per patch; latlon: number of rings
   int columns = 13;    ///< yinyang: n_phi per patch; latlon: cameras per ring
   bool poles = false;  ///< latlon: add one camera at each pole
   int count = 130;     ///< fibonacci: number of points
-  std::string path;    ///< file: the camera file
+  std::string path;    ///< file: the camera file; path: the polyline file
+  std::array<int, 3> lattice{4, 4, 3};  ///< lattice: nodes along world x, y, z
+  double margin = 0;                    ///< lattice: fraction of the extent kept free at each face
   std::vector<double> radii{kDefaultRadius};  ///< shell radii, bounding-sphere radii (not for file)
   double fov_y_degrees = 0;                   ///< 0 = frame the domain from the outermost shell
   Vec3 up{0, 0, 0};                           ///< requested up of every camera; zero = the sky direction

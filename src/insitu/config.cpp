@@ -234,6 +234,7 @@ void SessionConfig::validate() const {
     throw Error("image.width/height: " + std::to_string(width) + "x" + std::to_string(height) +
                 "; expected 2.." + std::to_string(kMaxImageSide) + " pixels each");
   (void)camera::RigSpec::parse(rig);  // throws naming the text
+  (void)camera::parse_projection(projection);
   if (tasks.empty()) throw Error("task: no [[task]] given; at least one visualization task is required");
   std::set<std::string> names;
   for (const TaskConfig& t : tasks) {
@@ -277,7 +278,13 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.outline = boolean(c, *im, "outline", "image.", true);
   }
   if (const auto* r = table(c, root, "rig")) {
-    only_keys(c, *r, "rig", {"spec", "up", "up_axis"});
+    only_keys(c, *r, "rig", {"spec", "up", "up_axis", "projection"});
+    s.projection = str(c, *r, "projection", "rig.", s.projection);
+    try {
+      (void)camera::parse_projection(s.projection);
+    } catch (const std::exception& e) {
+      c.fail("rig.projection", e.what());
+    }
     s.up_axis = str(c, *r, "up_axis", "rig.", s.up_axis);
     try {
       if (!s.up_axis.empty()) (void)camera::parse_up_axis(s.up_axis);
@@ -406,7 +413,11 @@ const char* config_keys_help() {
             optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R);
             up_axis = "z_up" | "z_down" (which way is the sky: poles, latitudes, the cameras' up and the
             player's Up key follow it; `panoptes run` and `panoptes demo` use "z_down", as z is depth);
-            up = [x, y, z] (world direction shown upwards in the images; default: the sky)
+            up = [x, y, z] (world direction shown upwards in the images; default: the sky);
+            spec = "lattice:NXxNYxNZ[@MARGIN]" | "path:FILE" put the cameras inside the volume (lattice nodes
+            at cell centres of the domain shrunk by MARGIN at each face; world-axis navigation);
+            projection = "perspective" | "equirectangular" (360 x 180 degree frames, e.g. 1920 x 960, for
+            looking around in the player; the domain outline is not drawn)
 [schedule]  every_steps = 10 | every_time = DT (exactly one); max_snapshots = 0 (unlimited)
 [video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4);
             playback_fps = 0 (the player's preferred rate; 0 = fps)

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "camera/rig_spec.hpp"
+#include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 #include "video/writer_memory.hpp"
 
@@ -46,8 +47,11 @@ MemoryEstimate estimate_session_memory(const SessionConfig& cfg, double block_po
 
 long long rig_camera_count(const SessionConfig& cfg, const render::GridGeometry& grid) {
   const camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
-  if (spec.kind != camera::RigSpec::Kind::file) return spec.cameras_per_shell() * (long long)spec.radii.size();
+  if (spec.kind == camera::RigSpec::Kind::lattice) return spec.cameras_per_shell();
+  if (spec.kind != camera::RigSpec::Kind::file && spec.kind != camera::RigSpec::Kind::path)
+    return spec.cameras_per_shell() * (long long)spec.radii.size();
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
+  if (spec.kind == camera::RigSpec::Kind::path) return camera::read_path_rig(spec.path, domain).size();
   return camera::read_rig_file(spec.path, domain).size();
 }
 

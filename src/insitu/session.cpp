@@ -255,7 +255,8 @@ void Session::Impl::init() {
   stage("building the rig " + cfg.rig);
   rig = camera::make_rig(spec, domain);
   cameras.reserve(std::size_t(rig.size()));
-  for (int c = 0; c < rig.size(); ++c) cameras.push_back(rig.camera(c, cfg.width, cfg.height));
+  const camera::Projection projection = camera::parse_projection(cfg.projection);
+  for (int c = 0; c < rig.size(); ++c) cameras.push_back(rig.camera(c, cfg.width, cfg.height, projection));
   for (int c = rank; c < rig.size(); c += size) owned.push_back(c);
   references.resize(field_names.size());
   stage(std::to_string(rig.size()) + " cameras placed; building the navigation graph and the manifest");
@@ -435,6 +436,10 @@ store::Manifest Session::Impl::make_manifest() const {
   man.video = cfg.video;
   man.rig.kind = rig.spec;
   man.rig.parameters = {{"spec", rig.spec}, {"shells", rig.shell_count}};
+  // Additive (issue 14): players read the projection and the lattice shape from here; older readers ignore them.
+  if (cfg.projection != "perspective") man.rig.parameters["projection"] = cfg.projection;
+  if (rig.is_lattice()) man.rig.parameters["lattice"] = rig.lattice;
+  if (rig.path) man.rig.parameters["path"] = true;
   const camera::NavigationGraph graph = camera::build_navigation_graph(rig);
   for (int c = 0; c < rig.size(); ++c) {
     const camera::RigCamera& rc = rig.cameras[std::size_t(c)];
@@ -640,7 +645,8 @@ void Session::Impl::render_snapshot(int frame) {
   const bool brick = me().has_brick;
   const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
   render::OutlineStyle outline;
-  outline.enabled = cfg.outline;
+  // Straight box edges are curves in a 360° frame: finish_image draws straight segments, so no outline.
+  outline.enabled = cfg.outline && cfg.projection == "perspective";
   for (int r0 = 0; r0 < C; r0 += size) {
     // Render every camera of this round, sending each partial set to its owner at once.
 #ifdef PANOPTES_HAVE_MPI

@@ -1,6 +1,8 @@
 #include "player/headless.hpp"
 
+#include <algorithm>
 #include <array>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -42,6 +44,8 @@ int parse_int(const std::string& text, const std::string& where) {
   }
 }
 
+constexpr const char* kWalkNames[] = {"forward", "back", "left", "right", "up", "down"};
+
 std::string describe(const ScriptCommand& c) {
   using K = ScriptCommand::Kind;
   switch (c.kind) {
@@ -59,14 +63,22 @@ std::string describe(const ScriptCommand& c) {
     case K::play: return "play";
     case K::pause: return "pause";
     case K::end: return "end";
+    case K::look: {
+      char b[96];
+      std::snprintf(b, sizeof b, "look=%g,%g,%g", c.look.yaw_deg, c.look.pitch_deg, c.look.fov_deg);
+      return b;
+    }
+    case K::walk: return std::string("walk=") + kWalkNames[int(c.walk)];
   }
   return "?";
 }
 
 // Applies one command; false if it could not apply (no such edge, unknown task name, ...).
-bool apply(Engine& engine, const ScriptCommand& c) {
+bool apply(Engine& engine, const ScriptCommand& c, Look& look) {
   using K = ScriptCommand::Kind;
   switch (c.kind) {
+    case K::look: look = clamped(c.look); return true;
+    case K::walk: return walk_keeping_view(engine, look, c.walk);
     case K::key: return engine.apply(c.action);
     case K::seek: engine.seek(c.value); return c.value >= 0 && c.value < engine.frame_count();
     case K::camera: return engine.jump_to_camera(c.value);
@@ -159,6 +171,24 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
         if (n != 3) throw Error(where + ": expected snap=X,Y,Z, got \"" + word + "\"");
         c.kind = K::snap, c.direction = {v[0], v[1], v[2]};
         if (norm(c.direction) == 0) throw Error(where + ": snap direction is the zero vector");
+      } else if (key == "look") {
+        std::array<double, 3> v{};
+        std::istringstream parts(value);
+        std::string part;
+        int n = 0;
+        while (std::getline(parts, part, ',')) {
+          if (n == 3) throw Error(where + ": expected look=YAW,PITCH,FOV (degrees), got \"" + word + "\"");
+          v[std::size_t(n++)] = parse_double(part, where);
+        }
+        if (n != 3) throw Error(where + ": expected look=YAW,PITCH,FOV (degrees), got \"" + word + "\"");
+        if (!(v[1] >= -89 && v[1] <= 89) || !(v[2] >= 20 && v[2] <= 120) || !std::isfinite(v[0]))
+          throw Error(where + ": look=" + value + ": expected pitch in -89..89 and field of view in 20..120 degrees");
+        c.kind = K::look, c.look = {v[0], v[1], v[2]};
+      } else if (key == "walk") {
+        const auto* it = std::find(std::begin(kWalkNames), std::end(kWalkNames), value);
+        if (it == std::end(kWalkNames))
+          throw Error(where + ": walk=" + value + ": expected forward, back, left, right, up or down");
+        c.kind = K::walk, c.walk = Walk(it - std::begin(kWalkNames));
       } else if (key == "speed") {
         c.kind = K::speed, c.speed = parse_double(value, where);
         if (c.speed < 0.25 || c.speed > 8) throw Error(where + ": speed " + value + " is outside 0.25 .. 8");
@@ -170,7 +200,7 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
         c.kind = K::end;
       } else {
         throw Error(where + ": unknown command \"" + word +
-                    "\" (expected key=, seek=, camera=, task=, axis=, snap=, speed=, play, pause or end)");
+                    "\" (expected key=, seek=, camera=, task=, axis=, snap=, look=, walk=, speed=, play, pause or end)");
       }
     }
     if (!have_t) throw Error(where + ": missing time (lines look like `t=0.5 key=Right`)");
@@ -246,6 +276,7 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
   }
 
   HeadlessResult result;
+  Look look = clamped(options.look);
   nlohmann::json displayed = nlohmann::json::array(), commands = nlohmann::json::array();
   std::size_t next_command = 0;
   for (long k = 0; k < ticks; ++k) {
@@ -259,7 +290,7 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
     while (next_command < options.script.size() && options.script[next_command].t <= t + 1e-9) {
       const ScriptCommand& c = options.script[next_command++];
       if (c.kind == ScriptCommand::Kind::end) ended = true;
-      const bool applied = apply(engine, c);
+      const bool applied = apply(engine, c, look);
       commands.push_back({{"t", c.t}, {"line", c.line}, {"command", describe(c)}, {"applied", applied}, {"tick", k}});
     }
     if (ended) break;
@@ -267,12 +298,15 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
     df.index = int(k);
     df.t = t;
     df.shown = engine.current_frame();
+    df.look = look;
     const auto& s = df.shown.selection;
     result.shown.push_back(s);
+    result.looks.push_back(look);
     ++result.frames_displayed;
     if (df.shown.status != FrameStatus::ok) ++result.placeholders;
     displayed.push_back({{"index", k}, {"t", t}, {"camera", s.camera}, {"task", s.task}, {"frame", s.frame},
-                         {"status", std::string(to_string(df.shown.status))}, {"cache_hit", df.shown.cache_hit}});
+                         {"status", std::string(to_string(df.shown.status))}, {"cache_hit", df.shown.cache_hit},
+                         {"look", {look.yaw_deg, look.pitch_deg, look.fov_deg}}});
     if (options.frames_out) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%06ld.png", k);

@@ -10,6 +10,9 @@
 //   t=SECONDS task=ID|NAME       select a task by id or by name
 //   t=SECONDS axis=NAME:DELTA    step parameter axis NAME by DELTA (e.g. axis=isovalue:+1)
 //   t=SECONDS snap=X,Y,Z         snap to the camera nearest the direction (as a mouse drag does)
+//   t=SECONDS look=YAW,PITCH,FOV set the view inside a 360° stream (degrees; player/look.hpp)
+//   t=SECONDS walk=DIR           walk to the neighbouring camera in direction DIR relative to the view:
+//                                forward, back, left, right, up or down (lattice and path rigs)
 //   t=SECONDS speed=FACTOR       playback speed (0.25 .. 8)
 //   t=SECONDS play | pause       set the play state
 //   t=SECONDS end                stop the run here (no frame is shown at this time)
@@ -25,6 +28,7 @@
 #include "core/vec3.hpp"
 #include "player/engine.hpp"
 #include "player/keys.hpp"
+#include "player/look.hpp"
 
 namespace panoptes::player {
 
@@ -33,7 +37,7 @@ inline constexpr double kMaxScriptSeconds = 86400;
 
 /// One parsed script line.
 struct ScriptCommand {
-  enum class Kind { key, seek, camera, task, axis, snap, speed, play, pause, end };
+  enum class Kind { key, seek, camera, task, axis, snap, speed, play, pause, end, look, walk };
   double t = 0;
   Kind kind = Kind::key;
   Action action = Action::none;  ///< kind == key
@@ -42,6 +46,8 @@ struct ScriptCommand {
   std::string name;              ///< task name or axis name
   Vec3 direction;                ///< kind == snap
   double speed = 1;              ///< kind == speed
+  Look look;                     ///< kind == look
+  Walk walk = Walk::forward;     ///< kind == walk
   int line = 0;                  ///< 1-based line number in the script
 };
 
@@ -60,6 +66,7 @@ struct DisplayedFrame {
   int index = 0;        ///< display tick (0, 1, 2, ...)
   double t = 0;         ///< virtual time of the tick, seconds
   ShownFrame shown;
+  Look look;  ///< the view at this tick (applies to 360° streams: see perspective_cutout)
 };
 
 /// Options of run_headless.
@@ -78,6 +85,7 @@ struct HeadlessOptions {
   /// Simulated display: wait for prefetch to go idle before each tick, as a real display would give
   /// the prefetch threads one frame period of time (makes cache hits on switches reproducible).
   bool wait_prefetch_each_tick = true;
+  Look look;  ///< initial view (look= commands change it)
 };
 
 /// Summary of a headless run.
@@ -86,6 +94,7 @@ struct HeadlessResult {
   int placeholders = 0;   ///< displayed frames whose status was not ok
   Statistics statistics;
   std::vector<Selection> shown;  ///< selection of every displayed frame, in order
+  std::vector<Look> looks;       ///< the view of every displayed frame, in order
 };
 
 /// Runs a script through an Engine over the database in dir. Display ticks are at t = k / fps

@@ -8,6 +8,7 @@
 #include "core/frame_stamp.hpp"
 #include "core/png.hpp"
 #include "player/test_db.hpp"
+#include "store/synthetic.hpp"
 
 namespace panoptes::player {
 namespace {
@@ -156,4 +157,60 @@ TEST(Headless, DeterministicAcrossRuns) {
 }
 
 }  // namespace
+// Issue 14: walking through a stamped synthetic lattice database while looking around. After each
+// walk/look command the shown stream (its stamp) is the lattice neighbour in the direction faced.
+TEST(Headless, WalksAndLooksThroughALatticeDatabase) {
+  TempDir dir("player-lattice");
+  const auto db = dir.path / "db";
+  store::SyntheticOptions so;
+  so.lattice = {3, 3, 2};
+  so.projection = "equirectangular";
+  so.width = 64, so.height = 32;
+  store::Manifest m = store::synthetic_manifest(so);
+  m.video.fps = 30;
+  testing::write_stamped(db, m, 2);
+  HeadlessOptions o;
+  o.engine.start_playing = false;
+  o.script = parse_script(
+      "t=0.1 walk=forward\n"     // faces +y: node (0,1,0) = 3
+      "t=0.2 look=90,0,90\n"     // faces +x
+      "t=0.3 walk=forward\n"     // (1,1,0) = 4
+      "t=0.4 walk=left\n"        // left of +x is +y: (1,2,0) = 7
+      "t=0.5 walk=up\n"          // (1,2,1) = 16
+      "t=0.6 look=180,-20,60\n"  // faces -y, a little down
+      "t=0.7 walk=forward\n"     // (1,1,1) = 13
+      "t=0.8 walk=right\n"       // right of -y is -x: (0,1,1) = 12
+      "t=0.9 walk=right\n"       // the lattice ends: stays at 12
+      "t=1.0 end\n");
+  o.frames_out = dir.path / "frames";
+  o.stats_out = dir.path / "stats.json";
+  const HeadlessResult r = run_headless(db, o);
+  ASSERT_EQ(r.frames_displayed, 30);
+  const struct {
+    int tick, camera;
+    Look look;
+  } expect[] = {{0, 0, {0, 0, 90}},    {3, 3, {0, 0, 90}},    {6, 3, {90, 0, 90}},   {9, 4, {90, 0, 90}},
+                {12, 7, {90, 0, 90}},  {15, 16, {90, 0, 90}}, {18, 16, {180, -20, 60}}, {21, 13, {180, -20, 60}},
+                {24, 12, {180, -20, 60}}, {27, 12, {180, -20, 60}}};
+  for (const auto& e : expect)
+    for (int k = e.tick; k < e.tick + 3; ++k) {
+      EXPECT_EQ(r.shown[std::size_t(k)].camera, e.camera) << "tick " << k;
+      EXPECT_NEAR(r.looks[std::size_t(k)].yaw_deg, e.look.yaw_deg, 1e-9) << "tick " << k;
+      EXPECT_NEAR(r.looks[std::size_t(k)].pitch_deg, e.look.pitch_deg, 1e-9) << "tick " << k;
+      EXPECT_NEAR(r.looks[std::size_t(k)].fov_deg, e.look.fov_deg, 1e-9) << "tick " << k;
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%06d.png", k);
+      const auto stamp = read_frame_stamp(read_png((*o.frames_out / name).string()));
+      ASSERT_TRUE(stamp.has_value()) << name;
+      EXPECT_EQ(stamp->camera, std::uint32_t(e.camera)) << name;
+    }
+  std::ifstream in(*o.stats_out);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_FALSE(j["commands"][8]["applied"].get<bool>());  // the walk off the lattice
+  EXPECT_EQ(j["displayed"][20]["look"][0].get<double>(), 180.0);
+  EXPECT_THROW(parse_script("t=0 walk=sideways\n"), Error);
+  EXPECT_THROW(parse_script("t=0 look=0,95,60\n"), Error);
+  EXPECT_THROW(parse_script("t=0 look=0,0\n"), Error);
+}
+
 }  // namespace panoptes::player

@@ -903,8 +903,9 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   // The brick's screen footprint.
   const int W = cam.width(), H = cam.height();
   PixelRect rect{W, H, 0, 0};
-  bool all = false;
-  for (int c = 0; c < 8; ++c) {
+  // An equirectangular image wraps around the camera: corner projections bound nothing, march every pixel.
+  bool all = cam.projection() != camera::Projection::perspective;
+  for (int c = 0; c < 8 && !all; ++c) {
     Vec3 p;
     for (int a = 0; a < 3; ++a)
       p[a] = S.grid.origin[a] + ((c >> a) & 1 ? S.brick.hi[a] : S.brick.lo[a]) * S.spacing[a];
@@ -953,6 +954,13 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
         tb0 = std::max(tb0, t0);
         tb1 = std::min(tb1, tg1);
         if (tb1 < tb0) continue;
+        // A camera inside the domain may sit exactly on a face this brick shares with its upper neighbour
+        // (e.g. a lattice node on an MPI cut): a ray leaving through that face has its t = 0 sample owned
+        // by the neighbour (half-open extents), so this brick's part lies just behind it in depth.
+        float depth = float(tb0);
+        if (tb0 == 0)
+          for (int a = 0; a < 3; ++a)
+            if (O[a] == bhi[a] && bhi[a] != ghi[a] && D[a] < 0) depth = std::nextafter(0.0f, 1.0f);
         ++n_rays;
         for (int i = 0; i < K; ++i) acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
         if (S.march_mask) march_ray(S, O, D, ray.direction, t0, tg1, tb0, tb1, acc, n_eff, n_marched);
@@ -976,7 +984,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
           PartialImage& o = out[std::size_t(i)];
           float* dst = o.rgba_at(x, y);
           dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
-          o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = float(tb0);
+          o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = depth;
         }
       }
   }

@@ -19,7 +19,43 @@
 
 namespace panoptes::store {
 
-Manifest synthetic_manifest(const SyntheticOptions& o) {
+namespace {
+// The lattice variant (see SyntheticOptions::lattice). Written out here rather than through camera/,
+// which store does not depend on; camera/volume_rigs_test checks the same layout and slots.
+void lattice_cameras(Manifest& m, const std::array<int, 3>& n) {
+  m.rig.kind = "lattice:" + std::to_string(n[0]) + "x" + std::to_string(n[1]) + "x" + std::to_string(n[2]) + "@0";
+  m.rig.parameters = {{"spec", m.rig.kind}, {"shells", 1}, {"lattice", n}, {"note", "synthetic"}};
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        CameraEntry e;
+        e.id = i + n[0] * (j + n[1] * k);
+        e.position = {-1 + 2 * (i + 0.5) / n[0], -1 + 2 * (j + 0.5) / n[1], -1 + 2 * (k + 0.5) / n[2]};
+        e.look_at = e.position + Vec3{0, 2.0 / n[1], 0};
+        e.up = {0, 0, 1};
+        e.fov_y_deg = 90;
+        e.labels.patch = "lattice";
+        m.cameras.push_back(e);
+        auto id = [&](int a, int b, int c) {
+          return a < 0 || b < 0 || c < 0 || a >= n[0] || b >= n[1] || c >= n[2] ? -1 : a + n[0] * (b + n[1] * c);
+        };
+        Neighbours nb;
+        nb.right = id(i + 1, j, k), nb.left = id(i - 1, j, k);
+        nb.in = id(i, j + 1, k), nb.out = id(i, j - 1, k);
+        nb.up = id(i, j, k + 1), nb.down = id(i, j, k - 1);
+        m.graph.neighbours.push_back(nb);
+      }
+}
+}  // namespace
+
+Manifest synthetic_manifest(const SyntheticOptions& options) {
+  SyntheticOptions o = options;
+  const bool lattice = o.lattice[0] > 0 && o.lattice[1] > 0 && o.lattice[2] > 0;
+  if (lattice) {
+    if (std::int64_t(o.lattice[0]) * o.lattice[1] * o.lattice[2] > kStampMaxCamera + 1)
+      throw Error("synthetic database: lattice of more than 2^24 cameras");
+    o.cameras = o.lattice[0] * o.lattice[1] * o.lattice[2];
+  }
   if (o.cameras <= 0 || o.tasks <= 0 || o.frames <= 0)
     throw Error("synthetic database: cameras (" + std::to_string(o.cameras) + "), tasks (" + std::to_string(o.tasks) +
                 ") and frames (" + std::to_string(o.frames) + ") must be positive");
@@ -39,10 +75,12 @@ Manifest synthetic_manifest(const SyntheticOptions& o) {
   m.image.height = o.height;
   m.video = o.video;
   for (int f = 0; f < o.frames; ++f) m.times.push_back(0.1 * f);
-  m.rig.kind = "fibonacci";
-  m.rig.parameters = {{"count", o.cameras}, {"radius", 3.0}, {"note", "synthetic; graph is a ring by index"}};
+  if (lattice) lattice_cameras(m, o.lattice);
+  if (!lattice) m.rig.kind = "fibonacci";
+  if (!lattice) m.rig.parameters = {{"count", o.cameras}, {"radius", 3.0}, {"note", "synthetic; graph is a ring by index"}};
+  if (o.projection != "perspective") m.rig.parameters["projection"] = o.projection;
   const double golden = M_PI * (3 - std::sqrt(5.0));
-  for (int c = 0; c < o.cameras; ++c) {
+  for (int c = 0; c < (lattice ? 0 : o.cameras); ++c) {
     const double z = 1 - (2.0 * c + 1) / o.cameras, r = std::sqrt(std::max(0.0, 1 - z * z));
     const double phi = golden * c;
     CameraEntry e;

@@ -1,6 +1,7 @@
 #pragma once
 // Synthetic databases: every frame carries the stamp of its (camera, task, frame) plus some visible
 // moving content, so player tests and benchmarks can verify *which* frame is shown.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -23,6 +24,13 @@ struct SyntheticOptions {
   int threads = 0;              ///< streams encoded in parallel (0 = hardware concurrency)
   std::string title = "synthetic database";
   std::string command_line;     ///< recorded in the provenance
+  /// Cameras on an nx x ny x nz lattice inside the domain instead of the sphere (all > 0 to use it):
+  /// camera i + nx·(j + ny·k) at the cell centre (i, j, k) of the domain [−1, 1]³, looking +y with +z up,
+  /// and the world-axis graph of camera/volume_rigs.hpp (right/left = ±x, in/out = ±y, up/down = ±z).
+  /// `cameras` is ignored then.
+  std::array<int, 3> lattice{0, 0, 0};
+  /// Recorded as rig parameter "projection" when not "perspective" (frames are stamped all the same).
+  std::string projection = "perspective";
 };
 
 /// The manifest of a synthetic database: cameras on a Fibonacci sphere (radius 3, looking at the

@@ -52,6 +52,19 @@ Hud::Hud(const store::Manifest& manifest) {
     shells.push_back(c.labels.shell);
   }
   minimap_.set_cameras(std::move(dirs), std::move(shells));
+  // Rigs inside the volume (issue 14) get a 3-D overview of the box and the cameras instead.
+  const auto& params = manifest.rig.parameters;
+  if (params.contains("lattice") || (params.contains("path") && params["path"] == true)) {
+    auto sky = [&](const Vec3& p) { return z_down ? Vec3{p.y, p.x, -p.z} : p; };
+    std::vector<Vec3> positions;
+    for (const auto& c : manifest.cameras) positions.push_back(sky(c.position));
+    const auto& d = manifest.domain;
+    const Vec3 hi{d.origin.x + double(std::max<std::int64_t>(d.dims[0] - 1, 0)) * d.spacing.x,
+                  d.origin.y + double(std::max<std::int64_t>(d.dims[1] - 1, 0)) * d.spacing.y,
+                  d.origin.z + double(std::max<std::int64_t>(d.dims[2] - 1, 0)) * d.spacing.z};
+    lattice_map_.set_scene(std::move(positions), sky(d.origin), sky(hi));
+    z_down_ = z_down;
+  }
 }
 
 void Hud::notify(std::string text, bool error) {
@@ -99,6 +112,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       ImGui::Text("camera %d%s%s   lat %+.0f  lon %+.0f%s", sel.camera, cam.labels.patch.empty() ? "" : " ",
                   cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg,
                   info.shell_count > 1 ? ("   shell " + std::to_string(cam.labels.shell)).c_str() : "");
+      if (!info.look_label.empty()) ImGui::TextUnformatted(info.look_label.c_str());
       const std::string params = format_parameters(m, task);
       ImGui::Text("task %d of %d: %s%s%s", sel.task, int(m.tasks.size()), task.name.c_str(),
                   params.empty() ? "" : "   ", params.c_str());
@@ -141,7 +155,12 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::SetNextWindowBgAlpha(0.35f);
     if (ImGui::Begin("##minimap", nullptr, kOverlayFlags)) {
       remember_window();
-      req.jump_camera = minimap_.draw(info.selection.camera, info.neighbours, map);
+      if (!lattice_map_.empty()) {
+        const Vec3& v = info.view_direction;
+        req.jump_camera = lattice_map_.draw(info.selection.camera, info.neighbours, z_down_ ? Vec3{v.y, v.x, -v.z} : v, map);
+      } else {
+        req.jump_camera = minimap_.draw(info.selection.camera, info.neighbours, map);
+      }
     }
     ImGui::End();
 

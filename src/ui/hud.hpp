@@ -6,6 +6,7 @@
 
 #include "player/engine.hpp"
 #include "store/manifest.hpp"
+#include "ui/lattice_map.hpp"
 #include "ui/minimap.hpp"
 
 namespace panoptes::ui {
@@ -35,6 +36,8 @@ struct HudInfo {
   std::string status_message;
   std::vector<int> neighbours;    ///< graph neighbours of the current camera (mini-map)
   int shell_count = 1;            ///< camera shells of the rig (the shell is shown only if > 1)
+  std::string look_label;         ///< 360° streams: lattice position and view (empty otherwise)
+  Vec3 view_direction{0, 1, 0};   ///< world direction of the current view (lattice mini-map arrow)
 };
 
 /// What the user did in the HUD this frame.
@@ -70,6 +73,8 @@ class Hud {
  private:
   void draw_help(float viewport_w, float viewport_h);
   MiniMap minimap_;
+  LatticeMap lattice_map_;
+  bool z_down_ = false;  ///< replaces the sphere map for rigs inside the volume (lattice, path)
   std::string message_;
   bool message_error_ = false;
   double message_until_ = 0;

@@ -4,6 +4,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -23,6 +24,7 @@
 #include "player/engine.hpp"
 #include "player/headless.hpp"
 #include "ui/drag_rotation.hpp"
+#include "ui/look_mesh.hpp"
 #include "ui/hud.hpp"
 #include "ui/sdl_keys.hpp"
 #include "ui/sdl_window.hpp"
@@ -167,6 +169,10 @@ class WindowApp {
     hud_.show_panel = options.show_hud;
     for (const auto& c : engine.manifest().cameras) shell_count_ = std::max(shell_count_, c.labels.shell + 1);
     hud_.show_help = options.show_help;
+    equirect_ = player::is_equirectangular(engine.manifest());
+    lattice_ = player::lattice_shape(engine.manifest());
+    const auto& params = engine.manifest().rig.parameters;
+    walkable_ = equirect_ && (lattice_[0] > 0 || (params.contains("path") && params["path"] == true));
   }
 
   WindowResult run();
@@ -197,6 +203,13 @@ class WindowApp {
   DragRotation drag_;
   Recorder recorder_;
   int shell_count_ = 1;
+  // Look-around in 360° streams (issue 14): the view, and the mesh that draws it on the GPU.
+  bool equirect_ = false, walkable_ = false;
+  std::array<int, 3> lattice_{0, 0, 0};
+  player::Look look_;
+  std::vector<MeshVertex> mesh_;
+  std::vector<SDL_Vertex> sdl_mesh_;
+  bool walk(player::Walk w);
 
   double t0_ = wall_seconds();
   bool quit_ = false;
@@ -244,6 +257,8 @@ void WindowApp::run_due_script_commands() {
       case Kind::play: engine_.set_playing(true); break;
       case Kind::pause: engine_.set_playing(false); break;
       case Kind::end: quit_ = true; break;
+      case Kind::look: look_ = player::clamped(c.look); break;
+      case Kind::walk: walk(c.walk); break;
     }
   }
 }
@@ -259,8 +274,31 @@ void WindowApp::zoom_by(double factor) {
     view_.zoom_at(factor, out_w_ / 2.0, out_h_ / 2.0);
 }
 
+bool WindowApp::walk(player::Walk w) {
+  if (player::walk_keeping_view(engine_, look_, w)) return true;
+  hud_.notify("no camera that way");
+  return false;
+}
+
 void WindowApp::do_action(player::Action action) {
   using player::Action;
+  if (walkable_) {
+    // Inside a lattice (or along a path) the arrows and PgUp/PgDn walk relative to the view.
+    switch (action) {
+      case Action::camera_up: walk(player::Walk::forward); return;
+      case Action::camera_down: walk(player::Walk::back); return;
+      case Action::camera_left: walk(player::Walk::left); return;
+      case Action::camera_right: walk(player::Walk::right); return;
+      case Action::axis_up: walk(player::Walk::up); return;
+      case Action::axis_down: walk(player::Walk::down); return;
+      default: break;
+    }
+  }
+  if (equirect_ && (action == Action::zoom_in || action == Action::zoom_out || action == Action::zoom_reset)) {
+    look_.fov_deg = action == Action::zoom_reset ? 90 : look_.fov_deg / (action == Action::zoom_in ? 1.25 : 0.8);
+    look_ = player::clamped(look_);
+    return;
+  }
   switch (action) {
     case Action::zoom_in: zoom_by(1.25); break;
     case Action::zoom_out: zoom_by(0.8); break;
@@ -330,7 +368,9 @@ void WindowApp::handle_event(const SDL_Event& e) {
     }
     case SDL_MOUSEBUTTONDOWN:
       if (hud_.covers(float(e.button.x), float(e.button.y))) break;
-      if (e.button.button == SDL_BUTTON_LEFT) {
+      if (e.button.button == SDL_BUTTON_LEFT && equirect_) {
+        left_down_ = true;
+      } else if (e.button.button == SDL_BUTTON_LEFT) {
         const auto& cam = engine_.manifest().cameras[std::size_t(engine_.selection().camera)];
         drag_.begin(cam.position, cam.up, cam.look_at);
         left_down_ = true;
@@ -347,7 +387,13 @@ void WindowApp::handle_event(const SDL_Event& e) {
       }
       break;
     case SDL_MOUSEMOTION:
-      if (left_down_ && drag_.active()) {
+      if (left_down_ && equirect_) {
+        // Grab-and-drag: the scene follows the pointer (one output pixel = fov / height degrees).
+        const double deg_per_px = look_.fov_deg / std::max(1, out_h_);
+        look_.yaw_deg -= e.motion.xrel * px_x_ * deg_per_px;
+        look_.pitch_deg += e.motion.yrel * px_y_ * deg_per_px;
+        look_ = player::clamped(look_);
+      } else if (left_down_ && drag_.active()) {
         drag_.move(e.motion.xrel * px_x_, e.motion.yrel * px_y_, out_h_);
         engine_.snap_to_direction(drag_.direction());
       } else if (right_down_) {
@@ -356,6 +402,10 @@ void WindowApp::handle_event(const SDL_Event& e) {
       break;
     case SDL_MOUSEWHEEL:
       if (hud_.covers(float(e.wheel.mouseX), float(e.wheel.mouseY))) break;
+      if (equirect_) {  // the wheel narrows / widens the look-around's field of view
+        if (e.wheel.preciseY != 0) look_ = player::clamped({look_.yaw_deg, look_.pitch_deg, look_.fov_deg / std::pow(1.15, double(e.wheel.preciseY))});
+        break;
+      }
       // The event carries the pointer position (SDL >= 2.26), so zoom happens where the wheel turned.
       if (e.wheel.preciseY != 0) view_.zoom_at(std::pow(1.2, double(e.wheel.preciseY)), e.wheel.mouseX * px_x_, e.wheel.mouseY * px_y_);
       break;
@@ -408,6 +458,22 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   h.status = shown.status;
   h.shell_count = shell_count_;
   h.status_message = shown.message;
+  // The lattice mini-map's arrow: where the viewer looks (the camera's forward outside 360° streams).
+  h.view_direction =
+      player::look_basis(player::camera_basis(engine_.manifest().cameras[std::size_t(shown.selection.camera)]),
+                         equirect_ ? look_ : player::Look{})
+          .forward;
+  if (equirect_) {
+    char text[160];
+    const auto node = player::lattice_node(lattice_, shown.selection.camera);
+    if (lattice_[0] > 0)
+      std::snprintf(text, sizeof text, "lattice (%d, %d, %d) of %dx%dx%d   look yaw %+.0f pitch %+.0f fov %.0f", node[0],
+                    node[1], node[2], lattice_[0], lattice_[1], lattice_[2], look_.yaw_deg, look_.pitch_deg, look_.fov_deg);
+    else
+      std::snprintf(text, sizeof text, "360 view   look yaw %+.0f pitch %+.0f fov %.0f", look_.yaw_deg, look_.pitch_deg,
+                    look_.fov_deg);
+    h.look_label = text;
+  }
   if (!m.graph.empty()) {
     const auto& n = m.graph.neighbours[std::size_t(shown.selection.camera)];
     for (int id : {n.left, n.right, n.up, n.down, n.in, n.out})
@@ -492,9 +558,20 @@ WindowResult WindowApp::run() {
     SDL_SetRenderDrawColor(r, 16, 17, 20, 255);
     const double draw0 = wall_seconds();
     SDL_RenderClear(r);
-    const Rect fr = view_.frame_rect();
-    const SDL_FRect dst{float(fr.x), float(fr.y), float(fr.w), float(fr.h)};
-    SDL_RenderCopyF(r, texture_.texture(), nullptr, &dst);
+    // Where the data is drawn: the fitted, zoomed frame; a look-around fills the window.
+    const Rect fr = equirect_ ? Rect{0, 0, double(out_w_), double(out_h_)} : view_.frame_rect();
+    if (equirect_) {
+      // The perspective cut-out of the 360° frame over the whole window, textured on the GPU.
+      const player::ViewBasis cam = player::camera_basis(engine_.manifest().cameras[std::size_t(shown.selection.camera)]);
+      build_look_mesh(cam, look_, 0, 0, float(out_w_), float(out_h_), mesh_);
+      sdl_mesh_.resize(mesh_.size());
+      for (std::size_t k = 0; k < mesh_.size(); ++k)
+        sdl_mesh_[k] = {{mesh_[k].x, mesh_[k].y}, {255, 255, 255, 255}, {mesh_[k].u, mesh_[k].v}};
+      SDL_RenderGeometry(r, texture_.texture(), sdl_mesh_.data(), int(sdl_mesh_.size()), nullptr, 0);
+    } else {
+      const SDL_FRect dst{float(fr.x), float(fr.y), float(fr.w), float(fr.h)};
+      SDL_RenderCopyF(r, texture_.texture(), nullptr, &dst);
+    }
 
     // Screenshots and recordings hold what is shown of the data, without the HUD on top.
     if (screenshot_pending_ || recorder_.due(now())) {

@@ -17,6 +17,7 @@
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "store/database.hpp"
+#include "store/synthetic.hpp"
 #include "store/test_support.hpp"
 #include "ui/window_app.hpp"
 #include "video/movie_reader.hpp"
@@ -450,6 +451,40 @@ TEST_F(WindowTest, DemoAt1280x1024FillsTheWindowTheHudStaysSmallAndUpGoesToTheSk
   const Vec3 sky = man.domain.sky();
   EXPECT_GT(dot(normalize(to.position - to.look_at), sky), dot(normalize(from.position - from.look_at), sky));
   EXPECT_GT(from.labels.lat_deg, 0) << "the first camera looks from above the surface";
+}
+
+// Issue 14: a 360° lattice database shows a look-around filling the window; the arrows and PgUp walk
+// through the lattice relative to the view (script look= turns it), and the HUD says where.
+TEST_F(WindowTest, LatticeLookAroundWalksWithTheArrowsRelativeToTheView) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  store::SyntheticOptions so;
+  so.lattice = {3, 3, 2};
+  so.projection = "equirectangular";
+  so.width = 128, so.height = 64;
+  so.frames = 2;
+  so.threads = 1;
+  store::write_synthetic_database(dir_->path / "lattice", so);
+  const auto script = dir_->path / "walk.txt";
+  std::ofstream(script) << "t=0.10 key=Up\n"          // faces +y: (0,1,0) = 3
+                           "t=0.20 look=90,0,90\n"    // faces +x
+                           "t=0.30 key=Up\n"          // (1,1,0) = 4
+                           "t=0.40 key=PageUp\n"      // (1,1,1) = 13
+                           "t=0.50 key=Right\n";      // right of +x is -y: (1,0,1) = 10
+  WindowOptions o;
+  o.software_renderer = true;
+  o.vsync = false;
+  o.paused = true;
+  o.virtual_time = true;
+  o.script = script;
+  o.width = 320, o.height = 240;
+  o.max_frames = 20;
+  o.screenshot_on_exit = dir_->path / "lattice.png";
+  const WindowResult r = run_window(dir_->path / "lattice", o);
+  EXPECT_EQ(r.camera, 10);
+  EXPECT_EQ(r.view_x, 0);
+  EXPECT_EQ(r.view_w, r.window_w);  // the cut-out fills the window
+  EXPECT_EQ(r.view_h, r.window_h);
+  keep_for_humans(o.screenshot_on_exit, "ui_lattice_window_test.png");
 }
 
 }  // namespace

@@ -1,0 +1,148 @@
+// Cameras inside the data (issue 14).
+//
+// BM_EquirectFrame: 360° x 180° frames at 1920x960 on the standard scene of render_bench (256x512x160
+// spherical wave fronts, sample distance 0.5 voxel), the paper's 3 tasks (p, s, p+s) in one march, from
+// a camera inside the volume (its centre) and from one outside (3 bounding radii).
+//   frames_core_s   camera-frames (all 3 tasks) per core-second: frames / process CPU seconds
+//   frames_s        the same per wall-second
+// BM_WalkLatency: switch latency when walking through a 4x4x3 lattice of 1920x960 360° streams (stamped
+// synthetic database, gop 1 as in situ) at 30 fps with prefetch, one walk every 5th frame along a fixed
+// route, paused or playing; the window draws the cut-out from the cached frame, so the switch is what the
+// user waits for. Target p99 < 16 ms.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+#include <time.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include "player/engine.hpp"
+#include "player/look.hpp"
+#include "render/renderer.hpp"
+#include "render/synthetic_fields.hpp"
+#include "store/synthetic.hpp"
+
+using namespace panoptes;
+using namespace panoptes::render;
+namespace fs = std::filesystem;
+
+namespace {
+
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// The standard scene of render_bench.cpp (kept identical so the numbers compare).
+struct StandardScene {
+  GridGeometry grid{{256, 512, 160}, {0, 0, 0}, {1, 1, 1}};
+  std::vector<float> p, s;
+  std::vector<PreparedField> fields;
+  StandardScene() {
+    const WaveFront pf[] = {{{128, 180, 90}, 150, 4, 1.0}, {{90, 380, 60}, 70, 4, 0.8}};
+    const WaveFront sf[] = {{{128, 180, 90}, 87, 3, 1.0}, {{90, 380, 60}, 40, 3, 0.9}};
+    p = wave_field(grid, pf);
+    s = wave_field(grid, sf);
+    fields = {PreparedField(FieldView::whole(grid, p.data())), PreparedField(FieldView::whole(grid, s.data()))};
+  }
+};
+
+const StandardScene& scene() {
+  static const StandardScene sc;
+  return sc;
+}
+
+void BM_EquirectFrame(benchmark::State& state) {
+  const auto& sc = scene();
+  const bool inside = state.range(0) != 0;
+  const Vec3 c = sc.grid.centre();
+  const Vec3 eye = inside ? c : c + normalize(Vec3{-0.6, -0.7, 0.4}) * (3 * 0.5 * norm(sc.grid.domain_hi() - sc.grid.domain_lo()));
+  const camera::Camera cam(eye, inside ? c + Vec3{0, 1, 0} : c, {0, 0, 1}, 60, 1920, 960, camera::Projection::equirectangular);
+  const std::vector<TaskSpec> tasks{
+      TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1)),
+      TaskSpec::volume(1, TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 1)),
+      TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
+                        TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 1))};
+  std::vector<PartialImage> out(tasks.size());
+  const double cpu0 = process_cpu_seconds(), wall0 = omp_get_wtime();
+  for (auto _ : state) {
+    render_brick(cam, sc.fields, tasks, out);
+    for (const PartialImage& o : out) benchmark::DoNotOptimize(finish_image(o, cam, sc.grid, {0, 0, 0}, OutlineStyle{false}));
+  }
+  const double frames = double(state.iterations());
+  state.counters["frames_core_s"] = frames / (process_cpu_seconds() - cpu0);
+  state.counters["frames_s"] = frames / (omp_get_wtime() - wall0);
+}
+BENCHMARK(BM_EquirectFrame)->ArgName("inside")->Arg(1)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+const fs::path& lattice_db() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / "panoptes_inside_bench_lattice";
+    if (!fs::exists(d / "panoptes.json")) {
+      store::SyntheticOptions o;
+      o.lattice = {4, 4, 3};
+      o.projection = "equirectangular";
+      o.tasks = 1;
+      o.frames = 12;
+      o.width = 1920, o.height = 960;
+      o.video.gop = 1;  // as the in-situ writers: every frame is a keyframe
+      o.overwrite = true;
+      store::write_synthetic_database(d, o);
+    }
+    return d;
+  }();
+  return dir;
+}
+
+void BM_WalkLatency(benchmark::State& state) {
+  const fs::path& db = lattice_db();
+  constexpr int kTicks = 150;  // 5 s at 30 fps
+  // A route through the lattice: forward, turn, forward, up, ... (yaw, walk).
+  const std::pair<double, player::Walk> route[] = {
+      {0, player::Walk::forward}, {0, player::Walk::forward}, {90, player::Walk::forward}, {90, player::Walk::up},
+      {90, player::Walk::forward}, {180, player::Walk::forward}, {180, player::Walk::down}, {-90, player::Walk::forward},
+      {-90, player::Walk::forward}, {0, player::Walk::back}};
+  std::vector<double> latencies;
+  std::int64_t hits = 0, switches = 0, refused = 0;
+  for (auto _ : state) {
+    player::EngineOptions o;
+    o.prefetch_threads = 2;
+    o.start_playing = state.range(0) != 0;
+    player::Engine engine(db, o);
+    engine.current_frame();
+    player::Look look;
+    const auto start = std::chrono::steady_clock::now();
+    for (int k = 0; k < kTicks; ++k) {
+      std::this_thread::sleep_until(start + std::chrono::microseconds(k * 1000000 / 30));
+      engine.tick();
+      if (k % 5 == 2) {
+        const auto& [yaw, walk] = route[(k / 5) % std::size(route)];
+        look.yaw_deg = yaw;
+        if (!player::walk_keeping_view(engine, look, walk)) ++refused;
+      }
+      benchmark::DoNotOptimize(engine.current_frame());
+    }
+    for (const auto& s : engine.statistics().switches) {
+      latencies.push_back(s.latency_ms);
+      hits += s.cache_hit;
+      ++switches;
+    }
+  }
+  const player::Summary s = player::summarize(latencies);
+  state.counters["walks"] = double(switches);
+  state.counters["refused"] = double(refused);
+  state.counters["walk_hit_pct"] = switches ? 100.0 * double(hits) / double(switches) : 0;
+  state.counters["walk_p50_ms"] = s.p50;
+  state.counters["walk_p99_ms"] = s.p99;
+  state.counters["walk_max_ms"] = s.max;
+}
+// playing:0 = looking around while paused (the prefetcher keeps the 6 neighbours' current frame);
+// playing:1 = walking while time plays at 30 fps (every neighbour's next frame must be decoded too).
+BENCHMARK(BM_WalkLatency)->ArgName("playing")->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kSecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
