@@ -450,6 +450,23 @@ TEST_F(WindowTest, DemoAt1280x1024FillsTheWindowTheHudStaysSmallAndUpGoesToTheSk
   const Vec3 sky = man.domain.sky();
   EXPECT_GT(dot(normalize(to.position - to.look_at), sky), dot(normalize(from.position - from.look_at), sky));
   EXPECT_GT(from.labels.lat_deg, 0) << "the first camera looks from above the surface";
+
+  // 3. F: full screen is the whole 1280x1024 screen as the X server has it (Xvfb has no window
+  // manager to grant SDL's request: the window used to keep its size while SDL drew for the
+  // screen's, and showed a black band until a resize), and the picture fills it; F again restores.
+  const auto [full, shot_full] = run("full", "t=0 key=F\n");
+  EXPECT_TRUE(full.fullscreen);
+  EXPECT_EQ(full.native_w, 1280);
+  EXPECT_EQ(full.native_h, 1024);
+  EXPECT_EQ(full.window_w, 1280);
+  EXPECT_EQ(full.window_h, 1024);
+  EXPECT_GE(full.view_h, 1000) << "the frame is scaled to the full-screen height";
+  const auto [back, shot_back] = run("full_back", "t=0 key=F\nt=0.1 key=F\n");
+  EXPECT_FALSE(back.fullscreen);
+  EXPECT_EQ(back.native_w, with_hud.native_w);
+  EXPECT_EQ(back.native_h, with_hud.native_h);
+  EXPECT_EQ(with_hud.native_w, with_hud.window_w) << "SDL and the X server agree on the window's size";
+  EXPECT_EQ(with_hud.native_h, with_hud.window_h);
 }
 
 }  // namespace
