@@ -63,6 +63,7 @@ struct WindowResult {
   int window_w = 0, window_h = 0;  ///< the window's drawing area at exit (pixels)
   int native_w = 0, native_h = 0;  ///< the window's size at exit as the windowing system has it
   bool fullscreen = false;         ///< in full screen at exit
+  std::string notice;              ///< the last notice the HUD showed (why a key did nothing, ...)
   bool hud_drawn = false;       ///< the HUD window was submitted to ImGui in the last frame
   std::string status = "ok";    ///< health of the frame shown last: "ok", "missing", "unreadable"
   std::string summary;          ///< one-paragraph statistics (switch latency, fps, cache hits)
