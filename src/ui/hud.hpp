@@ -63,6 +63,8 @@ class Hud {
   bool show_help = false;
   /// Shows `text` for a few seconds at the bottom centre (screenshot saved, recording errors, ...).
   void notify(std::string text, bool error = false);
+  /// The last notice given to notify() (empty if none), whether or not still on screen.
+  const std::string& last_notice() const { return message_; }
   /// True if the status panel was submitted in the last draw() (the window test checks it).
   bool panel_drawn() const { return panel_drawn_; }
   /// True if window point (x, y) lies on one of the HUD's windows as drawn last frame. Mouse events

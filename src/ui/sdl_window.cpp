@@ -2,6 +2,10 @@
 
 #include <SDL.h>
 #include <imgui.h>
+#ifdef PANOPTES_HAVE_X11
+#include <SDL_syswm.h>
+#include <X11/Xlib.h>
+#endif
 
 #include <algorithm>
 #include <cfloat>
@@ -17,6 +21,39 @@ namespace {
 std::string no_display_hint() {
   return " (no display available? run `panoptes play --headless ...` for batch use, or start the "
          "window under a virtual display: `xvfb-run -a panoptes play ...`)";
+}
+
+#ifdef PANOPTES_HAVE_X11
+Display* x11_display(SDL_Window* window, ::Window* xwindow) {
+  SDL_SysWMinfo info;
+  SDL_VERSION(&info.version);
+  if (!SDL_GetWindowWMInfo(window, &info) || info.subsystem != SDL_SYSWM_X11) return nullptr;
+  if (xwindow) *xwindow = info.info.x11.window;
+  return info.info.x11.display;
+}
+#endif
+
+// False only where we know no window manager would answer a full-screen request: an X server
+// without an EWMH window manager (no _NET_SUPPORTING_WM_CHECK on the root window), such as Xvfb.
+bool window_manager_grants_fullscreen(SDL_Window* window) {
+#ifdef PANOPTES_HAVE_X11
+  Display* d = x11_display(window, nullptr);
+  if (!d) return true;
+  const Atom check = XInternAtom(d, "_NET_SUPPORTING_WM_CHECK", True);
+  if (check == None) return false;
+  Atom type = None;
+  int format = 0;
+  unsigned long items = 0, after = 0;
+  unsigned char* data = nullptr;
+  const int status = XGetWindowProperty(d, DefaultRootWindow(d), check, 0, 1, False, AnyPropertyType, &type,
+                                        &format, &items, &after, &data);
+  const bool present = status == Success && data && items == 1;
+  if (data) XFree(data);
+  return present;
+#else
+  (void)window;
+  return true;
+#endif
 }
 
 SDL_Renderer* create_renderer(SDL_Window* window, bool software, bool vsync) {
@@ -58,7 +95,6 @@ SdlWindow::SdlWindow(const SdlWindowOptions& options) {
     height = std::max(64, int(height * factor));
   }
   Uint32 wflags = SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI;
-  if (options.fullscreen) wflags |= SDL_WINDOW_FULLSCREEN_DESKTOP;
   window_ = SDL_CreateWindow(options.title.c_str(), SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED,
                              width, height, wflags);
   if (!window_) {
@@ -67,7 +103,8 @@ SdlWindow::SdlWindow(const SdlWindowOptions& options) {
     throw Error("cannot create a " + std::to_string(width) + "x" + std::to_string(height) +
                 " window: " + why + no_display_hint());
   }
-  fullscreen_ = options.fullscreen;
+  // Full screen is entered once the window exists, by the path that works on this display.
+  if (options.fullscreen) set_fullscreen(true);
   renderer_ = create_renderer(window_, options.software_renderer, options.vsync);
   if (!renderer_) {
     const std::string why = SDL_GetError();
@@ -110,7 +147,46 @@ void SdlWindow::output_size(int& w, int& h) const {
 }
 
 void SdlWindow::set_fullscreen(bool on) {
+  if (on == fullscreen_) return;
+  if (on && !window_manager_grants_fullscreen(window_)) {
+    // Without a window manager the X server applies a move and resize at once, and SDL then reports
+    // the new size, so the renderer and the HUD follow.
+    const int display = std::max(0, SDL_GetWindowDisplayIndex(window_));
+    SDL_Rect bounds{};
+    if (SDL_GetDisplayBounds(display, &bounds) != 0) return;
+    SDL_GetWindowPosition(window_, &windowed_x_, &windowed_y_);
+    SDL_GetWindowSize(window_, &windowed_w_, &windowed_h_);
+    SDL_SetWindowBordered(window_, SDL_FALSE);
+    SDL_SetWindowPosition(window_, bounds.x, bounds.y);
+    SDL_SetWindowSize(window_, bounds.w, bounds.h);
+    emulated_fullscreen_ = true;
+    fullscreen_ = true;
+    return;
+  }
+  if (!on && emulated_fullscreen_) {
+    SDL_SetWindowSize(window_, windowed_w_, windowed_h_);
+    SDL_SetWindowPosition(window_, windowed_x_, windowed_y_);
+    SDL_SetWindowBordered(window_, SDL_TRUE);
+    emulated_fullscreen_ = false;
+    fullscreen_ = false;
+    return;
+  }
   if (SDL_SetWindowFullscreen(window_, on ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0) == 0) fullscreen_ = on;
+}
+
+void SdlWindow::native_size(int& w, int& h) const {
+  SDL_GetWindowSize(window_, &w, &h);
+#ifdef PANOPTES_HAVE_X11
+  ::Window xw = 0;
+  if (Display* d = x11_display(window_, &xw)) {
+    XSync(d, False);
+    XWindowAttributes a{};
+    if (XGetWindowAttributes(d, xw, &a)) {
+      w = a.width;
+      h = a.height;
+    }
+  }
+#endif
 }
 
 void SdlWindow::begin_imgui_frame() {

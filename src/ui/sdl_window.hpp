@@ -41,9 +41,14 @@ class SdlWindow {
   /// Size of the renderer's output in pixels (may differ from the window size on HiDPI screens).
   void output_size(int& w, int& h) const;
 
-  /// Toggles desktop full screen.
+  /// Toggles full screen: the desktop full-screen mode where a window manager can grant it; on an X
+  /// server without one (Xvfb, bare X) a borderless window over the whole display, since there SDL's
+  /// request goes unanswered and the window kept its size while SDL drew for the display's.
   void set_fullscreen(bool on);
   bool fullscreen() const { return fullscreen_; }
+  /// The window's size as the windowing system has it (X11: the X server's own geometry), which is
+  /// what the user sees; falls back to SDL's window size where that cannot be asked.
+  void native_size(int& w, int& h) const;
 
   /// Starts an ImGui frame (call once per frame, after the events were given to process_event).
   void begin_imgui_frame();
@@ -59,6 +64,8 @@ class SdlWindow {
   SDL_Renderer* renderer_ = nullptr;
   std::string renderer_name_;
   bool fullscreen_ = false;
+  bool emulated_fullscreen_ = false;  ///< full screen as a borderless display-sized window (no WM)
+  int windowed_x_ = 0, windowed_y_ = 0, windowed_w_ = 0, windowed_h_ = 0;  ///< restored when leaving it
   bool imgui_sdl_ = false, imgui_renderer_ = false;
 };
 

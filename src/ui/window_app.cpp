@@ -638,8 +638,11 @@ WindowResult WindowApp::run() {
     result.hud_drawn = hud_.panel_drawn();
     result.window_w = out_w_;
     result.window_h = out_h_;
+    result.fullscreen = window_.fullscreen();
+    result.notice = hud_.last_notice();
     result.status = std::string(player::to_string(shown.status));
   }
+  window_.native_size(result.native_w, result.native_h);
   if (recorder_.active()) {
     const std::string path = recorder_.path();
     const int n = recorder_.stop();

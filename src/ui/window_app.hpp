@@ -61,6 +61,9 @@ struct WindowResult {
   double zoom = 1.0;            ///< magnification at exit (1 = whole frame fitted to the window)
   int view_x = 0, view_y = 0, view_w = 0, view_h = 0;  ///< where the frame was drawn at exit (pixels)
   int window_w = 0, window_h = 0;  ///< the window's drawing area at exit (pixels)
+  int native_w = 0, native_h = 0;  ///< the window's size at exit as the windowing system has it
+  bool fullscreen = false;         ///< in full screen at exit
+  std::string notice;              ///< the last notice the HUD showed (why a key did nothing, ...)
   bool hud_drawn = false;       ///< the HUD window was submitted to ImGui in the last frame
   std::string status = "ok";    ///< health of the frame shown last: "ok", "missing", "unreadable"
   std::string summary;          ///< one-paragraph statistics (switch latency, fps, cache hits)
