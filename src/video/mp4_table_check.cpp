@@ -40,6 +40,7 @@ struct Walker {
   // A table of `count` entries of `entry` bytes each, starting `header` bytes into the payload.
   void table_fits(const char* type, std::int64_t at, std::uint64_t payload, std::uint64_t header,
                   std::uint64_t count, std::uint64_t entry) const {
+    if (count == 0) return;
     if (header > payload || (entry > 0 && count > (payload - header) / entry))
       refuse(type, at, "declares " + std::to_string(count) + " entries of " + std::to_string(entry) +
                            " bytes but holds only " + std::to_string(payload > header ? payload - header : 0) +
@@ -55,9 +56,13 @@ struct Walker {
   }
 
   void leaf(const char* type, std::int64_t at, std::int64_t body, std::uint64_t payload) {
+    // FFmpeg cuts a box to its parent but then reads a table's header fields whether or not they lie
+    // inside the box (a 7-byte trun still has its sample count read from the bytes after it), so the
+    // fields come from the file and only the table is held to the box.
     std::uint8_t h[20] = {};
-    const int want = int(payload < sizeof h ? payload : sizeof h);
-    if (want < 8 || !read(body, h, want)) return;  // too short for any table: FFmpeg refuses it
+    const std::int64_t in_file = size - body;
+    const int want = int(in_file < std::int64_t(sizeof h) ? in_file : std::int64_t(sizeof h));
+    if (want < 8 || !read(body, h, want)) return;  // not even a count left in the file
     const int version = h[0];
     const std::uint32_t flags = std::uint32_t(be(h + 1, 3));
     const std::uint64_t count = be(h + 4, 4);
@@ -80,21 +85,27 @@ struct Walker {
       table_fits(type, at, payload, header, count, entry);
       add_samples(type, at, count);
     } else if (is("stsz")) {
-      if (payload < 12) return;
+      if (want < 12) return;
       const std::uint64_t sample_size = be(h + 4, 4), n = be(h + 8, 4);
       table_fits(type, at, payload, 12, n, sample_size == 0 ? 4 : 0);
       add_samples(type, at, n);
     } else if (is("stz2")) {
-      if (payload < 12) return;
+      if (want < 12) return;
       const std::uint64_t field_bits = h[7], n = be(h + 8, 4);
       // 4-, 8- or 16-bit sizes: compare bits to keep 4-bit tables exact.
-      if (field_bits == 4 || field_bits == 8 || field_bits == 16)
-        if (n > (payload - 12) * 8 / field_bits)
+      if (n > 0 && (field_bits == 4 || field_bits == 8 || field_bits == 16))
+        if (payload < 12 || n > (payload - 12) * 8 / field_bits)
           refuse(type, at, "declares " + std::to_string(n) + " sample sizes but holds only " +
-                               std::to_string(payload - 12) + " bytes of table");
+                               std::to_string(payload > 12 ? payload - 12 : 0) + " bytes of table");
       add_samples(type, at, n);
+    } else if (is("sbgp")) {
+      // grouping_type, (v1) grouping_type_parameter, entry_count; 8-byte entries. FFmpeg allocates the
+      // whole table from the count before reading it.
+      const std::uint64_t header = version == 1 ? 12 : 8;
+      if (std::uint64_t(want) < header + 4) return;
+      table_fits(type, at, payload, header + 4, be(h + header, 4), 8);
     } else if (is("tfra")) {
-      if (payload < 16) return;
+      if (want < 16) return;
       const std::uint64_t lengths = be(h + 8, 4), n = be(h + 12, 4);
       const std::uint64_t entry = (version == 1 ? 16 : 8) + ((lengths >> 4) & 3) + 1 + ((lengths >> 2) & 3) + 1 +
                                   (lengths & 3) + 1;
