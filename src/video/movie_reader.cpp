@@ -292,8 +292,12 @@ struct MovieReader::Impl {
     // One thread: no frame delay, so a frame comes out as soon as its packet goes in. The player runs
     // many readers in parallel instead.
     dec->thread_count = 1;
-    // The container's size is checked above; the stream's own (SPS) may claim another.
-    dec->max_pixels = kMaxMoviePixels;
+    // The container's size is checked above; the stream's own (SPS) may claim another, and a 2 kB
+    // stream of skipped macroblocks claiming 35 Mpixel pictures costs seconds per packet to decode. A
+    // picture may be no larger than about what the container says: FFmpeg checks its buffers' size
+    // (width aligned to the SIMD stride, up to 64), so allow twice that, within kMaxMoviePixels.
+    dec->max_pixels = std::min(kMaxMoviePixels,
+                               2 * std::int64_t((coded_width + 63) / 64 * 64) * ((coded_height + 15) / 16 * 16));
     ret = avcodec_open2(dec, codec, nullptr);
     if (ret < 0) throw FileError(path, "cannot open the video decoder: " + av_error_string(ret));
 

@@ -127,6 +127,33 @@ TEST_F(Mp4TableCheck, TableLongerThanItsBoxIsRefused) {
   EXPECT_NE(o.message.find("declares 1000000 entries of 8 bytes"), std::string::npos) << o.message;
 }
 
+// A stream whose pictures (SPS) are far larger than its container says: a tiny file could otherwise
+// make every packet a 35-Mpixel decode. The decoder refuses the pictures; the reader reports an error.
+TEST_F(Mp4TableCheck, PicturesLargerThanTheContainerSaysAreNotDecoded) {
+  const std::string big = (dir_ / "big.mp4").string();
+  {
+    MovieWriter writer(big, 512, 512);
+    for (int i = 0; i < 2; ++i) writer.append(testing::make_test_frame(512, 512, i));
+    writer.close();
+  }
+  auto b = slurp(big);
+  std::size_t avc1 = 0;
+  for (std::size_t i = 0; i + 32 <= b.size() && !avc1; ++i)
+    if (b[i] == 'a' && b[i + 1] == 'v' && b[i + 2] == 'c' && b[i + 3] == '1') avc1 = i + 4;
+  ASSERT_GT(avc1, 0u);
+  ASSERT_EQ(b[avc1 + 24], 0x02);  // width 512, big-endian, 24 bytes into the sample entry
+  b[avc1 + 24] = 0;
+  b[avc1 + 25] = 32;  // the container now says 32x32
+  b[avc1 + 26] = 0;
+  b[avc1 + 27] = 32;
+  const std::string path = (dir_ / "small_container.mp4").string();
+  spill(path, b);
+  MovieReader reader(path);
+  EXPECT_EQ(reader.coded_width(), 32);
+  YuvFrame frame;
+  EXPECT_THROW(reader.read(0, frame), Error) << "a 512x512 picture was decoded for a 32x32 container";
+}
+
 #ifdef PANOPTES_FUZZ_REGRESSIONS
 // The committed input itself (also replayed by fuzz.replay.movie and the sanitizer stage).
 TEST(Mp4TableCheckRegression, FuzzerMovieIsRefusedFastInLittleMemory) {
