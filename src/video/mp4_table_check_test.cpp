@@ -54,8 +54,10 @@ struct Outcome {
 Outcome open_movie(const std::string& path) {
   Outcome o;
   o.message = "(no error)";
-  const long before = peak_rss_mib();
+  // After the reset the peak is the current resident size: the baseline (the peak before it may
+  // have been reached by an earlier test).
   const bool can_measure = reset_peak_rss() == 0;
+  const long before = peak_rss_mib();
   const auto t0 = std::chrono::steady_clock::now();
   try {
     MovieReader reader(path);
