@@ -563,11 +563,12 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
   auto check = [&](std::int64_t i) {
     const int camera = int(i / tasks), task = int(i % tasks);
     StreamProblem problem{camera, task, StreamProblem::Kind::missing, {}};
+    std::int64_t file_bytes = -1;
     try {
       const fs::path resolved = resolve_stream(dir_, stream_path(camera, task), camera, task);
       std::error_code ec;
       const auto size = fs::file_size(resolved, ec);
-      if (!ec) bytes += std::int64_t(size);
+      if (!ec) bytes += file_bytes = std::int64_t(size);
       auto reader = stream(camera, task);
       problem.message.clear();
       if (decode_all) {
@@ -599,9 +600,12 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
       problem.message = e.what();  // a decode failure of the last frame
       problem.kind = StreamProblem::Kind::unreadable;
     }
-    // A database stopped before its first checkpoint records no frame: a movie not created yet is
-    // not a problem then (nothing it should hold is missing).
-    if (problem.kind == StreamProblem::Kind::missing && frame_count() == 0) problem.message.clear();
+    // A database stopped before its first checkpoint records no frame: a movie not created yet, or
+    // created but still empty (the writer was killed before its header), is not a problem then
+    // (nothing it should hold is missing).
+    if (frame_count() == 0 && (problem.kind == StreamProblem::Kind::missing ||
+                               (problem.kind == StreamProblem::Kind::unreadable && file_bytes == 0)))
+      problem.message.clear();
     if (!problem.message.empty()) {
       std::lock_guard lock(mutex);
       report.problems.push_back(std::move(problem));

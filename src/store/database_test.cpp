@@ -242,6 +242,31 @@ TEST(Database, BrokenStreamsGiveClearErrorsAndOthersStillRead) {
   EXPECT_EQ(report.problems[2].task, 2);
 }
 
+// A writer killed before its first checkpoint may leave a movie created but still empty (cli.kill_run
+// met one: SIGKILL between creating the file and writing its header). With no frame recorded nothing
+// is missing; once frames are recorded an empty movie is a problem.
+TEST(Database, EmptyMovieOfADatabaseWithoutFramesIsNotAProblem) {
+  TempDir dir;
+  {
+    DatabaseWriter w = DatabaseWriter::create(dir.path, sample_manifest(2, 1));
+  }  // interrupted before the first checkpoint
+  fs::create_directories(dir / "movies/c1");
+  std::ofstream(dir / "movies/c1/t0.mp4", std::ios::trunc).close();
+  ASSERT_TRUE(fs::exists(dir / "movies/c1/t0.mp4"));
+  ASSERT_EQ(fs::file_size(dir / "movies/c1/t0.mp4"), 0u);
+  const Database empty = Database::open(dir.path);
+  ASSERT_EQ(empty.frame_count(), 0);
+  EXPECT_TRUE(empty.validate_streams(1, true).problems.empty());
+
+  TempDir dir2;
+  write_db(dir2.path, sample_manifest(2, 1), 1);
+  std::ofstream(dir2 / "movies/c1/t0.mp4", std::ios::trunc).close();
+  const StreamReport report = Database::open(dir2.path).validate_streams(1, true);
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_EQ(report.problems[0].kind, StreamProblem::Kind::unreadable);
+  EXPECT_CONTAINS(report.problems[0].message, "the file is empty");
+}
+
 TEST(Database, PathsLeavingTheDirectoryAreRefused) {
   TempDir outside("outside"), dir;
   write_db(dir.path, sample_manifest(3, 1), 2);

@@ -19,6 +19,7 @@ extern "C" {
 
 #include "core/error.hpp"
 #include "video/ffmpeg_util.hpp"
+#include "video/mp4_table_check.hpp"
 #include "video/packet_checksum.hpp"
 
 namespace panoptes::video {
@@ -34,6 +35,14 @@ struct PacketInfo {
 };
 
 std::string errno_string(int e) { return std::strerror(e); }
+
+// What a movie may make the decoder allocate: the largest picture a database may hold (the same
+// bound as the manifest's image size, store::kMaxImagePixels / kMaxImageSide, 8192x4352 and 16384 a
+// side). FFmpeg's own default lets a 2 kB stream ask for INT_MAX-pixel pictures.
+constexpr std::int64_t kMaxMoviePixels = std::int64_t(139264) * 256;
+constexpr int kMaxMovieSide = 16384;
+// Streams the demuxer may create (FFmpeg's default is 1000, each with its own tables); ours have one.
+constexpr int kMaxMovieStreams = 16;
 
 }  // namespace
 
@@ -156,6 +165,8 @@ struct MovieReader::Impl {
     file_size = sb.st_size;
     if (file_size == 0) throw FileError(path, "not a readable movie (the file is empty)");
     view_size = readable_prefix();
+    // Before FFmpeg sees the file: its sample tables must fit in it (see mp4_table_check.hpp).
+    check_mp4_sample_tables(fd, view_size, path);
 
     constexpr int kIoBuffer = 1 << 15;
     auto* io_buf = static_cast<std::uint8_t*>(av_malloc(kIoBuffer));
@@ -169,6 +180,7 @@ struct MovieReader::Impl {
     }
     fmt->pb = io;
     fmt->flags |= AVFMT_FLAG_CUSTOM_IO;
+    fmt->max_streams = kMaxMovieStreams;
     struct Closer {
       AVFormatContext*& f;
       AVIOContext* io;
@@ -194,6 +206,11 @@ struct MovieReader::Impl {
     coded_width = st->codecpar->width;
     coded_height = st->codecpar->height;
     if (coded_width <= 0 || coded_height <= 0) throw FileError(path, "video stream has no frame size");
+    if (coded_width > kMaxMovieSide || coded_height > kMaxMovieSide ||
+        std::int64_t(coded_width) * coded_height > kMaxMoviePixels)
+      throw FileError(path, "video frame size " + std::to_string(coded_width) + "x" + std::to_string(coded_height) +
+                                " is larger than a movie may be (at most " + std::to_string(kMaxMovieSide) +
+                                " a side and " + std::to_string(kMaxMoviePixels) + " pixels)");
 
     // One pass over the packets (no decoding) gives the exact frame count, even for fragmented or
     // truncated files whose header holds no sample table. Samples cut off by truncation are dropped.
@@ -275,6 +292,12 @@ struct MovieReader::Impl {
     // One thread: no frame delay, so a frame comes out as soon as its packet goes in. The player runs
     // many readers in parallel instead.
     dec->thread_count = 1;
+    // The container's size is checked above; the stream's own (SPS) may claim another, and a 2 kB
+    // stream of skipped macroblocks claiming 35 Mpixel pictures costs seconds per packet to decode. A
+    // picture may be no larger than about what the container says: FFmpeg checks its buffers' size
+    // (width aligned to the SIMD stride, up to 64), so allow twice that, within kMaxMoviePixels.
+    dec->max_pixels = std::min(kMaxMoviePixels,
+                               2 * std::int64_t((coded_width + 63) / 64 * 64) * ((coded_height + 15) / 16 * 16));
     ret = avcodec_open2(dec, codec, nullptr);
     if (ret < 0) throw FileError(path, "cannot open the video decoder: " + av_error_string(ret));
 
