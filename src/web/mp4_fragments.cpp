@@ -1,6 +1,7 @@
 #include "web/mp4_fragments.hpp"
 
 #include <array>
+#include <climits>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -69,8 +70,8 @@ class File {
 bool is(const BoxHeader& h, const char* type) { return std::memcmp(h.type.data(), type, 4) == 0; }
 
 /// Sum of trun sample counts over every traf of the moof at [begin, end).
-int moof_samples(File& f, std::uint64_t begin, std::uint64_t end) {
-  int samples = 0;
+std::uint64_t moof_samples(File& f, std::uint64_t begin, std::uint64_t end) {
+  std::uint64_t samples = 0;
   bool found = false;
   BoxHeader traf;
   for (std::uint64_t p = begin; p < end && f.box(p, end, traf); p += traf.size) {
@@ -81,7 +82,7 @@ int moof_samples(File& f, std::uint64_t begin, std::uint64_t end) {
       if (!is(child, "trun")) continue;
       unsigned char b[8];  // version + flags, sample_count
       if (!f.read(q + child.header, b, 8)) break;
-      samples += int(be32(b + 4));
+      samples += be32(b + 4);
       found = true;
     }
   }
@@ -109,7 +110,13 @@ FragmentIndex index_fragments(const std::filesystem::path& movie) {
       BoxHeader mdat;
       const std::uint64_t q = p + h.size;
       if (!f.box(q, f.size(), mdat) || !is(mdat, "mdat") || q + mdat.size > f.size()) break;
-      const int n = moof_samples(f, p + h.header, p + h.size);
+      const std::uint64_t count = moof_samples(f, p + h.header, p + h.size);
+      // A hostile trun count must not overflow the frame numbers: every sample takes at least one byte.
+      if (count > mdat.size || count > std::uint64_t(INT_MAX - next_frame))
+        throw FileError(movie.string(), "fragment at byte " + std::to_string(p) + " claims " + std::to_string(count) +
+                                            " samples in an mdat of " + std::to_string(mdat.size) +
+                                            " bytes (expected at most one sample per byte)");
+      const int n = int(count);
       index.fragments.push_back({p, h.size + mdat.size, next_frame, n});
       next_frame += n;
       h.size += mdat.size;

@@ -50,6 +50,29 @@ TEST(Mp4Fragments, OneFragmentPerGopCoversEveryFrame) {
   EXPECT_LE(expected_offset, index.file_size);  // a finished movie ends with an mfra box
 }
 
+TEST(Mp4Fragments, HostileSampleCountIsRefusedNotOverflowed) {
+  store::testing::TempDir tmp("web-frag");
+  const fs::path movie = make_db(tmp.path / "db", 3, 1);
+  std::string bytes;
+  {
+    std::ifstream in(movie, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t trun = bytes.find("trun");
+  ASSERT_NE(trun, std::string::npos);
+  for (int i = 0; i < 4; ++i) bytes[trun + 8 + i] = char(0xff);  // sample_count after version + flags
+  {
+    std::ofstream out(movie, std::ios::binary | std::ios::trunc);
+    out << bytes;
+  }
+  try {
+    index_fragments(movie);
+    FAIL() << "a trun count of 2^32-1 was accepted";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("4294967295 samples"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Mp4Fragments, TruncatedMovieKeepsItsCompleteFragments) {
   store::testing::TempDir tmp("web-frag");
   const fs::path movie = make_db(tmp.path / "db", 4, 1);
