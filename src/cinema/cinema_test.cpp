@@ -62,14 +62,7 @@ cinema::ExportOptions export_options(std::vector<int> frames, std::string format
   return o;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using panoptes::store::testing::error_of;
 
 }  // namespace
 

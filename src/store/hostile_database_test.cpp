@@ -20,20 +20,11 @@
 using namespace panoptes;
 using namespace panoptes::store;
 using panoptes::store::testing::sample_manifest;
+using panoptes::store::testing::error_of;
 using panoptes::store::testing::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
 
 #define EXPECT_CONTAINS(text, part) \
   EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text) << "\nexpected: " << (part)

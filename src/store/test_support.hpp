@@ -7,9 +7,21 @@
 #include <random>
 #include <string>
 
+#include "core/error.hpp"
 #include "store/manifest.hpp"
 
 namespace panoptes::store::testing {
+
+/// The message of the panoptes::Error that f() throws, or "<no error>" (tests assert on messages).
+template <class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
 
 /// A fresh directory under the system temp dir, removed (recursively) on destruction.
 struct TempDir {
