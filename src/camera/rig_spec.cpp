@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera/number_line.hpp"
 #include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 #include "core/file_read.hpp"
@@ -343,21 +344,9 @@ std::vector<FileCamera> parse_text_cameras(const std::string& text, const std::s
   std::istringstream in(text);
   std::string line;
   for (int line_no = 1; std::getline(in, line); ++line_no) {
-    if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    for (char& ch : line)
-      if (ch == ',' || ch == '\t' || ch == '\r') ch = ' ';
-    std::istringstream fields(line);
-    std::vector<double> v;
-    std::string tok;
     FileCamera fc;
     fc.where = "line " + std::to_string(line_no);
-    while (fields >> tok) {
-      double x = 0;
-      const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), x);
-      if (ec != std::errc() || end != tok.data() + tok.size() || !std::isfinite(x))
-        throw FileError(path, fc.where + ": '" + tok + "' is not a number");
-      v.push_back(x);
-    }
+    const std::vector<double> v = parse_number_line(line, path, fc.where);
     if (v.empty()) continue;
     if (v.size() != 3 && v.size() != 6 && v.size() != 9 && v.size() != 10 && v.size() != 11)
       throw FileError(path, fc.where + ": " + std::to_string(v.size()) +

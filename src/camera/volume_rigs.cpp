@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "camera/number_line.hpp"
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
 #include "core/file_read.hpp"
@@ -78,19 +79,7 @@ Rig read_path_rig(const std::string& path, const Domain& domain, double fov_y_de
   std::istringstream in(text);
   std::string line;
   for (int line_no = 1; std::getline(in, line); ++line_no) {
-    if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    for (char& ch : line)
-      if (ch == ',' || ch == '\t' || ch == '\r') ch = ' ';
-    std::istringstream fields(line);
-    std::vector<double> v;
-    std::string tok;
-    while (fields >> tok) {
-      double x = 0;
-      const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), x);
-      if (ec != std::errc() || end != tok.data() + tok.size() || !std::isfinite(x))
-        throw FileError(path, "line " + std::to_string(line_no) + ": '" + tok + "' is not a number");
-      v.push_back(x);
-    }
+    const std::vector<double> v = parse_number_line(line, path, "line " + std::to_string(line_no));
     if (v.empty()) continue;
     if (v.size() != 3)
       throw FileError(path, "line " + std::to_string(line_no) + ": " + std::to_string(v.size()) +
