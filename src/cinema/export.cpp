@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cinema/csv.hpp"
+#include "cinema/stream_workers.hpp"
 #include "core/error.hpp"
 #include "core/png.hpp"
 #include "store/database.hpp"
@@ -100,46 +101,26 @@ ExportReport export_cinema(const fs::path& db_dir, const fs::path& out, const Ex
 
   // Streams are independent: decode them on a few threads, each stream's frames in order.
   const std::int64_t streams = std::int64_t(cams) * tasks, total = streams * std::int64_t(frames.size());
-  std::atomic<std::int64_t> next{0}, done{0}, bytes{0};
-  std::mutex error_mutex, progress_mutex;
-  std::exception_ptr error;
-  auto work = [&] {
-    for (std::int64_t s; (s = next++) < streams;) {
-      {
-        std::lock_guard lock(error_mutex);
-        if (error) return;
-      }
-      try {
-        const int c = int(s / tasks), t = int(s % tasks);
-        const auto reader = db.stream(c, t);
-        for (int f : frames) {
-          const Image img = reader->read_rgba(f);
-          const fs::path path = out / rel_file(c, t, f);
-          if (o.format == "png")
-            write_png(path.string(), img);
-          else
-            write_jpg(path.string(), img, o.jpeg_quality);
-          bytes += std::int64_t(fs::file_size(path));
-          const std::int64_t d = ++done;
-          if (progress && (d % 64 == 0 || d == total)) {
-            std::lock_guard lock(progress_mutex);
-            progress(d, total);
-          }
-        }
-      } catch (...) {
-        std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        return;
+  std::atomic<std::int64_t> done{0}, bytes{0};
+  std::mutex progress_mutex;
+  for_each_stream(streams, o.threads, [&](std::int64_t s) {
+    const int c = int(s / tasks), t = int(s % tasks);
+    const auto reader = db.stream(c, t);
+    for (int f : frames) {
+      const Image img = reader->read_rgba(f);
+      const fs::path path = out / rel_file(c, t, f);
+      if (o.format == "png")
+        write_png(path.string(), img);
+      else
+        write_jpg(path.string(), img, o.jpeg_quality);
+      bytes += std::int64_t(fs::file_size(path));
+      const std::int64_t d = ++done;
+      if (progress && (d % 64 == 0 || d == total)) {
+        std::lock_guard lock(progress_mutex);
+        progress(d, total);
       }
     }
-  };
-  const int n = std::max(1, std::min<int>(o.threads > 0 ? o.threads : int(std::thread::hardware_concurrency()),
-                                          int(std::min<std::int64_t>(streams, 64))));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < n; ++i) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
+  });
 
   // data.csv: one row per image; parameters first, FILE last (Spec D).
   std::string csv = "time,camera,phi,theta,task";

@@ -13,6 +13,7 @@
 #include "camera/rig.hpp"
 #include "cinema/cinema_database.hpp"
 #include "cinema/csv.hpp"
+#include "cinema/stream_workers.hpp"
 #include "core/error.hpp"
 #include "core/png.hpp"
 #include "store/database.hpp"
@@ -311,45 +312,25 @@ ImportReport import_cinema(const fs::path& cdb, const fs::path& out, const Impor
   for (int f = 0; f < nf; ++f) writer.set_time(f, m.times[std::size_t(f)]);
 
   const std::int64_t streams = std::int64_t(nc) * nt, total = streams * nf;
-  std::atomic<std::int64_t> next{0}, done{0};
-  std::mutex mutex;
-  std::exception_ptr error;
-  auto work = [&] {
-    for (std::int64_t s; (s = next++) < streams;) {
-      {
-        std::lock_guard lock(mutex);
-        if (error) return;
-      }
-      try {
-        for (int f = 0; f < nf; ++f) {
-          const fs::path& path = plan.files[std::size_t(s) * std::size_t(nf) + std::size_t(f)];
-          const Image img = read_image(path.string());
-          if (img.width != m.image.width || img.height != m.image.height)
-            throw FileError(path.string(), "image is " + std::to_string(img.width) + "x" + std::to_string(img.height) +
-                                               "; expected " + std::to_string(m.image.width) + "x" +
-                                               std::to_string(m.image.height));
-          writer.append(int(s / nt), int(s % nt), img);
-          const std::int64_t d = ++done;
-          if (progress && (d % 64 == 0 || d == total)) {
-            std::lock_guard lock(mutex);
-            progress(d, total);
-          }
-        }
-        writer.close_stream(int(s / nt), int(s % nt));
-      } catch (...) {
-        std::lock_guard lock(mutex);
-        if (!error) error = std::current_exception();
-        return;
+  std::atomic<std::int64_t> done{0};
+  std::mutex progress_mutex;
+  for_each_stream(streams, o.threads, [&](std::int64_t s) {
+    for (int f = 0; f < nf; ++f) {
+      const fs::path& path = plan.files[std::size_t(s) * std::size_t(nf) + std::size_t(f)];
+      const Image img = read_image(path.string());
+      if (img.width != m.image.width || img.height != m.image.height)
+        throw FileError(path.string(), "image is " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                                           "; expected " + std::to_string(m.image.width) + "x" +
+                                           std::to_string(m.image.height));
+      writer.append(int(s / nt), int(s % nt), img);
+      const std::int64_t d = ++done;
+      if (progress && (d % 64 == 0 || d == total)) {
+        std::lock_guard lock(progress_mutex);
+        progress(d, total);
       }
     }
-  };
-  const int n = std::max(1, std::min<int>(o.threads > 0 ? o.threads : int(std::thread::hardware_concurrency()),
-                                          int(std::min<std::int64_t>(streams, 64))));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < n; ++i) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
+    writer.close_stream(int(s / nt), int(s % nt));
+  });
   writer.finalize();
   return {nc, nt, nf, plan.spec};
 }
