@@ -12,32 +12,18 @@
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
 #include "core/file_read.hpp"
+#include "core/toml_keys.hpp"
 
 namespace panoptes::insitu {
 
 namespace {
 
-struct Ctx {
-  std::string source;
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw Error(source + ": " + key + ": " + what);
-  }
-};
-
-std::string join(const std::set<std::string>& s) {
-  std::string out;
-  for (const auto& a : s) out += (out.empty() ? "" : ", ") + a;
-  return out;
-}
-
-void only_keys(const Ctx& c, const toml::table& t, const std::string& where, const std::set<std::string>& allowed) {
-  for (const auto& [k, v] : t) {
-    (void)v;
-    if (!allowed.count(std::string(k.str())))
-      c.fail(where.empty() ? std::string(k.str()) : where + "." + std::string(k.str()),
-             "unknown key (expected one of: " + join(allowed) + ")");
-  }
-}
+using Ctx = toml_keys::Source;
+using toml_keys::boolean;
+using toml_keys::int_in;
+using toml_keys::integer;
+using toml_keys::only_keys;
+using toml_keys::str;
 
 const toml::table* table(const Ctx& c, const toml::table& t, const std::string& key) {
   const auto* n = t.get(key);
@@ -58,38 +44,6 @@ double number_of(const Ctx& c, const toml::node& n, const std::string& key) {
 double num(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, double def) {
   const auto* n = t.get(key);
   return n ? number_of(c, *n, where + key) : def;
-}
-
-long long integer(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def) {
-  const auto* n = t.get(key);
-  if (!n) return def;
-  if (auto v = n->value_exact<int64_t>()) return *v;
-  c.fail(where + key, "expected an integer");
-}
-
-// An integer key that must fit an int field: checked before narrowing (4294967336 is not 40).
-int int_in(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def,
-           long long lo, long long hi) {
-  const long long v = integer(c, t, key, where, def);
-  if (v < lo || v > hi)
-    c.fail(where + key, std::to_string(v) + " is out of range (expected an integer in " + std::to_string(lo) + " .. " +
-                            std::to_string(hi) + ")");
-  return int(v);
-}
-
-bool boolean(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, bool def) {
-  const auto* n = t.get(key);
-  if (!n) return def;
-  if (auto v = n->value_exact<bool>()) return *v;
-  c.fail(where + key, "expected true or false");
-}
-
-std::string str(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where,
-                const std::string& def) {
-  const auto* n = t.get(key);
-  if (!n) return def;
-  if (auto v = n->value_exact<std::string>()) return *v;
-  c.fail(where + key, "expected a string");
 }
 
 std::vector<double> numbers(const Ctx& c, const toml::node& n, const std::string& key) {

@@ -12,31 +12,23 @@
 
 #include "core/error.hpp"
 #include "core/file_read.hpp"
+#include "core/toml_keys.hpp"
 #include "seismic/solver.hpp"
 
 namespace panoptes::seismic {
 
 namespace {
 
-struct Ctx {
-  std::string file;
-  std::string base;
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw FileError(file, key + ": " + what);
-  }
-};
+using toml_keys::boolean;
+using toml_keys::int_in;
+using toml_keys::integer;
+using toml_keys::only_keys;
+using toml_keys::str;
 
-void only_keys(const Ctx& c, const toml::table& t, const std::string& where, std::set<std::string> allowed) {
-  for (const auto& [k, v] : t) {
-    (void)v;
-    if (!allowed.count(std::string(k.str()))) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      c.fail(where.empty() ? std::string(k.str()) : where + "." + std::string(k.str()),
-             "unknown key (expected one of: " + list + ")");
-    }
-  }
-}
+// The source's name for messages and the folder relative paths in it are resolved against.
+struct Ctx : toml_keys::Source {
+  std::string base;
+};
 
 const toml::table* table(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where) {
   const auto* n = t.get(key);
@@ -56,45 +48,6 @@ double num(const Ctx& c, const toml::table& t, const std::string& key, const std
   if (auto v = n->value_exact<int64_t>()) return double(*v);
   if (auto s = n->value_exact<std::string>(); s && (*s == "inf" || *s == "infinity")) return INFINITY;
   c.fail(where + key, "expected a number");
-}
-
-long long integer(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def,
-                  bool required = false) {
-  const auto* n = t.get(key);
-  if (!n) {
-    if (required) c.fail(where + key, "missing (an integer is required)");
-    return def;
-  }
-  if (auto v = n->value_exact<int64_t>()) return *v;
-  c.fail(where + key, "expected an integer");
-}
-
-// An integer key that must fit an int field: checked before narrowing (4294967336 is not 40).
-int int_in(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, long long def,
-           long long lo, long long hi, bool required = false) {
-  const long long v = integer(c, t, key, where, def, required);
-  if (v < lo || v > hi)
-    c.fail(where + key, std::to_string(v) + " is out of range (expected an integer in " + std::to_string(lo) + " .. " +
-                            std::to_string(hi) + ")");
-  return int(v);
-}
-
-bool boolean(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, bool def) {
-  const auto* n = t.get(key);
-  if (!n) return def;
-  if (auto v = n->value_exact<bool>()) return *v;
-  c.fail(where + key, "expected true or false");
-}
-
-std::string str(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where,
-                const std::string& def, bool required = false) {
-  const auto* n = t.get(key);
-  if (!n) {
-    if (required) c.fail(where + key, "missing (a string is required)");
-    return def;
-  }
-  if (auto v = n->value_exact<std::string>()) return *v;
-  c.fail(where + key, "expected a string");
 }
 
 template <std::size_t N>
