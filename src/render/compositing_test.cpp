@@ -117,6 +117,38 @@ TEST(Compositing, EmptySpaceSkippingDoesNotChangeImagesAndSkips) {
   }
 }
 
+// A dense field with one empty macro-cell: rays that miss it skip the macro-cell walk (one run),
+// rays through it walk and skip its samples. Both must give the images of the unskipped march.
+TEST(Compositing, DenseFieldWithOneEmptyCellSkipsOnlyThere) {
+  const GridGeometry grid{{41, 33, 34}, {0, 0, 0}, {1, 1, 1}};
+  std::vector<float> v(std::size_t(grid.dims[0]) * grid.dims[1] * grid.dims[2]);
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i) {
+        // Points 15 … 25 on every axis are zero, so macro-cell (2, 2, 2) of size 8 is all zero.
+        const bool hole = i >= 15 && i <= 25 && j >= 15 && j <= 25 && k >= 15 && k <= 25;
+        v[(std::size_t(k) * grid.dims[1] + j) * grid.dims[0] + i] = hole ? 0.0f : 0.5f + 0.01f * float((i + 2 * j + 3 * k) % 7);
+      }
+  const std::vector<FieldView> views{FieldView::whole(grid, v.data())};
+  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave", 0.2f), ValueWindow::absolute(0, 1))};
+  const camera::Camera cam({70, -50, 45}, {20, 16, 16}, {0, 0, 1}, 40, 64, 60);
+  std::vector<PreparedField> fields{PreparedField(views[0])};
+  std::vector<PartialImage> a(1), b(1);
+  RenderOptions on, off;
+  off.skip_empty = false;
+  const auto sa = render_brick(cam, fields, tasks, a, on);
+  const auto sb = render_brick(cam, fields, tasks, b, off);
+  EXPECT_EQ(a[0].rgba, b[0].rgba);
+  EXPECT_EQ(sa.samples, sb.samples);
+  EXPECT_LT(sa.marched_samples, sb.marched_samples);  // the hole's samples were skipped
+  EXPECT_GT(sa.marched_samples, sb.marched_samples * 9 / 10);  // and little else
+  const auto ref = render_bricked(cam, views, tasks, {Brick::whole(grid)});
+  for (int axis : {0, 2}) {
+    const auto img = render_bricked(cam, views, tasks, {Brick::slab(grid, axis, 2, 0), Brick::slab(grid, axis, 2, 1)});
+    EXPECT_LE(max_diff(img[0], ref[0]), 1) << "axis " << axis;
+  }
+}
+
 TEST(Compositing, ManyTasksAreSplitIntoGroupsOfMarches) {
   GridGeometry g{{9, 9, 9}, {-4, -4, -4}, {1, 1, 1}};
   std::vector<float> v(9 * 9 * 9, 0.5f);

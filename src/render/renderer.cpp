@@ -187,6 +187,11 @@ struct Shared {
   std::vector<TaskRt> rt;
   std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
   std::uint64_t march_mask = 0, iso_mask = 0;
+  // Dense scenes: (nearly) every macro-cell is visible to every march task. A ray that meets none
+  // of the few cells that are not (`exceptions`: their boxes in index space, grown by one voxel) would
+  // have its walk merge all its cells into one run, so the march skips the walk and runs [ks, ke].
+  bool direct = false;
+  std::vector<std::array<double, 6>> exceptions;  // lo xyz, hi xyz
   std::vector<int> slices;
   double dt = 0;
   float termination = 0.998f;
@@ -616,6 +621,30 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     }
   };
 
+  if (S.direct) {
+    // The ray's samples lie within [t0 + (ks − 1)·dt, t0 + (ke + 1)·dt]; the walk visits only cells
+    // that stretch meets, and the boxes are grown by a voxel, so a miss is conservative.
+    const double ta = t0 + double(ks - 1) * dt, tb = t0 + double(ke + 1) * dt;
+    bool clear = true;
+    for (const auto& e : S.exceptions) {
+      double u0, u1;
+      if (slab(O, D, &e[0], &e[3], u0, u1) && u1 >= ta && u0 <= tb) {
+        clear = false;
+        break;
+      }
+    }
+    if (clear) {
+      // One run over the whole ray: the samples and their order are those of the merged walk, so
+      // images are the same bits; `safe` = false only means clamped indices (same bits, see interp()).
+      run(ks, ke, S.march_mask, false);
+      for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
+        float* a = acc[std::countr_zero(m)];
+        a[3] = 1.0f - a[3];
+      }
+      return;
+    }
+  }
+
   // 3-D DDA over the macro-cells (Amanatides–Woo): per cell only a compare, an add and a mask load;
   // sample indices are computed only for cells that some live task can see, so a run of empty
   // cells costs a few cycles each. The walk starts in the cell of sample ks (clamped to the brick).
@@ -898,6 +927,24 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       }
     }
     S.active[std::size_t(m)] = bits;
+  }
+  {
+    constexpr int kMaxExceptions = 16;  // beyond that the per-ray box tests would cost more than they save
+    int n_exc = 0;
+    for (int m = 0; m < nmc && n_exc <= kMaxExceptions; ++m) n_exc += S.active[std::size_t(m)] != S.march_mask;
+    S.direct = S.march_mask && n_exc <= kMaxExceptions;
+    if (S.direct)
+      for (int m = 0; m < nmc; ++m) {
+        if (S.active[std::size_t(m)] == S.march_mask) continue;
+        const int mc3[3] = {m % S.mcount[0], (m / S.mcount[0]) % S.mcount[1], m / (S.mcount[0] * S.mcount[1])};
+        std::array<double, 6> e;
+        for (int a = 0; a < 3; ++a) {
+          const int c0 = S.brick.lo[a] + mc3[a] * S.mc, c1 = std::min(c0 + S.mc, S.brick.hi[a]);
+          e[std::size_t(a)] = c0 - 1.0;
+          e[std::size_t(a) + 3] = c1 + 1.0;
+        }
+        S.exceptions.push_back(e);
+      }
   }
 
   // The brick's screen footprint.
