@@ -381,8 +381,8 @@ inline void lut_bin_block(const float* v, float lo, float sc, float last, bool a
 // Composites lanes 0 … n−1 of a block (sample k0 + l, LUT bins `bin`) of one single-field volume
 // task into the accumulator (colour c0..c2, transmittance tr). Returns the lane where the ray became
 // opaque, or −1. Shared by the fast path and the general path, so both give the same bits.
-inline int composite_volume1(const LutEntry* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
-                             float partial, float tr_stop, float& c0, float& c1, float& c2, float& tr) {
+inline int composite_volume1_scalar(const LutEntry* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
+                                    float partial, float tr_stop, float& c0, float& c1, float& c2, float& tr) {
   for (int l = 0; l < n; ++l) {
     const LutEntry& e = lut[bin[l]];
     float pr = e.pr, pg = e.pg, pb = e.pb, al = e.alpha;
@@ -391,14 +391,43 @@ inline int composite_volume1(const LutEntry* lut, const int* bin, int n, std::in
       const float sf = al > 0 ? an / al : 0.0f;
       pr *= sf, pg *= sf, pb *= sf, al = an;
     }
-    c0 += tr * pr;
-    c1 += tr * pg;
-    c2 += tr * pb;
+    c0 = std::fma(tr, pr, c0);
+    c1 = std::fma(tr, pg, c1);
+    c2 = std::fma(tr, pb, c2);
     tr *= 1.0f - al;
     if (tr <= tr_stop) [[unlikely]]
       return l;
   }
   return -1;
+}
+
+inline int composite_volume1(const LutEntry* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
+                             float partial, float tr_stop, float& c0, float& c1, float& c2, float& tr) {
+#ifdef PANOPTES_RENDER_AVX2
+  // The common block (no shortened last sample) with the colour in one 4-lane register: per sample
+  // one 16-byte LUT load, one FMA and the transmittance multiply, and no termination test. The
+  // transmittance never increases, so the block's final value tells whether some sample reached
+  // tr_stop; only then (once per ray) is the block redone sample by sample from its start. The
+  // operations per sample are those of the scalar loop (fused multiply-adds, the same order), so
+  // both loops give the same bits.
+  if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
+    __m128 c = _mm_setr_ps(c0, c1, c2, 0.0f);
+    __m128 t = _mm_set1_ps(tr);
+    const __m128 one = _mm_set1_ps(1.0f);
+    for (int l = 0; l < n; ++l) {
+      const LutEntry& e = lut[bin[l]];
+      c = _mm_fmadd_ps(t, _mm_loadu_ps(&e.pr), c);
+      t = _mm_mul_ps(t, _mm_sub_ps(one, _mm_broadcast_ss(&e.alpha)));
+    }
+    if (_mm_cvtss_f32(t) > tr_stop) [[likely]] {
+      alignas(16) float cc[4];
+      _mm_store_ps(cc, c);
+      c0 = cc[0], c1 = cc[1], c2 = cc[2], tr = _mm_cvtss_f32(t);
+      return -1;
+    }
+  }
+#endif
+  return composite_volume1_scalar(lut, bin, n, k0, k_partial, partial, tr_stop, c0, c1, c2, tr);
 }
 
 // The same for a two-field volume task (extinctions add, colours mix by extinction).
