@@ -431,8 +431,9 @@ inline int composite_volume1(const LutEntry* lut, const int* bin, int n, std::in
 }
 
 // The same for a two-field volume task (extinctions add, colours mix by extinction).
-inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const int* bin1, const int* bin2, int n,
-                             std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop, float* a) {
+inline int composite_volume2_scalar(const LutEntry* lut1, const LutEntry* lut2, const int* bin1, const int* bin2,
+                                    int n, std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop,
+                                    float* a) {
   float c0 = a[0], c1 = a[1], c2 = a[2], tr = a[3];
   int stop = -1;
   for (int l = 0; l < n; ++l) {
@@ -443,9 +444,9 @@ inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const i
     float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
     if (k0 + l == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
     const float s = tr * al / tau;
-    c0 += s * (e1.tau * e1.r + e2.tau * e2.r);
-    c1 += s * (e1.tau * e1.g + e2.tau * e2.g);
-    c2 += s * (e1.tau * e1.b + e2.tau * e2.b);
+    c0 = std::fma(s, std::fma(e1.tau, e1.r, e2.tau * e2.r), c0);
+    c1 = std::fma(s, std::fma(e1.tau, e1.g, e2.tau * e2.g), c1);
+    c2 = std::fma(s, std::fma(e1.tau, e1.b, e2.tau * e2.b), c2);
     tr = tr * (1.0f - al);
     if (tr <= tr_stop) [[unlikely]] {
       stop = l;
@@ -454,6 +455,37 @@ inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const i
   }
   a[0] = c0, a[1] = c1, a[2] = c2, a[3] = tr;
   return stop;
+}
+
+inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const int* bin1, const int* bin2, int n,
+                             std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop, float* a) {
+#ifdef PANOPTES_RENDER_AVX2
+  // As composite_volume1(): colours mixed and accumulated as 4-lane vectors (the same fused
+  // operations as the scalar loop, so the same bits), termination tested once per block.
+  if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
+    __m128 c = _mm_setr_ps(a[0], a[1], a[2], 0.0f);
+    float tr = a[3];
+    for (int l = 0; l < n; ++l) {
+      const LutEntry& e1 = lut1[bin1[l]];
+      const LutEntry& e2 = lut2[bin2[l]];
+      const float tau = e1.tau + e2.tau;
+      if (tau <= 0) continue;
+      const float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);
+      const float s = tr * al / tau;
+      const __m128 mix = _mm_fmadd_ps(_mm_broadcast_ss(&e1.tau), _mm_loadu_ps(&e1.r),
+                                      _mm_mul_ps(_mm_broadcast_ss(&e2.tau), _mm_loadu_ps(&e2.r)));
+      c = _mm_fmadd_ps(_mm_set1_ps(s), mix, c);
+      tr = tr * (1.0f - al);
+    }
+    if (tr > tr_stop) [[likely]] {
+      alignas(16) float cc[4];
+      _mm_store_ps(cc, c);
+      a[0] = cc[0], a[1] = cc[1], a[2] = cc[2], a[3] = tr;
+      return -1;
+    }
+  }
+#endif
+  return composite_volume2_scalar(lut1, lut2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
 }
 
 // The single-volume-task loop over samples kb … kend with field, LUT and accumulator in registers.
