@@ -687,11 +687,25 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     // that stretch meets, and the boxes are grown by a voxel, so a miss is conservative.
     const double ta = t0 + double(ks - 1) * dt, tb = t0 + double(ke + 1) * dt;
     bool clear = true;
-    for (const auto& e : S.exceptions) {
-      double u0, u1;
-      if (slab(O, D, &e[0], &e[3], u0, u1) && u1 >= ta && u0 <= tb) {
-        clear = false;
-        break;
+    if (!S.exceptions.empty()) {
+      // Reciprocals instead of six divisions per box: rounding does not matter, the boxes have a voxel of margin.
+      double inv[3];
+      for (int a = 0; a < 3; ++a) inv[a] = D[a] != 0 ? 1.0 / D[a] : 0.0;
+      for (const auto& e : S.exceptions) {
+        double u0 = ta, u1 = tb;
+        for (int a = 0; a < 3 && u0 <= u1; ++a) {
+          if (D[a] == 0) {
+            if (O[a] < e[std::size_t(a)] || O[a] > e[std::size_t(a) + 3]) u0 = INFINITY;
+            continue;
+          }
+          double v0 = (e[std::size_t(a)] - O[a]) * inv[a], v1 = (e[std::size_t(a) + 3] - O[a]) * inv[a];
+          if (v0 > v1) std::swap(v0, v1);
+          u0 = std::max(u0, v0), u1 = std::min(u1, v1);
+        }
+        if (u0 <= u1) {
+          clear = false;
+          break;
+        }
       }
     }
     if (clear) {
