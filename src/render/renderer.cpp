@@ -642,9 +642,23 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
           }
           case RtKind::iso: {
             const float* v = vb[T.s1];
-            for (int l = (prev_valid >> T.s1 & 1) ? 0 : 1; l < n; ++l) {
+            const int l0 = (prev_valid >> T.s1 & 1) ? 0 : 1;
+            // Lanes whose segment (sample l − 1 … l) changes sign, found for the whole block at once.
+            unsigned cross = 0;
+#ifdef PANOPTES_RENDER_AVX2
+            {
+              const __m256 iso = _mm256_set1_ps(T.iso), zero = _mm256_setzero_ps();
+              const __m256 sp = _mm256_cmp_ps(_mm256_sub_ps(_mm256_loadu_ps(v), iso), zero, _CMP_LT_OQ);
+              const __m256 sn = _mm256_cmp_ps(_mm256_sub_ps(_mm256_loadu_ps(v + 1), iso), zero, _CMP_LT_OQ);
+              cross = unsigned(_mm256_movemask_ps(_mm256_xor_ps(sp, sn)));
+            }
+#else
+            for (int l = 0; l < kBlock; ++l) cross |= unsigned((v[l] - T.iso < 0) != (v[l + 1] - T.iso < 0)) << l;
+#endif
+            cross &= ((1u << n) - 1) & ~((1u << l0) - 1);
+            if (cross) {
+              const int l = std::countr_zero(cross);
               const float d = v[l + 1] - T.iso, dp = v[l] - T.iso;
-              if ((dp < 0) == (d < 0)) continue;
               // First crossing between samples kk − 1 and kk: linear estimate, one regula-falsi step.
               const std::int64_t kk = k0 + l;
               const FieldAcc& f = fa[T.s1];
@@ -659,7 +673,6 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
               shade_hit(S, f, ph, dir, T, a);
               a[3] = 0;  // opaque: transmittance 0
               stop = l;
-              break;
             }
             break;
           }
