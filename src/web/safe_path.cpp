@@ -1,5 +1,6 @@
 #include "web/safe_path.hpp"
 
+#include <cstdint>
 #include <system_error>
 
 #include "core/error.hpp"
@@ -39,6 +40,21 @@ std::optional<fs::path> SafeRoot::resolve(std::string_view relative, std::string
   if (rel.empty() || *rel.begin() == "..") return refuse("resolves outside the served directory");
   if (!fs::is_regular_file(real, ec)) return refuse("no such file");
   return real;
+}
+
+store::FileHandle SafeRoot::open(std::string_view relative, std::string* why) const {
+  const auto real = resolve(relative, why);
+  if (!real) return {};
+  // real is canonical and under root_: every component is a plain directory or the file itself.
+  const fs::path rel = real->lexically_relative(root_);
+  try {
+    const store::FileHandle root = store::open_directory(root_);
+    const store::FileHandle dir = store::open_subdirectory(root.get(), rel.parent_path().generic_string(), false, root_);
+    return store::open_regular_file(dir.get(), rel.filename().string(), UINT64_MAX, "file", root_ / rel.parent_path());
+  } catch (const Error& e) {
+    if (why) *why = std::string("changed while being opened: ") + e.what();
+    return {};
+  }
 }
 
 }  // namespace panoptes::web

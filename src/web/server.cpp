@@ -1,7 +1,10 @@
 #include "web/server.hpp"
 
 #include <httplib.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <chrono>
 #include <cstdio>
@@ -69,26 +72,24 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
   res.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
 }
 
-/// Serves a whole file or, with a Range header, the asked bytes (httplib answers 206 / 416).
-void send_file(httplib::Response& res, const fs::path& file, const std::string& type) {
-  std::error_code ec;
-  const auto size = fs::file_size(file, ec);
-  if (ec) return send_error(res, 404, "cannot read the file");
-  auto in = std::make_shared<std::ifstream>(file, std::ios::binary);
-  if (!*in) return send_error(res, 404, "cannot read the file");
+/// Serves an opened file whole or, with a Range header, the asked bytes (httplib answers 206 / 416).
+/// Reads go through the descriptor opened by SafeRoot::open (pread: no shared offset, no re-open).
+void send_file(httplib::Response& res, store::FileHandle file, const std::string& type) {
+  struct stat st{};
+  if (::fstat(file.get(), &st) != 0) return send_error(res, 404, "cannot read the file");
+  const auto size = std::size_t(st.st_size);
   res.set_header("Cache-Control", "no-cache");
   res.set_header("Accept-Ranges", "bytes");
   if (size == 0) return res.set_content("", type);
-  res.set_content_provider(std::size_t(size), type, [in](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+  auto fd = std::make_shared<store::FileHandle>(std::move(file));
+  res.set_content_provider(size, type, [fd](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
     char buf[64 * 1024];
-    in->clear();
-    in->seekg(std::streamoff(offset));
     while (length > 0) {
-      const std::size_t n = std::min(length, sizeof buf);
-      in->read(buf, std::streamsize(n));
-      const auto got = std::size_t(in->gcount());
-      if (got == 0 || !sink.write(buf, got)) return false;
-      length -= got;
+      const ssize_t got = ::pread(fd->get(), buf, std::min(length, sizeof buf), off_t(offset));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0 || !sink.write(buf, std::size_t(got))) return false;
+      offset += std::size_t(got);
+      length -= std::size_t(got);
     }
     return true;
   });
@@ -169,12 +170,12 @@ struct Server::Impl {
   void serve_under(const SafeRoot& root, const std::string& relative, const httplib::Request& req,
                    httplib::Response& res) {
     std::string why;
-    const auto file = root.resolve(relative, &why);
+    store::FileHandle file = root.open(relative, &why);
     if (!file) {
       log(req.remote_addr + " " + req.method + " " + req.path + " 404 refused: " + why);
       return send_error(res, 404, "not found");
     }
-    send_file(res, *file, content_type(*file));
+    send_file(res, std::move(file), content_type(fs::path(relative)));
   }
 
   void routes() {
