@@ -2,7 +2,7 @@
 // over `panoptes serve` or a static export. Decoding: WebCodecs + mp4box.js (movies.js). Prefetch:
 // the current stream and every neighbour are kept decoded a few frames past the playhead, in step
 // with playback (pump() below), so a switch finds its frame decoded.
-import { FrameCache, Stream, traffic } from "./movies.js";
+import { FrameCache, Stream, traffic, marks, mark } from "./movies.js";
 import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable } from "./cameras.js";
@@ -19,6 +19,7 @@ const options = {
   ahead: Number(params.get("ahead") || 6),  // frames past the playhead kept decoded, current stream
   nbAhead: Number(params.get("nbahead") || 3),  // the same for every neighbour
   fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
+  warmTasks: params.get("warmtasks") !== "0",  // fetch ahead the graph neighbours of the task neighbours
 };
 
 const canvas = document.getElementById("view");
@@ -185,6 +186,16 @@ function releaseDecoders() {
   const hot = new Set([`${S.camera}/${S.task}`, ...neighbourSelections(S.camera, S.task).map(([c, t]) => `${c}/${t}`)]);
   for (const [key, st] of streams) if (!hot.has(key) && st.decoder && st.inflight.size === 0) st.close();
 }
+/// The streams a task switch makes neighbours: the graph neighbours of the current camera in the
+/// task-neighbour tasks (after Tab they all become neighbours at once, which was round 2's tail).
+function taskNeighbourGraph(camera, task) {
+  const out = [];
+  for (const [c0, t0] of neighbourSelections(camera, task)) {
+    if (c0 !== camera) continue;
+    for (const [c, t] of neighbourSelections(c0, t0)) if (c !== camera && t === t0) out.push([c, t]);
+  }
+  return out;
+}
 function pump() {
   if (!S.db) return;
   const f = currentFrame();
@@ -198,9 +209,26 @@ function pump() {
     const st = streams.get(`${c}/${t}`);
     if (st && (st.status === "missing" || st.status === "unreadable")) continue;
     const g = firstMissing(c, t, f, ahead);
-    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, batch);
+    // The very first frame is decoded alone: a batch of 8 before the first picture is 8 decodes of waiting.
+    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, S.firstFrameMs === null ? 1 : batch);
     else if (g < 0 && st && st.status === "ok" && S.playing) fetchAhead(st, f);
   }
+  if (!nb.length) return;
+  // Warm, at a lower priority (a connection kept for the hot streams): the streams a Tab would make
+  // neighbours get opened and their compressed samples fetched ahead, so that after the Tab only
+  // their decode is left (one batch each, from memory) — no index, init segment or range round trip.
+  if (options.warmTasks)
+    for (const [c, t] of taskNeighbourGraph(S.camera, S.task)) {
+      if (inflight >= options.connections - 1) return;
+      const key = `${c}/${t}`;
+      if (busy.has(key)) continue;
+      const st = stream(c, t);
+      if (st.status === "new") {
+        busy.add(key);
+        inflight++;
+        st.open().finally(() => { busy.delete(key); inflight--; });
+      } else if (st.status === "ok" && S.playing) fetchAhead(st, f);
+    }
   for (const [c0, t0] of nb)
     for (const [c, t] of neighbourSelections(c0, t0)) {
       if (inflight >= options.connections - 1) return;  // keep a connection for the hot streams
@@ -289,7 +317,7 @@ function tick(now) {
   if (drawn) {
     const now = performance.now();
     S.shown = { camera: S.camera, task: S.task, frame: shownFrame, status };
-    if (S.firstFrameMs === null) S.firstFrameMs = now;
+    if (S.firstFrameMs === null) { S.firstFrameMs = now; mark("drawn"); }
     if (S.pending) {
       S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit: firstTickAfterSwitch,
                         lag: (frame - shownFrame + S.db.frames) % S.db.frames, diag: S.pending.diag });
@@ -455,16 +483,19 @@ canvas.addEventListener("pointercancel", endDrag);
 
 // ---- start --------------------------------------------------------------------------------------
 async function main() {
+  mark("scripts");
   if (!("VideoDecoder" in window)) {
     statusLine.textContent = "This browser has no WebCodecs VideoDecoder (Chromium 94+, Firefox 130+, Safari 16.4+).";
     return;
   }
-  const res = await fetch(base + "api/database.json", { cache: "no-store" });
+  // index.html starts this fetch before the modules load (one round trip less before the first frame).
+  const res = await (window.panoptesDatabase ?? fetch(base + "api/database.json", { cache: "no-store" }));
   if (!res.ok) {
     statusLine.textContent = `cannot load the database: HTTP ${res.status} ${res.status === 401 ? "(open the URL with ?token=...)" : ""}`;
     return;
   }
   const db = await res.json();
+  mark("database.json");
   canvas.width = db.image.width;
   canvas.height = db.image.height;
   // Frames are shown as large as the window allows (small renders are common: the demo's are 256x224).
@@ -530,6 +561,8 @@ window.panoptes = {
   switches: () => S.switches,
   traffic: () => ({ ...traffic }),
   firstFrameMs: () => S.firstFrameMs,
+  /// The steps to the first frame (ms since navigation start): scripts, database.json, index, init, ...
+  marks: () => ({ ...marks }),
   /// When the camera table was in and parsed (performance.now() ms) and its size; null before.
   cameraTable: () => S.cameraTableMs ?? null,
   /// Camera c's neighbour in a direction ("left", ...), -1 if none or the cameras are not loaded yet.
