@@ -223,27 +223,41 @@ export class Stream {
   /// Decodes the fragment holding `frame`, and the following ones up to `batchFrames` frames, into
   /// the cache with one decoder flush (every fragment starts with a keyframe); their samples are
   /// fetched first if they are not in memory yet (`fetchFrames` ahead). Resolves when done.
-  async ensure(frame, cache, batchFrames = 4, fetchFrames = 16) {
+  /// With `stride` > 1 and a stream of keyframes only (one frame per fragment, i.e. gop 1) only every
+  /// stride-th fragment of the batch is decoded: a neighbour then has a frame at most stride - 1
+  /// behind any playhead for a stride-th of the decoding (see pump() in player.js).
+  async ensure(frame, cache, batchFrames = 4, fetchFrames = 16, stride = 1) {
     await this.open();
     if (this.status !== "ok") return;
-    const n = this.fragmentOf(frame);
+    const step = stride > 1 && this.intraOnly() ? stride : 1;
+    const n = this.fragmentOf(frame - (frame % step));  // on the grid 0, step, 2 step, …
     if (n < 0) return;  // beyond a truncated movie's end: the player shows its placeholder
     if (!this.inflight.has(n)) {
       const f = this.index.fragments;
-      let m = n + 1;
-      while (m < f.length && f[m][2] + f[m][3] - f[n][2] <= batchFrames && !this.inflight.has(m) &&
-             !cache.has(`${this.camera}/${this.task}/${f[m][2]}`)) m++;
-      const p = (this.chain = this.chain.then(() => this._decodeFragments(n, m, cache, fetchFrames)));
-      for (let k = n; k < m; k++) this.inflight.set(k, p);
-      p.finally(() => { for (let k = n; k < m; k++) if (this.inflight.get(k) === p) this.inflight.delete(k); });
+      const list = [n];
+      for (let m = n + step; m < f.length && f[m][2] < this.frameCount && f[m][2] + f[m][3] - f[n][2] <= batchFrames && !this.inflight.has(m) &&
+           !cache.has(`${this.camera}/${this.task}/${f[m][2]}`); m += step) list.push(m);
+      const p = (this.chain = this.chain.then(() => this._decodeFragments(list, cache, fetchFrames)));
+      for (const k of list) this.inflight.set(k, p);
+      p.finally(() => { for (const k of list) if (this.inflight.get(k) === p) this.inflight.delete(k); });
     }
     return this.inflight.get(n);
   }
 
-  async _decodeFragments(n, m, cache, fetchFrames) {
-    const f = this.index.fragments;
-    if (cache.has(`${this.camera}/${this.task}/${f[n][2]}`) && m === n + 1) return;  // decoded meanwhile
-    for (let k = n; k < m && this.status === "ok"; k++) if (!this.samples.has(k)) await this.fetchAhead(f[k][2], fetchFrames);
+  /// Every fragment holds one frame, so every frame is a keyframe (each fragment starts with one):
+  /// any subset of the frames can be decoded.
+  intraOnly() {
+    if (this._intraOnly === undefined) this._intraOnly = this.index.fragments.every((x) => x[3] === 1);
+    return this._intraOnly;
+  }
+
+  async _decodeFragments(list, cache, fetchFrames) {
+    const f = this.index.fragments, n = list[0];
+    if (list.every((k) => cache.has(`${this.camera}/${this.task}/${f[k][2]}`))) return;  // decoded meanwhile
+    for (const k of list) {
+      if (this.status !== "ok") break;
+      if (!this.samples.has(k)) await this.fetchAhead(f[k][2], fetchFrames);
+    }
     if (this.status !== "ok") return;
     try {
       const t0 = performance.now();
@@ -255,7 +269,7 @@ export class Stream {
         this.decoder.configure(this.config);
       }
       let count = 0;
-      for (let k = n; k < m; k++) {
+      for (const k of list) {
         const samples = this.samples.get(k);
         if (!samples) break;  // evicted meanwhile: the pump asks again
         samples.forEach((s, i) => {
@@ -269,7 +283,7 @@ export class Stream {
       if (this.decodeError) throw this.decodeError;
     } catch (e) {
       this.status = "unreadable";
-      this.message = `${this.url}: fragments ${n}..${m - 1}: ${e.message || e}`;
+      this.message = `${this.url}: fragments ${n}..${list[list.length - 1]}: ${e.message || e}`;
       if (this.decoder && this.decoder.state !== "closed") this.decoder.close();
     }
   }

@@ -18,6 +18,7 @@ const options = {
   nbBatch: Number(params.get("nbbatch") || 4),  // the same for a neighbour's prefetch
   ahead: Number(params.get("ahead") || 6),  // frames past the playhead kept decoded, current stream
   nbAhead: Number(params.get("nbahead") || 3),  // the same for every neighbour
+  nbStride: Number(params.get("nbstride") || 2),  // a neighbour of keyframes only: every stride-th frame decoded
   fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
   warmTasks: params.get("warmtasks") !== "0",  // fetch ahead the graph neighbours of the task neighbours
 };
@@ -164,20 +165,22 @@ function fetchAhead(st, f) {
   if (!run(f, Math.min(W, n - f)) && S.loop && f + W > n) run(0, f + W - n);
 }
 const busy = new Set();  // "c/t" with a pump batch in flight
-/// The first frame in [f, f + ahead) of the stream that is neither decoded nor being decoded; -1 if none.
-function firstMissing(c, t, f, ahead) {
+/// The first frame in [f, f + ahead) of the stream that is not decoded; -1 if none. With stride s > 1
+/// only the frames on the grid 0, s, 2s, … are asked for (frame k is then covered by k - k % s).
+function firstMissing(c, t, f, ahead, stride = 1) {
   const n = S.db.frames;
   for (let k = 0; k < ahead; k++) {
-    const g = S.playing ? (f + k) % n : Math.min(f + k, n - 1);
+    let g = S.playing ? (f + k) % n : Math.min(f + k, n - 1);
+    g -= g % stride;
     if (!cache.has(`${c}/${t}/${g}`)) return g;
   }
   return -1;
 }
-function startBatch(c, t, g, batch) {
+function startBatch(c, t, g, batch, stride = 1) {
   const key = `${c}/${t}`;
   busy.add(key);
   inflight++;
-  stream(c, t).ensure(g, cache, batch, options.fetchAhead).finally(() => { busy.delete(key); inflight--; pump(); });
+  stream(c, t).ensure(g, cache, batch, options.fetchAhead, stride).finally(() => { busy.delete(key); inflight--; pump(); });
 }
 /// Closes the VideoDecoder of every stream that is neither current nor a neighbour any more and has
 /// no decode in flight (a decoder holds threads and buffers; 96 streams may be open). A stream that
@@ -199,18 +202,23 @@ function taskNeighbourGraph(camera, task) {
 function pump() {
   if (!S.db) return;
   const f = currentFrame();
-  const hot = [[S.camera, S.task, S.playing ? options.ahead : 1, options.batch]];
+  const hot = [[S.camera, S.task, S.playing ? options.ahead : 1, options.batch, 1]];
   // Until the first frame is on screen the current stream has the connections and the decoder to itself.
   const nb = options.prefetch && S.firstFrameMs !== null ? neighbourSelections(S.camera, S.task) : [];
-  for (const [c, t] of nb) hot.push([c, t, S.playing ? options.nbAhead : 1, options.nbBatch]);
-  for (const [c, t, ahead, batch] of hot) {
+  // While playing, a neighbour of keyframes only (gop 1) is decoded at every stride-th frame: a switch
+  // then shows, on the next display frame, the new stream's frame at most stride - 1 frames behind
+  // the playhead (at 30 fps, 33 ms of simulated time for stride 2) and the frames after it in step.
+  // Decoding every neighbour at every frame was more than a loaded machine could do.
+  const nbStride = S.playing ? options.nbStride : 1;
+  for (const [c, t] of nb) hot.push([c, t, S.playing ? options.nbAhead : 1, options.nbBatch, nbStride]);
+  for (const [c, t, ahead, batch, stride] of hot) {
     if (inflight >= options.connections && c !== S.camera) return;  // the current stream may exceed it
     if (busy.has(`${c}/${t}`)) continue;
     const st = streams.get(`${c}/${t}`);
     if (st && (st.status === "missing" || st.status === "unreadable")) continue;
-    const g = firstMissing(c, t, f, ahead);
+    const g = firstMissing(c, t, f, ahead, stride > 1 && st && st.status === "ok" && st.intraOnly() ? stride : 1);
     // The very first frame is decoded alone: a batch of 8 before the first picture is 8 decodes of waiting.
-    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, S.firstFrameMs === null ? 1 : batch);
+    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, S.firstFrameMs === null ? 1 : batch, stride);
     else if (g < 0 && st && st.status === "ok" && S.playing) fetchAhead(st, f);
   }
   if (!nb.length) return;
@@ -576,6 +584,9 @@ window.panoptes = {
     return readStamp(img.data, img.width, w, h);
   },
   select: (camera, task) => select(camera, task, "api"),
+  /// The decoded frames of (camera, task) in the frame cache, ascending.
+  cachedFrames: (camera, task) => [...cache.map.keys()].filter((k) => k.startsWith(`${camera}/${task}/`))
+    .map((k) => Number(k.split("/")[2])).sort((a, b) => a - b),
   cameraDirections: () => Array.from(dirs()),
   dragDirection: () => drag.dir,
 };

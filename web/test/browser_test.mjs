@@ -255,6 +255,15 @@ await check("live database: new frames of a running simulation play without a re
   const { page, errors } = await open(liveUrl + "?play=1");
   assert.equal(await page.evaluate(() => window.panoptes.state().frames), 8);
   await expectShown(page, 0, 0, null, "live, 8 frames");
+  // Keyframes only: the playing neighbour (camera 1) is decoded at even frames only, and a switch to
+  // it shows its stamp (a frame at most one behind the playhead), then it is decoded at every frame.
+  await page.waitForFunction(() => window.panoptes.cachedFrames(1, 0).length >= 2, { timeout: 5000 });
+  const nbFrames = await page.evaluate(() => window.panoptes.cachedFrames(1, 0));
+  assert.ok(nbFrames.every((f) => f % 2 === 0), `neighbour decoded at frames ${nbFrames}, expected even ones only`);
+  await page.evaluate(() => window.panoptes.select(1, 0));
+  await expectShown(page, 1, 0, null, "switch to a stride-decoded neighbour while playing");
+  await page.waitForFunction(() => window.panoptes.cachedFrames(1, 0).some((f) => f % 2 === 1), { timeout: 5000 });
+  await page.evaluate(() => window.panoptes.select(0, 0));
   checkpoint(16);
   await page.waitForFunction(() => window.panoptes.state().frames === 16, { timeout: 8000 });
   await page.waitForFunction(() => window.panoptes.shown().frame >= 8, { timeout: 5000 });

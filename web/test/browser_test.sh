@@ -33,7 +33,8 @@ done
 "$panoptes" export-web "$tmp/db" "$tmp/site" >/dev/null
 
 # A "running" database: this script holds its writer lock (fd 9) until it exits.
-"$panoptes" synth-db "$tmp/live" --cameras 2 --tasks 1 --frames 16 --size 160x120 --gop 4 >/dev/null
+# gop 1 (keyframes only), so that a playing neighbour is decoded at every second frame (nbstride).
+"$panoptes" synth-db "$tmp/live" --cameras 2 --tasks 1 --frames 16 --size 160x120 --gop 1 >/dev/null
 exec 9>"$tmp/live/.panoptes.lock"
 flock -x 9
 "$panoptes" serve "$tmp/live" --port 0 > "$tmp/live.log" 2>&1 &
