@@ -254,6 +254,14 @@ export class Stream {
   async _decodeFragments(list, cache, fetchFrames) {
     const f = this.index.fragments, n = list[0];
     if (list.every((k) => cache.has(`${this.camera}/${this.task}/${f[k][2]}`))) return;  // decoded meanwhile
+    // Configured before the samples are awaited: the codec's set-up overlaps the range request.
+    if (!this.decoder || this.decoder.state === "closed") {
+      this.decoder = new VideoDecoder({
+        output: (vf) => cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf),
+        error: (e) => { this.decodeError = e; },
+      });
+      this.decoder.configure(this.config);
+    }
     for (const k of list) {
       if (this.status !== "ok") break;
       if (!this.samples.has(k)) await this.fetchAhead(f[k][2], fetchFrames);
@@ -261,13 +269,6 @@ export class Stream {
     if (this.status !== "ok") return;
     try {
       const t0 = performance.now();
-      if (!this.decoder || this.decoder.state === "closed") {
-        this.decoder = new VideoDecoder({
-          output: (vf) => cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf),
-          error: (e) => { this.decodeError = e; },
-        });
-        this.decoder.configure(this.config);
-      }
       let count = 0;
       for (const k of list) {
         const samples = this.samples.get(k);
