@@ -506,7 +506,7 @@ async function main() {
   mark("database.json");
   canvas.width = db.image.width;
   canvas.height = db.image.height;
-  // Frames are shown as large as the window allows (small renders are common: the demo's are 256x224).
+  // Frames are shown as large as the window allows (in-situ renders are often small).
   const fit = () => {
     const s = Math.max(0.1, Math.min((innerWidth - 20) / db.image.width, (innerHeight - 110) / db.image.height));
     canvas.style.width = `${Math.floor(db.image.width * s)}px`;
