@@ -20,7 +20,7 @@ async function run(browser, prefetch) {
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 900 });
   const t0 = Date.now();
-  await page.goto(url + `?play=1&prefetch=${prefetch ? 1 : 0}${process.env.WEB_BENCH_QUERY || ""}`);
+  await page.goto(url + `?play=1&fps=30&prefetch=${prefetch ? 1 : 0}${process.env.WEB_BENCH_QUERY || ""}`);
   await page.waitForFunction(() => window.panoptes && window.panoptes.firstFrameMs() !== null, { timeout: 30000 });
   const firstFrame = await page.evaluate(() => window.panoptes.firstFrameMs());  // since navigation start
   const marks = await page.evaluate(() => (window.panoptes.marks ? window.panoptes.marks() : {}));

@@ -12,6 +12,8 @@ nlohmann::json database_json(const store::Database& db, bool inline_cameras) {
   j["status"] = std::string(store::to_string(db.status()));
   j["frames"] = db.frame_count();
   j["fps"] = m.video.fps;
+  // The rate the database asks its players to use (0: none; the movies' own rate then), as the desktop player does.
+  j["playback_fps"] = m.playback_fps;
   j["gop"] = m.video.gop;
   j["image"] = {{"width", m.image.width}, {"height", m.image.height}};
   json times = json::array();

@@ -41,6 +41,10 @@ struct Fixture {
     o.video.gop = 2;
     o.threads = 1;
     store::write_synthetic_database(db, o);
+    // A preferred playback rate, as the demo records one (the web player plays at it, as the desktop one).
+    store::Manifest m = store::read_manifest(db / store::kManifestFileName);
+    m.playback_fps = 12.5;
+    store::write_manifest_atomic(db / store::kManifestFileName, m);
     fs::create_directories(player);
     std::ofstream(player / "index.html") << "<!doctype html><title>player</title>";
     std::ofstream(secret) << "TOP-SECRET-CONTENT";
@@ -91,6 +95,7 @@ TEST(Server, ServesDatabaseJsonIndexAndByteRanges) {
   ASSERT_EQ(res->status, 200);
   const auto db = nlohmann::json::parse(res->body);
   EXPECT_EQ(db["frames"], 5);
+  EXPECT_EQ(db["playback_fps"], 12.5);
   EXPECT_EQ(db["cameras"]["count"], 3);
   EXPECT_EQ(db["tasks"].size(), 2u);
   // The cameras are in the database's binary table, which the player fetches as it is.

@@ -65,7 +65,7 @@ function stream(camera, task) {
 function currentFrame(now = performance.now()) {
   const n = S.db.frames;
   if (!S.playing) return S.anchorFrame;
-  let f = S.anchorFrame + Math.floor(((now - S.anchorTime) / 1000) * S.db.fps * S.speed);
+  let f = S.anchorFrame + Math.floor(((now - S.anchorTime) / 1000) * S.fps * S.speed);
   if (f >= n) {
     if (S.loop) f %= n;
     else { f = n - 1; S.playing = false; S.anchorFrame = f; }
@@ -522,6 +522,8 @@ async function main() {
   S.anchorFrame = Math.min(Number(params.get("frame") || 0), db.frames - 1);
   S.anchorTime = performance.now();
   S.db = db;
+  // Playback rate: ?fps=N, else the database's preferred rate (the desktop player's rule), else the movies'.
+  S.fps = Number(params.get("fps")) || (db.playback_fps > 0 ? db.playback_fps : db.fps);
   requestAnimationFrame(tick);
   // The first frame does not need the cameras: it is fetched meanwhile. Navigation by the graph, the
   // mini-map and drag start when the table is in (at 10^6 cameras it is tens of MB).
