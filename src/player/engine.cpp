@@ -170,6 +170,8 @@ struct Engine::Impl {
   std::vector<std::thread> workers;
   Selection scheduled{-1, -1, -1};
   bool scheduled_valid = false;
+  Vec3 view_hint{0, 0, 0};  // unit world direction the viewer faces (set_view_direction)
+  bool has_view_hint = false;
 
   Impl(store::Database database, EngineOptions opts)
       : db(std::move(database)),
@@ -326,57 +328,94 @@ struct Engine::Impl {
     return wrap_frame(n);
   }
 
-  // Replaces the prefetch queue with the neighbourhood of the selection. Order = priority: the current
-  // stream's next frame (playback), then every neighbour at the next frame (what a switch during
-  // playback shows), then the current stream's further read-ahead, then neighbours at the current frame
-  // (a switch while paused). Neighbours come before the read-ahead because the read-ahead frames are
-  // queued again at the front on the following ticks, while a neighbour's next frame is needed within
-  // one display period or never: under load (workers starved) this raised switch cache hits from
-  // 47-70 % to 77 % (bench/player_bench BM_SwitchLatency with 4 extra busy loops on 2 cores).
+  // Replaces the prefetch queue with the neighbourhood of the selection. Order = priority, and it
+  // depends on what a switch would show next:
+  //  - playing: the current stream's next frame (playback), then every neighbour at the next frame
+  //    (what a switch during playback shows), then the current stream's further read-ahead, then the
+  //    neighbours at the current frame. Neighbours come before the read-ahead because the read-ahead
+  //    frames are queued again at the front on the following ticks, while a neighbour's next frame is
+  //    needed within one display period or never: under load (workers starved) this raised switch cache
+  //    hits from 47-70 % to 77 % (bench/player_bench BM_SwitchLatency with 4 extra busy loops on 2 cores).
+  //  - paused: a switch shows the neighbours' CURRENT frame, so those come first, then the current
+  //    stream's next frames (a frame step), then the neighbours' next frames (play, then switch). With
+  //    the playing order the paused walks through 1920x960 360° streams waited for 9 useless decodes
+  //    before the 6 they needed and missed every first visit (bench/inside_bench BM_WalkLatency).
+  // Camera neighbours are ranked by how well their direction from this camera agrees with the view
+  // direction hint (set_view_direction), so the camera ahead is decoded first when the machine cannot
+  // decode all of them in time.
   void schedule_prefetch() {
     if (workers.empty()) return;
     if (scheduled_valid && scheduled == sel) return;
     scheduled = sel;
     scheduled_valid = true;
-    std::vector<Selection> list;
-    const int next = next_frame();
-    int f = sel.frame;
-    for (int k = 0; k <= options.read_ahead; ++k) {
-      f = (k == 0) ? next : wrap_frame(f + dir * std::max(1, int(std::lround(speed_factor))));
-      list.push_back({sel.camera, sel.task, f});
-    }
-    std::vector<std::pair<int, int>> streams;  // (camera, task) neighbours
-    if (options.prefetch_cameras && !db.manifest().graph.empty()) {
-      const auto& n = db.manifest().graph.neighbours[std::size_t(sel.camera)];
-      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out})
-        if (c >= 0 && c != sel.camera) streams.emplace_back(c, sel.task);
-    }
-    if (options.prefetch_tasks && tasks > 1) {
-      streams.emplace_back(sel.camera, (sel.task + 1) % tasks);
-      streams.emplace_back(sel.camera, (sel.task + tasks - 1) % tasks);
-      const auto& m = db.manifest();
-      for (const auto& a : m.axes)
-        for (int d : {1, -1}) {
-          const int t = m.step_task_on_axis(sel.task, a.name, d);
-          if (t >= 0) streams.emplace_back(sel.camera, t);
-        }
-    }
-    std::sort(streams.begin(), streams.end());
-    streams.erase(std::unique(streams.begin(), streams.end()), streams.end());
-    std::erase_if(streams, [&](const auto& p) { return p.first == sel.camera && p.second == sel.task; });
-    std::vector<Selection> ordered;
-    ordered.reserve(list.size() + 2 * streams.size());
-    ordered.push_back(list.front());
-    for (const auto& [c, t] : streams) ordered.push_back({c, t, next});
-    ordered.insert(ordered.end(), list.begin() + 1, list.end());
-    for (const auto& [c, t] : streams) ordered.push_back({c, t, sel.frame});
-    list = std::move(ordered);
+    std::vector<Selection> list = prefetch_plan();
     {
       std::lock_guard lock(job_mutex);
       jobs = std::move(list);
       job_next = 0;
     }
     job_ready.notify_all();
+  }
+
+  std::vector<Selection> prefetch_plan() const {
+    std::vector<Selection> ahead;  // the current stream's next frames
+    const int next = next_frame();
+    int f = sel.frame;
+    for (int k = 0; k <= options.read_ahead; ++k) {
+      f = (k == 0) ? next : wrap_frame(f + dir * std::max(1, int(std::lround(speed_factor))));
+      ahead.push_back({sel.camera, sel.task, f});
+    }
+    std::vector<std::pair<int, int>> cams;  // (rank, camera): graph neighbours, best view alignment first
+    if (options.prefetch_cameras && !db.manifest().graph.empty()) {
+      const auto& man = db.manifest();
+      const auto& n = man.graph.neighbours[std::size_t(sel.camera)];
+      const Vec3 here = man.cameras[std::size_t(sel.camera)].position;
+      int slot = 0;
+      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out}) {
+        ++slot;
+        if (c < 0 || c == sel.camera || c >= cameras) continue;
+        int rank = slot;
+        if (has_view_hint) {
+          const Vec3 step = man.cameras[std::size_t(c)].position - here;
+          const double len = norm(step);
+          // -1000..1000 by cosine; ties keep the graph order.
+          if (len > 0) rank = int(std::lround(-1000.0 * dot(step, view_hint) / len)) * 8 + slot;
+        }
+        if (std::none_of(cams.begin(), cams.end(), [&](const auto& p) { return p.second == c; })) cams.emplace_back(rank, c);
+      }
+      std::sort(cams.begin(), cams.end());
+    }
+    std::vector<std::pair<int, int>> streams;  // (camera, task) neighbours in priority order
+    for (const auto& [rank, c] : cams) streams.emplace_back(c, sel.task);
+    if (options.prefetch_tasks && tasks > 1) {
+      std::vector<std::pair<int, int>> ts;
+      ts.emplace_back(sel.camera, (sel.task + 1) % tasks);
+      ts.emplace_back(sel.camera, (sel.task + tasks - 1) % tasks);
+      const auto& m = db.manifest();
+      for (const auto& a : m.axes)
+        for (int d : {1, -1}) {
+          const int t = m.step_task_on_axis(sel.task, a.name, d);
+          if (t >= 0) ts.emplace_back(sel.camera, t);
+        }
+      for (const auto& p : ts)
+        if (p.second != sel.task && std::find(streams.begin(), streams.end(), p) == streams.end()) streams.push_back(p);
+    }
+    std::vector<Selection> plan;
+    plan.reserve(ahead.size() + 2 * streams.size());
+    const auto add_neighbours = [&](int frame) {
+      for (const auto& [c, t] : streams) plan.push_back({c, t, frame});
+    };
+    if (is_playing) {
+      plan.push_back(ahead.front());
+      add_neighbours(next);
+      plan.insert(plan.end(), ahead.begin() + 1, ahead.end());
+      add_neighbours(sel.frame);
+    } else {
+      add_neighbours(sel.frame);
+      plan.insert(plan.end(), ahead.begin(), ahead.end());
+      add_neighbours(next);
+    }
+    return plan;
   }
 
   // ---- clock ----
@@ -402,6 +441,7 @@ struct Engine::Impl {
       } else {
         p = p < 0 ? 0 : frames - 1;
         is_playing = false;
+        scheduled_valid = false;
       }
       position = p;
     }
@@ -585,6 +625,7 @@ void Engine::set_playing(bool playing) {
   if (playing == m.is_playing) return;
   m.tick();  // freeze the position reached so far
   m.is_playing = playing;
+  m.scheduled_valid = false;  // the prefetch order depends on the play state
   // Like a video player: play at the end (without loop) starts again from the other end.
   if (playing && !m.looping && m.sel.frame == (m.dir > 0 ? m.frames - 1 : 0) && m.frames > 1)
     m.set_position(m.dir > 0 ? 0 : m.frames - 1);
@@ -718,6 +759,7 @@ void Engine::step_frame(int delta) {
   Impl& m = *impl_;
   m.tick();
   m.is_playing = false;
+  m.scheduled_valid = false;
   m.set_position(m.wrap_frame(m.sel.frame + delta));
 }
 
@@ -767,6 +809,19 @@ ShownFrame Engine::frame_at(const Selection& selection) {
                 ", frame " + std::to_string(selection.frame) + ") is out of range");
   bool hit = false, waited = false;
   return m.make_shown(selection, m.fetch(selection, hit, waited), hit);
+}
+
+std::vector<Selection> Engine::prefetch_plan() const { return impl_->prefetch_plan(); }
+
+void Engine::set_view_direction(const Vec3& direction) {
+  Impl& m = *impl_;
+  const double len = norm(direction);
+  const bool valid = std::isfinite(len) && len > 0;
+  const Vec3 d = valid ? direction / len : Vec3{0, 0, 0};
+  if (valid == m.has_view_hint && (!valid || dot(d, m.view_hint) > 0.999)) return;
+  m.view_hint = d;
+  m.has_view_hint = valid;
+  m.scheduled_valid = false;  // re-rank on the next current_frame()
 }
 
 void Engine::wait_prefetch_idle() {

@@ -244,6 +244,15 @@ class Engine {
   ShownFrame current_frame();
   /// The frame of any selection, through the cache (does not count as shown, no switch record).
   ShownFrame frame_at(const Selection& selection);
+  /// What the prefetch threads are asked to decode for the current selection and play state, in
+  /// priority order (the queue current_frame() schedules): paused, the neighbours' current frame
+  /// first; playing, the current stream's next frame and the neighbours' next frame first. Camera
+  /// neighbours are ordered by the view direction hint when one is set.
+  std::vector<Selection> prefetch_plan() const;
+  /// The world direction the viewer faces (360° look-around): graph neighbours whose displacement is
+  /// best aligned with it are prefetched first, so a walk ahead hits the cache even when the machine
+  /// cannot decode all neighbours in time. A zero/non-finite vector clears the hint (graph order).
+  void set_view_direction(const Vec3& direction);
   /// Blocks until the prefetch threads have nothing queued (tests, benchmarks). Returns immediately
   /// when prefetch is off.
   void wait_prefetch_idle();

@@ -212,6 +212,35 @@ TEST_F(EngineTest, PrefetchMakesASwitchHitTheCache) {
   EXPECT_GT(st.prefetch_decodes, 0);
 }
 
+// The prefetch queue's order is what decides a switch under load (issue 14: paused walks through
+// 1920x960 360° streams missed because the neighbours' current frame came after 9 other decodes).
+TEST_F(EngineTest, PrefetchPlanPutsWhatASwitchShowsFirst) {
+  Engine e(db(), opts());
+  e.seek(4);
+  const auto is_neighbour = [](const Selection& s) { return !(s.camera == 0 && s.task == 0); };
+  // Paused: a switch shows a neighbour's frame 4, so every neighbour at frame 4 comes before anything else.
+  std::vector<Selection> plan = e.prefetch_plan();
+  ASSERT_GE(plan.size(), 5u);
+  std::size_t first_other = 0;
+  while (first_other < plan.size() && plan[first_other].frame == 4 && is_neighbour(plan[first_other])) ++first_other;
+  EXPECT_EQ(first_other, 5u) << "cameras 1 and 5, tasks 1 and 3 (next/previous), task 2 (the window axis)";
+  EXPECT_EQ(plan[first_other], (Selection{0, 0, 5})) << "then the current stream's next frame";
+  // Playing: the current stream's next frame, then every neighbour at that frame.
+  e.set_playing(true);
+  plan = e.prefetch_plan();
+  EXPECT_EQ(plan[0], (Selection{0, 0, 5}));
+  for (std::size_t i = 1; i <= 5; ++i) EXPECT_TRUE(plan[i].frame == 5 && is_neighbour(plan[i])) << "entry " << i;
+  e.set_playing(false);
+  // A view hint towards camera 5 ranks it first; towards camera 1, that one.
+  const auto& cams = e.manifest().cameras;
+  e.set_view_direction(cams[5].position - cams[0].position);
+  EXPECT_EQ(e.prefetch_plan()[0], (Selection{5, 0, 4}));
+  e.set_view_direction(cams[1].position - cams[0].position);
+  EXPECT_EQ(e.prefetch_plan()[0], (Selection{1, 0, 4}));
+  e.set_view_direction({0, 0, 0});  // cleared: graph order (left = 5 first)
+  EXPECT_EQ(e.prefetch_plan()[0], (Selection{5, 0, 4}));
+}
+
 TEST_F(EngineTest, PrefetchDuringPlaybackServesTheNextFrameOfANeighbour) {
   Engine e(db(), opts(true));
   for (int k = 0; k < 8; ++k) {

@@ -114,6 +114,7 @@ bool walk_keeping_view(Engine& engine, Look& look, Walk walk) {
   if (to < 0 || !engine.jump_to_camera(to)) return false;
   const ViewBasis view = look_basis(camera_basis(m.cameras[std::size_t(from)]), look);
   look = look_towards(camera_basis(m.cameras[std::size_t(to)]), view.forward, look.fov_deg);
+  engine.set_view_direction(view.forward);  // prefetch the next camera ahead first
   return true;
 }
 

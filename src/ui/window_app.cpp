@@ -463,6 +463,8 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
       player::look_basis(player::camera_basis(engine_.manifest().cameras[std::size_t(shown.selection.camera)]),
                          equirect_ ? look_ : player::Look{})
           .forward;
+  // Inside a 360° stream the camera ahead is the likeliest walk: prefetch it first.
+  if (equirect_) engine_.set_view_direction(h.view_direction);
   if (equirect_) {
     char text[160];
     const auto node = player::lattice_node(lattice_, shown.selection.camera);
