@@ -1,5 +1,6 @@
 #include "ui/hud.hpp"
 
+#include "ui/hud_text.hpp"
 #include <imgui.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "player/keys.hpp"
+#include "ui/hud_text.hpp"
 
 namespace panoptes::ui {
 namespace {
@@ -107,11 +109,15 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       const auto& sel = info.selection;
       const auto& cam = m.cameras[std::size_t(sel.camera)];
       const auto& task = m.tasks[std::size_t(sel.task)];
-      ImGui::Text("t = %.4g   frame %d of %d   %s x%.2g%s%s", info.sim_time, sel.frame, info.frame_count, info.playing ? "playing" : "paused", info.speed,
-                  info.direction < 0 ? " reverse" : "", info.loop ? "" : " once");
-      ImGui::Text("camera %d%s%s   lat %+.0f  lon %+.0f%s", sel.camera, cam.labels.patch.empty() ? "" : " ",
-                  cam.labels.patch.c_str(), cam.labels.lat_deg, cam.labels.lon_deg,
-                  info.shell_count > 1 ? ("   shell " + std::to_string(cam.labels.shell)).c_str() : "");
+      ImGui::Text("t = %.4g   frame %d of %d   %s x%.2g%s%s", info.sim_time + 0.0, sel.frame, info.frame_count,
+                  info.playing ? "playing" : "paused", info.speed, info.direction < 0 ? " reverse" : "", info.loop ? "" : " once");
+      const std::string shell = info.shell_count > 1 ? "   shell " + std::to_string(cam.labels.shell) : "";
+      if (!info.position_label.empty())
+        ImGui::Text("camera %d   %s%s", sel.camera, info.position_label.c_str(), shell.c_str());
+      else
+        ImGui::Text("camera %d%s%s   lat %s  lon %s%s", sel.camera, cam.labels.patch.empty() ? "" : " ",
+                    cam.labels.patch.c_str(), signed_degrees(cam.labels.lat_deg).c_str(),
+                    signed_degrees(cam.labels.lon_deg).c_str(), shell.c_str());
       if (!info.look_label.empty()) ImGui::TextUnformatted(info.look_label.c_str());
       const std::string params = format_parameters(m, task);
       ImGui::Text("task %d of %d: %s%s%s", sel.task, int(m.tasks.size()), task.name.c_str(),

@@ -36,7 +36,8 @@ struct HudInfo {
   std::string status_message;
   std::vector<int> neighbours;    ///< graph neighbours of the current camera (mini-map)
   int shell_count = 1;            ///< camera shells of the rig (the shell is shown only if > 1)
-  std::string look_label;         ///< 360° streams: lattice position and view (empty otherwise)
+  std::string position_label;     ///< lattice cameras: "lattice (i, j, k) of NxNyxNz" instead of lat/lon
+  std::string look_label;         ///< 360° streams: where the viewer looks (empty otherwise)
   Vec3 view_direction{0, 1, 0};   ///< world direction of the current view (lattice mini-map arrow)
 };
 

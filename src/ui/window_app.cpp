@@ -26,6 +26,7 @@
 #include "ui/drag_rotation.hpp"
 #include "ui/look_mesh.hpp"
 #include "ui/hud.hpp"
+#include "ui/hud_text.hpp"
 #include "ui/sdl_keys.hpp"
 #include "ui/sdl_window.hpp"
 #include "ui/view_transform.hpp"
@@ -465,17 +466,8 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
           .forward;
   // Inside a 360° stream the camera ahead is the likeliest walk: prefetch it first.
   if (equirect_) engine_.set_view_direction(h.view_direction);
-  if (equirect_) {
-    char text[160];
-    const auto node = player::lattice_node(lattice_, shown.selection.camera);
-    if (lattice_[0] > 0)
-      std::snprintf(text, sizeof text, "lattice (%d, %d, %d) of %dx%dx%d   look yaw %+.0f pitch %+.0f fov %.0f", node[0],
-                    node[1], node[2], lattice_[0], lattice_[1], lattice_[2], look_.yaw_deg, look_.pitch_deg, look_.fov_deg);
-    else
-      std::snprintf(text, sizeof text, "360 view   look yaw %+.0f pitch %+.0f fov %.0f", look_.yaw_deg, look_.pitch_deg,
-                    look_.fov_deg);
-    h.look_label = text;
-  }
+  h.position_label = lattice_position_text(lattice_, shown.selection.camera);
+  if (equirect_) h.look_label = (lattice_[0] > 0 ? "" : "360 view   ") + look_text(look_);
   if (!m.graph.empty()) {
     const auto& n = m.graph.neighbours[std::size_t(shown.selection.camera)];
     for (int id : {n.left, n.right, n.up, n.down, n.in, n.out})
