@@ -94,9 +94,25 @@ std::vector<int> visibility_order(const camera::Camera& cam, const GridGeometry&
     }
     key[i] = k;
   }
+  // A camera on a face shared by bricks is at distance 0 from all of them; the one that owns the eye
+  // by the march's rule (half-open [lo, hi), closed at the domain's upper faces) holds every ray's t = 0
+  // sample and must come first; any other ray crosses only one of the rest.
+  std::vector<char> owns(bricks.size());
+  for (std::size_t i = 0; i < bricks.size(); ++i) {
+    bool in = true;
+    for (int a = 0; a < 3; ++a) {
+      const double p = (cam.position()[a] - g.origin[a]) / g.spacing[a];
+      const double lo = bricks[i].lo[a], hi = bricks[i].hi[a];
+      in = in && p >= lo && (p < hi || (p == hi && hi == g.dims[a] - 1));
+    }
+    owns[i] = in;
+  }
   std::vector<int> order(bricks.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key[std::size_t(a)] < key[std::size_t(b)]; });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    const auto ia = std::size_t(a), ib = std::size_t(b);
+    return key[ia] != key[ib] ? key[ia] < key[ib] : owns[ia] > owns[ib];
+  });
   return order;
 }
 

@@ -67,7 +67,8 @@ PartialImage composite_ordered(std::span<const PartialImage* const> front_to_bac
 
 /// A front-to-back order of bricks for a camera: indices into `bricks` sorted by the sum over axes
 /// of the world distance from the camera to the brick's extent along that axis (0 when the camera
-/// lies within it). Valid for bricks cut on common planes (slabs, rectilinear block
+/// lies within it; a camera on a shared face: the brick that owns the eye by the march's half-open
+/// rule first). Valid for bricks cut on common planes (slabs, rectilinear block
 /// decompositions, as MPI codes use); for arbitrary boxes use composite() (per-pixel depth).
 std::vector<int> visibility_order(const camera::Camera& cam, const GridGeometry& grid, std::span<const Brick> bricks);
 
