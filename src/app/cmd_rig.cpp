@@ -50,11 +50,17 @@ void run(const Options& o) {
   t0 = std::chrono::steady_clock::now();
   const NavigationGraph graph = build_navigation_graph(rig);
   const double graph_ms = ms_since(t0);
+  // Cameras inside the volume: angles seen from the centre mean nothing there, distances do.
+  const bool inside = rig.is_lattice() || rig.path;
   RigStatistics st;
+  VolumeRigStatistics vst;
   double stats_ms = 0;
   if (!o.no_stats) {
     t0 = std::chrono::steady_clock::now();
-    st = rig_statistics(rig, graph);
+    if (inside)
+      vst = volume_rig_statistics(rig, graph);
+    else
+      st = rig_statistics(rig, graph);
     stats_ms = ms_since(t0);
   }
   int nearest = -1;
@@ -92,7 +98,19 @@ void run(const Options& o) {
                         {"out", nb.out}}}});
     }
     j["cameras"] = std::move(cams);
-    if (!o.no_stats)
+    if (!o.no_stats && inside)
+      j["statistics"] = {{"lattice", vst.lattice},
+                         {"spacing", to_json(vst.spacing)},
+                         {"box_lo", to_json(vst.box_lo)},
+                         {"box_hi", to_json(vst.box_hi)},
+                         {"min_step", vst.min_step},
+                         {"max_step", vst.max_step},
+                         {"path_length", vst.path_length},
+                         {"reverse_return", vst.reverse_return},
+                         {"missing_moves", vst.missing_moves},
+                         {"reachable_from_0", vst.reachable_from_0},
+                         {"strongly_connected", vst.strongly_connected}};
+    else if (!o.no_stats)
       j["statistics"] = {{"min_nearest_deg", st.min_nearest_deg},
                          {"max_nearest_deg", st.max_nearest_deg},
                          {"covering_deg", st.covering_deg},
@@ -111,34 +129,55 @@ void run(const Options& o) {
   std::printf("rig %s\n", rig.spec.c_str());
   std::printf("domain               origin %g,%g,%g extent %g,%g,%g (bounding-sphere radius R = %g)\n", domain.origin.x,
               domain.origin.y, domain.origin.z, domain.extent.x, domain.extent.y, domain.extent.z, domain.radius());
-  std::printf("cameras              %d on %d shell%s\n", rig.size(), rig.shell_count, rig.shell_count == 1 ? "" : "s");
-  for (int s = 0; s < rig.shell_count; ++s) {
-    int count = 0;
-    double rmin = 1e300, rmax = 0;
-    for (const RigCamera& k : rig.cameras)
-      if (k.shell == s) {
-        ++count;
-        rmin = std::min(rmin, k.radius);
-        rmax = std::max(rmax, k.radius);
-      }
-    if (rmin == rmax)
-      std::printf("  shell %-3d          %d cameras at radius %g (%.4g R)\n", s, count, rmin, rmin / domain.radius());
-    else
-      std::printf("  shell %-3d          %d cameras at radius %g..%g\n", s, count, rmin, rmax);
-  }
-  std::printf("patches             ");
-  for (const auto& [name, count] : patches) std::printf(" %s %d", name.c_str(), count);
-  std::printf("\nfield of view        %.3f deg (vertical, square or landscape images)\n",
-              rig.cameras.empty() ? 0.0 : rig.cameras[0].fov_y_degrees);
-  if (!o.no_stats) {
-    std::printf("nearest neighbour    %.3f .. %.3f deg (max/min %.3f)\n", st.min_nearest_deg, st.max_nearest_deg,
-                st.min_nearest_deg > 0 ? st.max_nearest_deg / st.min_nearest_deg : 0.0);
-    std::printf("covering radius      %.3f deg (no direction farther from a camera)\n", st.covering_deg);
-    std::printf("right then left      returns for %.1f %% of cameras\n", 100 * st.right_left_return);
-    std::printf("up then down         returns for %.1f %% of cameras\n", 100 * st.up_down_return);
-    std::printf("missing moves        %.1f %% of right/left/up/down\n", 100 * st.missing_moves);
-    std::printf("reachable            %d of %d from camera 0, %s\n", st.reachable_from_0, rig.size(),
-                st.strongly_connected ? "strongly connected" : "NOT strongly connected");
+  if (inside) {
+    std::printf("cameras              %d inside the domain (%s)\n", rig.size(), rig.is_lattice() ? "lattice" : "path");
+    std::printf("field of view        %.3f deg for perspective frames (360-degree frames see everything)\n",
+                rig.cameras.empty() ? 0.0 : rig.cameras[0].fov_y_degrees);
+    if (!o.no_stats) {
+      if (rig.is_lattice())
+        std::printf("lattice              %d x %d x %d nodes, spacing %g, %g, %g (x, y, z)\n", vst.lattice[0], vst.lattice[1],
+                    vst.lattice[2], vst.spacing.x, vst.spacing.y, vst.spacing.z);
+      else
+        std::printf("path                 length %g along the cameras\n", vst.path_length);
+      std::printf("camera box           x %g..%g  y %g..%g  z %g..%g\n", vst.box_lo.x, vst.box_hi.x, vst.box_lo.y,
+                  vst.box_hi.y, vst.box_lo.z, vst.box_hi.z);
+      std::printf("neighbour distance   %g .. %g (one walk step)\n", vst.min_step, vst.max_step);
+      std::printf("opposite move        returns for %.1f %% of moves\n", 100 * vst.reverse_return);
+      std::printf("missing moves        %.1f %% of the six moves (%s)\n", 100 * vst.missing_moves,
+                  rig.is_lattice() ? "lattice faces" : "path ends, sideways");
+      std::printf("reachable            %d of %d from camera 0, %s\n", vst.reachable_from_0, rig.size(),
+                  vst.strongly_connected ? "strongly connected" : "NOT strongly connected");
+    }
+  } else {
+    std::printf("cameras              %d on %d shell%s\n", rig.size(), rig.shell_count, rig.shell_count == 1 ? "" : "s");
+    for (int s = 0; s < rig.shell_count; ++s) {
+      int count = 0;
+      double rmin = 1e300, rmax = 0;
+      for (const RigCamera& k : rig.cameras)
+        if (k.shell == s) {
+          ++count;
+          rmin = std::min(rmin, k.radius);
+          rmax = std::max(rmax, k.radius);
+        }
+      if (rmin == rmax)
+        std::printf("  shell %-3d          %d cameras at radius %g (%.4g R)\n", s, count, rmin, rmin / domain.radius());
+      else
+        std::printf("  shell %-3d          %d cameras at radius %g..%g\n", s, count, rmin, rmax);
+    }
+    std::printf("patches             ");
+    for (const auto& [name, count] : patches) std::printf(" %s %d", name.c_str(), count);
+    std::printf("\nfield of view        %.3f deg (vertical, square or landscape images)\n",
+                rig.cameras.empty() ? 0.0 : rig.cameras[0].fov_y_degrees);
+    if (!o.no_stats) {
+      std::printf("nearest neighbour    %.3f .. %.3f deg (max/min %.3f)\n", st.min_nearest_deg, st.max_nearest_deg,
+                  st.min_nearest_deg > 0 ? st.max_nearest_deg / st.min_nearest_deg : 0.0);
+      std::printf("covering radius      %.3f deg (no direction farther from a camera)\n", st.covering_deg);
+      std::printf("right then left      returns for %.1f %% of cameras\n", 100 * st.right_left_return);
+      std::printf("up then down         returns for %.1f %% of cameras\n", 100 * st.up_down_return);
+      std::printf("missing moves        %.1f %% of right/left/up/down\n", 100 * st.missing_moves);
+      std::printf("reachable            %d of %d from camera 0, %s\n", st.reachable_from_0, rig.size(),
+                  st.strongly_connected ? "strongly connected" : "NOT strongly connected");
+    }
   }
   std::printf("time                 rig %.2f ms, graph %.2f ms%s", make_ms, graph_ms, o.no_stats ? "\n" : "");
   if (!o.no_stats) std::printf(", statistics %.1f ms\n", stats_ms);
@@ -166,7 +205,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       "RIG syntax: yinyang[:NTxNP] (default 5x13 = 130), latlon[:NLATxNLON[+poles]] (default 8x16+poles),\n"
       "fibonacci[:N] (default 130), file:PATH or PATH (text: 'x y z [lx ly lz [ux uy uz [fov [shell]]]]' per line;\n"
       "or JSON {\"cameras\": [{\"position\": [x,y,z], ...}]}). Built-in kinds take @R1,R2,... = shell radii in\n"
-      "bounding-sphere radii (default @3), e.g. shells:yinyang@1.5,2.5,4. See docs/cameras.md.\n"
+      "bounding-sphere radii (default @3), e.g. shells:yinyang@1.5,2.5,4. Inside the volume: lattice:NXxNYxNZ[@MARGIN]\n"
+      "and path:FILE (statistics in world units: spacing, walk steps). See docs/cameras.md.\n"
       "Examples:\n"
       "  panoptes rig yinyang\n"
       "  panoptes rig fibonacci:10000 --extent 256,512,160\n"

@@ -108,6 +108,29 @@ int reachable_count(const NavigationGraph& graph, int start) {
   return int(queue.size());
 }
 
+namespace {
+// Strongly connected iff camera 0 reaches everyone and everyone reaches camera 0 (reverse graph).
+bool is_strongly_connected(const NavigationGraph& graph, int reachable_from_0) {
+  if (reachable_from_0 != graph.size()) return false;
+  std::vector<std::vector<int>> in_edges(std::size_t(graph.size()));
+  for (int c = 0; c < graph.size(); ++c) {
+    const Neighbours& nb = graph.neighbours[std::size_t(c)];
+    for (int j : {nb.right, nb.left, nb.up, nb.down, nb.in, nb.out})
+      if (j >= 0) in_edges[std::size_t(j)].push_back(c);
+  }
+  std::vector<char> seen(std::size_t(graph.size()), 0);
+  std::vector<int> queue{0};
+  seen[0] = 1;
+  for (std::size_t q = 0; q < queue.size(); ++q)
+    for (int j : in_edges[std::size_t(queue[q])])
+      if (!seen[std::size_t(j)]) {
+        seen[std::size_t(j)] = 1;
+        queue.push_back(j);
+      }
+  return int(queue.size()) == graph.size();
+}
+}  // namespace
+
 RigStatistics rig_statistics(const Rig& rig, const NavigationGraph& graph) {
   RigStatistics st;
   st.cameras = rig.size();
@@ -135,25 +158,60 @@ RigStatistics rig_statistics(const Rig& rig, const NavigationGraph& graph) {
   st.up_down_return = double(ud) / graph.size();
   st.missing_moves = double(missing) / (4.0 * graph.size());
   st.reachable_from_0 = reachable_count(graph, 0);
-  // Strongly connected iff camera 0 reaches everyone and everyone reaches camera 0 (reverse graph).
-  if (st.reachable_from_0 == graph.size()) {
-    std::vector<std::vector<int>> in_edges(graph.size());
-    for (int c = 0; c < graph.size(); ++c) {
-      const Neighbours& nb = graph.neighbours[c];
-      for (int j : {nb.right, nb.left, nb.up, nb.down, nb.in, nb.out})
-        if (j >= 0) in_edges[j].push_back(c);
+  st.strongly_connected = is_strongly_connected(graph, st.reachable_from_0);
+  return st;
+}
+
+VolumeRigStatistics volume_rig_statistics(const Rig& rig, const NavigationGraph& graph) {
+  VolumeRigStatistics st;
+  st.cameras = rig.size();
+  st.lattice = rig.lattice;
+  if (rig.size() == 0) return st;
+  const auto pos = [&](int id) { return rig.cameras[std::size_t(id)].position; };
+  st.box_lo = st.box_hi = pos(0);
+  for (const RigCamera& c : rig.cameras)
+    for (int a = 0; a < 3; ++a) {
+      st.box_lo[a] = std::min(st.box_lo[a], c.position[a]);
+      st.box_hi[a] = std::max(st.box_hi[a], c.position[a]);
     }
-    std::vector<char> seen(graph.size(), 0);
-    std::vector<int> queue{0};
-    seen[0] = 1;
-    for (std::size_t q = 0; q < queue.size(); ++q)
-      for (int j : in_edges[queue[q]])
-        if (!seen[j]) {
-          seen[j] = 1;
-          queue.push_back(j);
-        }
-    st.strongly_connected = int(queue.size()) == graph.size();
+  if (rig.is_lattice()) {
+    const int strides[3] = {1, rig.lattice[0], rig.lattice[0] * rig.lattice[1]};
+    for (int a = 0; a < 3; ++a)
+      if (rig.lattice[std::size_t(a)] > 1 && strides[a] < rig.size()) st.spacing[a] = norm(pos(strides[a]) - pos(0));
   }
+  st.min_step = 1e300;
+  int existing = 0, returned = 0, missing = 0;
+  for (int c = 0; c < graph.size(); ++c) {
+    const Neighbours& nb = graph.neighbours[std::size_t(c)];
+    const std::pair<int, int> moves[] = {{nb.right, 0}, {nb.left, 1}, {nb.up, 2}, {nb.down, 3}, {nb.in, 4}, {nb.out, 5}};
+    for (const auto& [j, slot] : moves) {
+      if (j < 0) {
+        ++missing;
+        continue;
+      }
+      ++existing;
+      const double d = norm(pos(j) - pos(c));
+      st.min_step = std::min(st.min_step, d);
+      st.max_step = std::max(st.max_step, d);
+      const Neighbours& back = graph.neighbours[std::size_t(j)];
+      const int opposite[] = {back.left, back.right, back.down, back.up, back.out, back.in};
+      returned += opposite[slot] == c;
+    }
+  }
+  if (existing == 0) st.min_step = 0;
+  st.reverse_return = existing ? double(returned) / existing : 0;
+  st.missing_moves = double(missing) / (6.0 * graph.size());
+  if (rig.path) {
+    std::vector<char> seen(std::size_t(graph.size()), 0);
+    for (int c = 0; c >= 0 && c < graph.size() && !seen[std::size_t(c)];) {
+      seen[std::size_t(c)] = 1;
+      const int next = graph.neighbours[std::size_t(c)].in;
+      if (next >= 0) st.path_length += norm(pos(next) - pos(c));
+      c = next;
+    }
+  }
+  st.reachable_from_0 = reachable_count(graph, 0);
+  st.strongly_connected = is_strongly_connected(graph, st.reachable_from_0);
   return st;
 }
 

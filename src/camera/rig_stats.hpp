@@ -1,5 +1,6 @@
 #pragma once
 // Quality measures of a rig and its navigation graph, for tests, `panoptes rig` and docs.
+#include <array>
 #include <vector>
 
 #include "camera/navigation.hpp"
@@ -34,6 +35,24 @@ struct RigStatistics {
 
 /// Computes the statistics (covering radius by covering_radius with automatic samples).
 RigStatistics rig_statistics(const Rig& rig, const NavigationGraph& graph);
+
+/// Summary of a rig inside the volume (lattice, path), where angles seen from the centre mean nothing:
+/// distances in world units between cameras the graph connects.
+struct VolumeRigStatistics {
+  int cameras = 0;
+  std::array<int, 3> lattice{0, 0, 0};  ///< nodes along x, y, z (all 0 for a path)
+  Vec3 spacing;                         ///< lattice: distance between adjacent nodes along x, y, z (0: one node)
+  Vec3 box_lo, box_hi;                  ///< bounding box of the camera positions
+  double min_step = 0, max_step = 0;    ///< shortest / longest graph edge (a walk's step)
+  double path_length = 0;               ///< path: sum of the steps along `in` from camera 0 (0 for lattices)
+  double reverse_return = 0;  ///< fraction of existing moves that the opposite move undoes (right/left, up/down, in/out)
+  double missing_moves = 0;   ///< fraction of (camera, six moves) with no neighbour (lattice faces, path ends)
+  int reachable_from_0 = 0;
+  bool strongly_connected = false;
+};
+
+/// Computes VolumeRigStatistics in O(cameras).
+VolumeRigStatistics volume_rig_statistics(const Rig& rig, const NavigationGraph& graph);
 
 /// Cameras reachable from `start` along the graph's directed edges (all six moves), by BFS.
 int reachable_count(const NavigationGraph& graph, int start);

@@ -16,7 +16,16 @@ echo "$out" | grep "yang 65 yin 65" >/dev/null || { echo "$out"; echo "bad patch
 echo "$out" | grep "nearest neighbour  *9.871 .. 18.000 deg" >/dev/null || { echo "$out"; echo "bad spacing"; exit 1; }
 echo "$out" | grep "strongly connected" >/dev/null || { echo "$out"; echo "graph not connected"; exit 1; }
 
-# Shells and --list: 3 x 130 cameras, in/out columns filled.
+# Cameras inside the volume: distances in world units, not angles from the centre (issue 14).
+out=$("$panoptes" rig lattice:4x4x3@0.05 --extent 25600,51200,16000)
+echo "$out" | grep "^cameras  *48 inside the domain (lattice)$" >/dev/null || { echo "$out"; echo "bad lattice count"; exit 1; }
+echo "$out" | grep "^lattice  *4 x 4 x 3 nodes, spacing 5760, 11520, 4800 (x, y, z)$" >/dev/null || { echo "$out"; echo "bad lattice spacing"; exit 1; }
+echo "$out" | grep "^neighbour distance  *4800 .. 11520 " >/dev/null || { echo "$out"; echo "bad walk steps"; exit 1; }
+echo "$out" | grep "^missing moves  *27.8 % of the six moves" >/dev/null || { echo "$out"; echo "bad missing moves"; exit 1; }
+if echo "$out" | grep -q "deg (max/min\|covering radius"; then echo "$out"; echo "sphere statistics printed for a lattice"; exit 1; fi
+"$panoptes" rig lattice:3x2x2 --json | python3 -c 'import json,sys; s=json.load(sys.stdin)["statistics"]; assert s["lattice"]==[3,2,2] and s["reverse_return"]==1.0 and s["strongly_connected"], s'
+
+: 3 x 130 cameras, in/out columns filled.
 "$panoptes" rig shells:yinyang@1.5,2.5,4 --list --no-stats > "$tmp/list.txt"
 grep -q "^cameras  *390 on 3 shells$" "$tmp/list.txt"
 [ "$(grep -cE '^ +[0-9]+ (yin|yang) ' "$tmp/list.txt")" = 390 ] || { echo "list has wrong row count"; exit 1; }
