@@ -104,6 +104,14 @@ class Database:
         return self._manifest.get("rig", {})
 
     @property
+    def projection(self):
+        """"perspective", or "equirectangular": every frame is a whole 360 x 180 degree panorama around a
+        camera inside the volume (longitude along the width, latitude along the height), not a view. Shown
+        as an image it looks distorted; `panoptes play` looks around in it and `panoptes export-path
+        --view-size WxH` cuts perspective views out of it."""
+        return self.rig.get("parameters", {}).get("projection", "perspective")
+
+    @property
     def provenance(self):
         return self._manifest.get("provenance", {})
 
@@ -167,7 +175,8 @@ class Database:
     def __repr__(self):
         w, h = self.image_size
         return (f"<panoptes.Database {str(self.path)!r}: {self.title!r}, {self.status}, {self.camera_count} cameras x "
-                f"{self.task_count} tasks, {self.frame_count} frames of {w}x{h}>")
+                f"{self.task_count} tasks, {self.frame_count} frames of {w}x{h}"
+                f"{' (360-degree equirectangular panoramas)' if self.projection == 'equirectangular' else ''}>")
 
 
 Error = _panoptes.Error

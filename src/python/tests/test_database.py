@@ -20,6 +20,18 @@ def test_summary(synth_db):
     assert [t["name"] for t in db.tasks] == [t["name"] for t in db.manifest["tasks"]]
     assert list(db.axes) == ["isovalue"] and db.axes["isovalue"].shape == (3,)
     assert "synthetic" in repr(db)
+    assert db.projection == "perspective" and "360" not in repr(db)
+
+
+def test_360_degree_databases_say_so(tmp_path):
+    """Issue 14: a lattice of equirectangular cameras; its frames are panoramas, not views."""
+    out = tmp_path / "lattice"
+    subprocess.run([panoptes_binary(), "synth-db", str(out), "--lattice", "2x2x1", "--projection", "equirectangular",
+                    "--tasks", "1", "--frames", "1", "--size", "64x32"], check=True, stdout=subprocess.DEVNULL)
+    db = panoptes.open(out)
+    assert db.projection == "equirectangular"
+    assert "360-degree equirectangular panoramas" in repr(db)
+    assert db.frame(0, 0, 0).shape == (32, 64, 3)
 
 
 def test_cameras_match_panoptes_info(synth_db):
