@@ -174,6 +174,7 @@ void BM_MissCost(benchmark::State& state) {
     player::EngineOptions o;
     o.prefetch = false;
     o.start_playing = false;
+    o.reader_pool_capacity = 64;  // every camera's reader stays open for the second loop
     player::Engine engine(db, o);
     engine.current_frame();
     const int n = engine.manifest().camera_count();
