@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green, both together) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: about 555 CPU-seconds (at least 4.6 min on two free cores), 2026-11-23: 12 of the 48 snapshots took 140.4 CPU-s (x4; OpenMP waiting passively, as scripts/demo sets it) on the shared 2-core machine at load ~13, with the renderer after issue #10's round 2; above the 2-3 min target.
+# Measured: 426 CPU-seconds (at least 3.6 min on two free cores), 2026-11-23: the whole demo as scripts/demo runs it (OpenMP waiting passively) took 425.7 CPU-s and 14.8 min wall on the shared 2-core machine at load 5-13 (mean 8.7), with issue #10's round-3 renderer; above the 2-3 min target.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
@@ -87,9 +87,11 @@ crf = 23
 preset = "superfast"
 playback_fps = 10      # the player shows the 48 snapshots in ~5 s (the movies themselves are 30 fps)
 
-[render]
-sample_distance = 1.0
-percentile = 0.999
+[render]               # 1.0 voxel: the largest step whose frames look like 0.5 voxel's. Measured on the demo's
+sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) against 0.5: PSNR mean 48-53 dB, min
+percentile = 0.999     # 34 dB (the view down onto the surface, whose thin dark gaps between saturated p rings thin
+                       # out slightly; they look alike). 1.5 voxel: min 26 dB, 2.0: min 22 dB, and the gaps fill in
+                       # visibly (docs/insitu.md). 0.5 voxel would cost more march for no visible gain.
 
 [[task]]
 name = "p-wave"

@@ -157,6 +157,10 @@ struct Session::Impl {
   std::vector<char> recv_buf;
   std::vector<std::vector<render::PartialImage>> received;  // [rank][task]
   std::vector<render::PartialImage> composited;
+  // Per owned camera: the partials of each task in rank order, and the empty partial of a camera
+  // no brick reaches (members, so their capacity is reused from camera to camera).
+  std::vector<std::vector<const render::PartialImage*>> parts;  // [task]
+  render::PartialImage empty_partial;
   // Finished frames waiting to be encoded: batch[i][task] of camera batch_camera[i].
   static constexpr int kEncodeBatch = 4;
   std::vector<std::vector<Image>> batch;
@@ -283,6 +287,7 @@ void Session::Impl::init() {
   send_buf.resize(std::size_t(slots));
   received.assign(std::size_t(size), std::vector<render::PartialImage>(tasks.size()));
   composited.resize(tasks.size());
+  parts.resize(tasks.size());
   batch.assign(kEncodeBatch, std::vector<Image>(tasks.size()));
   batch_camera.assign(kEncodeBatch, 0);
 }
@@ -674,7 +679,7 @@ void Session::Impl::render_snapshot(int frame) {
     if (mine < C) {
       auto t0 = Clock::now();
       // Partials of my camera in rank order (a deterministic order: composite() sorts per pixel).
-      std::vector<std::vector<const render::PartialImage*>> parts(static_cast<std::size_t>(K));
+      for (auto& p : parts) p.clear();
       for (int s = 0; s < size; ++s) {
         if (!blocks[std::size_t(s)].has_brick) continue;
         if (s == rank) {
@@ -701,15 +706,16 @@ void Session::Impl::render_snapshot(int frame) {
       // both cores busy for any K (a loop over K = 3 tasks on 2 threads left one idle a third of the time).
       std::vector<Image>& images = batch[std::size_t(batch_n)];
       for (int t = 0; t < K; ++t) {
-        render::PartialImage empty;
-        if (parts[std::size_t(t)].empty()) {
-          empty.reset(cfg.width, cfg.height, {0, 0, 0, 0});
-          images[std::size_t(t)] = render::finish_image(empty, cam, grid, bg, outline);
-        } else if (parts[std::size_t(t)].size() == 1) {
-          images[std::size_t(t)] = render::finish_image(*parts[std::size_t(t)][0], cam, grid, bg, outline);
+        const std::vector<const render::PartialImage*>& p = parts[std::size_t(t)];
+        Image& out = images[std::size_t(t)];
+        if (p.empty()) {
+          empty_partial.reset(cfg.width, cfg.height, {0, 0, 0, 0});
+          render::finish_image_into(empty_partial, cam, grid, out, bg, outline);
+        } else if (p.size() == 1) {
+          render::finish_image_into(*p[0], cam, grid, out, bg, outline);
         } else {
-          composited[std::size_t(t)] = render::composite(parts[std::size_t(t)]);
-          images[std::size_t(t)] = render::finish_image(composited[std::size_t(t)], cam, grid, bg, outline);
+          render::composite_into(p, composited[std::size_t(t)]);
+          render::finish_image_into(composited[std::size_t(t)], cam, grid, out, bg, outline);
         }
       }
       time.composite += since(t0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 
 #include "core/error.hpp"
@@ -23,9 +24,12 @@ void PartialImage::reset(int w, int h, PixelRect r) {
 }
 
 namespace {
-PartialImage union_target(std::span<const PartialImage* const> parts) {
-  PartialImage out;
-  if (parts.empty()) return out;
+// Resets `out` to the union of the parts' rects (reusing its buffers' capacity).
+void union_target(std::span<const PartialImage* const> parts, PartialImage& out) {
+  if (parts.empty()) {
+    out = PartialImage{};
+    return;
+  }
   PixelRect u{1 << 30, 1 << 30, -(1 << 30), -(1 << 30)};
   for (const PartialImage* p : parts) {
     if (p->width != parts[0]->width || p->height != parts[0]->height)
@@ -40,33 +44,43 @@ PartialImage union_target(std::span<const PartialImage* const> parts) {
   }
   if (u.empty()) u = {};
   out.reset(parts[0]->width, parts[0]->height, u);
-  return out;
 }
 }  // namespace
 
-PartialImage composite(std::span<const PartialImage* const> parts) {
-  PartialImage out = union_target(parts);
+void composite_into(std::span<const PartialImage* const> parts, PartialImage& out) {
+  union_target(parts, out);
   const int n = int(parts.size());
-#pragma omp parallel for schedule(static)
-  for (int y = out.rect.y0; y < out.rect.y1; ++y) {
+#pragma omp parallel
+  {
+    // One sort buffer per thread (parts are few: one per rank with a brick).
     std::vector<std::pair<float, int>> order(std::size_t(n) + 0);
-    for (int x = out.rect.x0; x < out.rect.x1; ++x) {
-      int m = 0;
-      for (int i = 0; i < n; ++i) {
-        const float d = parts[i]->depth_at(x, y);
-        if (d != PartialImage::kNoDepth) order[std::size_t(m++)] = {d, i};
+#pragma omp for schedule(static)
+    for (int y = out.rect.y0; y < out.rect.y1; ++y) {
+      for (int x = out.rect.x0; x < out.rect.x1; ++x) {
+        int m = 0;
+        for (int i = 0; i < n; ++i) {
+          const float d = parts[i]->depth_at(x, y);
+          if (d != PartialImage::kNoDepth) order[std::size_t(m++)] = {d, i};
+        }
+        std::sort(order.begin(), order.begin() + m);
+        float* acc = out.rgba_at(x, y);
+        for (int r = 0; r < m; ++r) over(acc, parts[order[std::size_t(r)].second]->rgba_at(x, y));
+        out.depth[std::size_t(y - out.rect.y0) * out.rect.width() + (x - out.rect.x0)] =
+            m ? order[0].first : PartialImage::kNoDepth;
       }
-      std::sort(order.begin(), order.begin() + m);
-      float* acc = out.rgba_at(x, y);
-      for (int r = 0; r < m; ++r) over(acc, parts[order[std::size_t(r)].second]->rgba_at(x, y));
-      out.depth[std::size_t(y - out.rect.y0) * out.rect.width() + (x - out.rect.x0)] = m ? order[0].first : PartialImage::kNoDepth;
     }
   }
+}
+
+PartialImage composite(std::span<const PartialImage* const> parts) {
+  PartialImage out;
+  composite_into(parts, out);
   return out;
 }
 
 PartialImage composite_ordered(std::span<const PartialImage* const> parts) {
-  PartialImage out = union_target(parts);
+  PartialImage out;
+  union_target(parts, out);
 #pragma omp parallel for schedule(static)
   for (int y = out.rect.y0; y < out.rect.y1; ++y)
     for (int x = out.rect.x0; x < out.rect.x1; ++x) {
@@ -117,8 +131,29 @@ std::vector<int> visibility_order(const camera::Camera& cam, const GridGeometry&
 }
 
 namespace {
-// Anti-aliased segment coverage into a w×h float buffer (max of coverages).
-void draw_segment(std::vector<float>& buf, int w, int h, double ax, double ay, double bx, double by, double width) {
+// The outline's coverage of the image, kept sparse: a segment of width 1.5 touches a few thousand
+// pixels of an image of a quarter million, so finish_image() composites every pixel without it and
+// then redoes only the touched ones. The dense buffers live per calling thread and are cleared
+// through the touched lists, so a warm call neither allocates nor writes the whole image twice.
+struct OutlineCoverage {
+  std::vector<float> front, back;                  // w×h coverage in [0, 1], zero where untouched
+  std::vector<std::uint32_t> touched;              // indices whose front or back coverage is > 0
+  void prepare(std::size_t n) {
+    if (front.size() < n) {
+      front.assign(n, 0.0f);
+      back.assign(n, 0.0f);
+    }
+  }
+  void clear() {
+    for (const std::uint32_t i : touched) front[i] = back[i] = 0.0f;
+    touched.clear();
+  }
+};
+
+// Anti-aliased segment coverage into a w×h float buffer (max of coverages); records every pixel the
+// buffer turns non-zero in `touched` (each at most once per buffer).
+void draw_segment(std::vector<float>& buf, std::vector<std::uint32_t>& touched, int w, int h, double ax, double ay,
+                  double bx, double by, double width) {
   const double half = 0.5 * width;
   const double x0 = std::min(ax, bx) - half - 1, x1 = std::max(ax, bx) + half + 1;
   const double y0 = std::min(ay, by) - half - 1, y1 = std::max(ay, by) + half + 1;
@@ -140,7 +175,9 @@ void draw_segment(std::vector<float>& buf, int w, int h, double ax, double ay, d
       t = std::clamp(t, 0.0, 1.0);
       const double ex = px - (ax + t * dx), ey = py - (ay + t * dy);
       const double cov = std::clamp(half + 0.5 - std::sqrt(ex * ex + ey * ey), 0.0, 1.0);
-      float& b = buf[std::size_t(steep ? m : n) * w + (steep ? n : m)];
+      const std::size_t i = std::size_t(steep ? m : n) * w + (steep ? n : m);
+      float& b = buf[i];
+      if (b == 0.0f && float(cov) > 0.0f) touched.push_back(std::uint32_t(i));
       b = std::max(b, float(cov));
     }
   }
@@ -155,56 +192,91 @@ bool project_segment(const camera::Camera& cam, Vec3 a, Vec3 b, double& ax, doub
   if (zb < near) b = b + (a - b) * ((near - zb) / (za - zb));
   return cam.project(a, ax, ay) && cam.project(b, bx, by);
 }
+
+// A colour in [0, 1] (NaN counts as 0) to 8 bits, rounding half away from zero: exactly
+// std::lround(v * 255) for every float v, since v * 255 is computed in float as before and a float
+// plus 0.5 is exact in double. Inline, so the pixel loop vectorizes (lroundf is a libm call).
+inline std::uint8_t to_byte(float c) {
+  const float v = (c > 0.0f ? std::min(c, 1.0f) : 0.0f) * 255.0f;
+  return std::uint8_t(int(double(v) + 0.5));
+}
 }  // namespace
 
-Image finish_image(const PartialImage& comp, const camera::Camera& cam, const GridGeometry& g, Rgb bg,
-                   const OutlineStyle& outline) {
+void finish_image_into(const PartialImage& comp, const camera::Camera& cam, const GridGeometry& g, Image& img, Rgb bg,
+                       const OutlineStyle& outline) {
   const int w = cam.width(), h = cam.height();
   if (comp.width != w || comp.height != h)
     throw Error("finish_image: partial image is " + std::to_string(comp.width) + "x" + std::to_string(comp.height) +
                 " but the camera's image is " + std::to_string(w) + "x" + std::to_string(h));
-  std::vector<float> front, back;
-  if (outline.enabled) {
-    front.assign(std::size_t(w) * h, 0.0f);
-    back.assign(std::size_t(w) * h, 0.0f);
-    const Vec3 lo = g.domain_lo(), hi = g.domain_hi(), c = cam.position();
-    // Face (axis a, side s) is turned towards the camera when the camera is beyond its plane.
-    auto facing = [&](int a, int s) { return s ? c[a] > hi[a] : c[a] < lo[a]; };
-    for (int a = 0; a < 3; ++a) {
-      const int b = (a + 1) % 3, d = (a + 2) % 3;
-      for (int sb = 0; sb < 2; ++sb)
-        for (int sd = 0; sd < 2; ++sd) {
-          Vec3 p = lo, q = lo;
-          p[b] = q[b] = sb ? hi[b] : lo[b];
-          p[d] = q[d] = sd ? hi[d] : lo[d];
-          q[a] = hi[a];
-          double ax, ay, bx, by;
-          if (!project_segment(cam, p, q, ax, ay, bx, by)) continue;
-          const bool is_front = facing(b, sb) || facing(d, sd);
-          draw_segment(is_front ? front : back, w, h, ax, ay, bx, by, outline.width);
-        }
-    }
-  }
-  Image img(w, h, 4);
+  if (img.width != w || img.height != h || img.channels != 4) img = Image(w, h, 4);
   const float lc[3] = {outline.colour.r, outline.colour.g, outline.colour.b};
   const float bgc[3] = {bg.r, bg.g, bg.b};
+  // Every pixel without the outline: the background, under the composited volume inside its rect.
+  const std::uint8_t bg8[4] = {to_byte(bgc[0]), to_byte(bgc[1]), to_byte(bgc[2]), 255};
+  const PixelRect& r = comp.rect;
 #pragma omp parallel for schedule(static)
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(y) * w + x;
-      float c[3] = {bgc[0], bgc[1], bgc[2]};
-      if (outline.enabled && back[i] > 0)
-        for (int k = 0; k < 3; ++k) c[k] = back[i] * lc[k] + (1 - back[i]) * c[k];
-      if (comp.rect.contains(x, y)) {
-        const float* v = comp.rgba_at(x, y);
-        for (int k = 0; k < 3; ++k) c[k] = v[k] + (1 - v[3]) * c[k];
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* o = img.row(y);
+    const bool in_rows = y >= r.y0 && y < r.y1;
+    const int xa = in_rows ? r.x0 : w, xb = in_rows ? r.x1 : w;
+    for (int x = 0; x < xa; ++x) std::memcpy(o + 4 * std::size_t(x), bg8, 4);
+    if (xa < xb) {
+      const float* v = comp.rgba_at(xa, y);
+      std::uint8_t* q = o + 4 * std::size_t(xa);
+      for (int x = xa; x < xb; ++x, v += 4, q += 4) {
+        q[0] = to_byte(v[0] + (1 - v[3]) * bgc[0]);
+        q[1] = to_byte(v[1] + (1 - v[3]) * bgc[1]);
+        q[2] = to_byte(v[2] + (1 - v[3]) * bgc[2]);
+        q[3] = 255;
       }
-      if (outline.enabled && front[i] > 0)
-        for (int k = 0; k < 3; ++k) c[k] = front[i] * lc[k] + (1 - front[i]) * c[k];
-      std::uint8_t* o = img.at(x, y);
-      for (int k = 0; k < 3; ++k) o[k] = std::uint8_t(std::lround(std::clamp(c[k], 0.0f, 1.0f) * 255.0f));
-      o[3] = 255;
     }
+    for (int x = std::max(xb, 0); x < w; ++x) std::memcpy(o + 4 * std::size_t(x), bg8, 4);
+  }
+  if (!outline.enabled) return;
+
+  thread_local OutlineCoverage cover;
+  cover.prepare(std::size_t(w) * h);
+  const Vec3 lo = g.domain_lo(), hi = g.domain_hi(), c = cam.position();
+  // Face (axis a, side s) is turned towards the camera when the camera is beyond its plane.
+  auto facing = [&](int a, int s) { return s ? c[a] > hi[a] : c[a] < lo[a]; };
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, d = (a + 2) % 3;
+    for (int sb = 0; sb < 2; ++sb)
+      for (int sd = 0; sd < 2; ++sd) {
+        Vec3 p = lo, q = lo;
+        p[b] = q[b] = sb ? hi[b] : lo[b];
+        p[d] = q[d] = sd ? hi[d] : lo[d];
+        q[a] = hi[a];
+        double ax, ay, bx, by;
+        if (!project_segment(cam, p, q, ax, ay, bx, by)) continue;
+        const bool is_front = facing(b, sb) || facing(d, sd);
+        draw_segment(is_front ? cover.front : cover.back, cover.touched, w, h, ax, ay, bx, by, outline.width);
+      }
+  }
+  // The touched pixels again, with the outline behind and in front of the volume. A pixel touched
+  // by both buffers is listed twice and computed twice to the same value.
+  for (const std::uint32_t i : cover.touched) {
+    const int x = int(i % std::uint32_t(w)), y = int(i / std::uint32_t(w));
+    const float fb = cover.back[i], ff = cover.front[i];
+    float col[3] = {bgc[0], bgc[1], bgc[2]};
+    if (fb > 0)
+      for (int k = 0; k < 3; ++k) col[k] = fb * lc[k] + (1 - fb) * col[k];
+    if (r.contains(x, y)) {
+      const float* v = comp.rgba_at(x, y);
+      for (int k = 0; k < 3; ++k) col[k] = v[k] + (1 - v[3]) * col[k];
+    }
+    if (ff > 0)
+      for (int k = 0; k < 3; ++k) col[k] = ff * lc[k] + (1 - ff) * col[k];
+    std::uint8_t* o = img.at(x, y);
+    for (int k = 0; k < 3; ++k) o[k] = to_byte(col[k]);
+  }
+  cover.clear();
+}
+
+Image finish_image(const PartialImage& comp, const camera::Camera& cam, const GridGeometry& g, Rgb bg,
+                   const OutlineStyle& outline) {
+  Image img;
+  finish_image_into(comp, cam, g, img, bg, outline);
   return img;
 }
 

@@ -62,6 +62,8 @@ inline void over(float* acc, const float* back) {
 /// pixel by depth (exact for any brick decomposition). The result covers the union of the rects;
 /// its depth is the nearest. Throws panoptes::Error if the image sizes differ.
 PartialImage composite(std::span<const PartialImage* const> parts);
+/// composite() into `out`, reusing its buffers (no allocation once warm: the in-situ session's path).
+void composite_into(std::span<const PartialImage* const> parts, PartialImage& out);
 /// Merges partial images already in front-to-back order (e.g. from visibility_order()).
 PartialImage composite_ordered(std::span<const PartialImage* const> front_to_back);
 
@@ -87,5 +89,9 @@ struct OutlineStyle {
 /// image (its rect). Throws panoptes::Error when its size differs from the camera's.
 Image finish_image(const PartialImage& composited, const camera::Camera& cam, const GridGeometry& grid,
                    Rgb background = {0, 0, 0}, const OutlineStyle& outline = {});
+/// finish_image() into `out`, reusing its pixels when it already has the camera's size and 4
+/// channels (the in-situ session finishes hundreds of images per snapshot into the same buffers).
+void finish_image_into(const PartialImage& composited, const camera::Camera& cam, const GridGeometry& grid, Image& out,
+                       Rgb background = {0, 0, 0}, const OutlineStyle& outline = {});
 
 }  // namespace panoptes::render

@@ -9,11 +9,15 @@ extern "C" {
 }
 
 #include <sys/stat.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -24,6 +28,22 @@ extern "C" {
 namespace panoptes::video {
 
 namespace {
+
+// An intra-only writer opens and frees an x264 encoder (several MB of buffers) for every frame.
+// glibc serves blocks that large with mmap and returns them on free, so each frame paid for fresh
+// pages: page faults and the kernel zeroing them. A fixed mmap threshold and a high trim threshold
+// keep freed encoder memory in the heap for the next frame. Measured on the demo's 528x512 frames
+// (2026-11-23, one thread, loaded machine): 7.9 ms of CPU per appended frame before, 2.6 ms after,
+// movie bytes unchanged. Process-wide and once; the heap then keeps up to 256 MB free per arena.
+void keep_freed_encoder_memory() {
+#ifdef __GLIBC__
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  });
+#endif
+}
 
 // Removes SEI NAL units (type 6) from an Annex B packet, in place. Each fresh x264 encoder puts its
 // version-and-options SEI (~550 bytes) into its first packet; intra-only movies get a fresh encoder
@@ -248,7 +268,10 @@ struct MovieWriter::Impl {
     pkt = av_packet_alloc();
     if (!pkt) throw Error("movie " + path + ": out of memory");
     transient = settings.gop == 1;
-    if (transient) release_encoder();
+    if (transient) {
+      release_encoder();
+      keep_freed_encoder_memory();
+    }
     open = true;
   }
 
