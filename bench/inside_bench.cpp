@@ -29,6 +29,7 @@
 #include "player/look.hpp"
 #include "render/renderer.hpp"
 #include "render/synthetic_fields.hpp"
+#include "standard_scene.hpp"
 #include "store/synthetic.hpp"
 
 using namespace panoptes;
@@ -43,24 +44,7 @@ double process_cpu_seconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-// The standard scene of render_bench.cpp (kept identical so the numbers compare).
-struct StandardScene {
-  GridGeometry grid{{256, 512, 160}, {0, 0, 0}, {1, 1, 1}};
-  std::vector<float> p, s;
-  std::vector<PreparedField> fields;
-  StandardScene() {
-    const WaveFront pf[] = {{{128, 180, 90}, 150, 4, 1.0}, {{90, 380, 60}, 70, 4, 0.8}};
-    const WaveFront sf[] = {{{128, 180, 90}, 87, 3, 1.0}, {{90, 380, 60}, 40, 3, 0.9}};
-    p = wave_field(grid, pf);
-    s = wave_field(grid, sf);
-    fields = {PreparedField(FieldView::whole(grid, p.data())), PreparedField(FieldView::whole(grid, s.data()))};
-  }
-};
-
-const StandardScene& scene() {
-  static const StandardScene sc;
-  return sc;
-}
+const bench::StandardScene& scene() { return bench::standard_scene(); }
 
 void BM_EquirectFrame(benchmark::State& state) {
   const auto& sc = scene();

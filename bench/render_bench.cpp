@@ -23,6 +23,7 @@
 
 #include "render/renderer.hpp"
 #include "render/synthetic_fields.hpp"
+#include "standard_scene.hpp"
 
 using namespace panoptes;
 using namespace panoptes::render;
@@ -31,24 +32,7 @@ namespace {
 
 constexpr int kWidth = 920, kHeight = 896;
 
-struct StandardScene {
-  GridGeometry grid{{256, 512, 160}, {0, 0, 0}, {1, 1, 1}};
-  std::vector<float> p, s;
-  std::vector<PreparedField> fields;
-  StandardScene() {
-    // Two sources; P fronts travel faster than S fronts, so their shells are larger.
-    const WaveFront pf[] = {{{128, 180, 90}, 150, 4, 1.0}, {{90, 380, 60}, 70, 4, 0.8}};
-    const WaveFront sf[] = {{{128, 180, 90}, 87, 3, 1.0}, {{90, 380, 60}, 40, 3, 0.9}};
-    p = wave_field(grid, pf);
-    s = wave_field(grid, sf);
-    fields = {PreparedField(FieldView::whole(grid, p.data())), PreparedField(FieldView::whole(grid, s.data()))};
-  }
-};
-
-const StandardScene& scene() {
-  static const StandardScene sc;
-  return sc;
-}
+const bench::StandardScene& scene() { return bench::standard_scene(); }
 
 // n directions spread over the sphere (golden-angle spiral), cameras at 3 bounding radii.
 camera::Camera camera_at(int i, int n) {
