@@ -100,6 +100,18 @@ void keep_for_humans(const std::filesystem::path& png, const std::string& name) 
     std::filesystem::copy_file(png, std::filesystem::path(keep) / name, std::filesystem::copy_options::overwrite_existing);
 }
 
+// A window test's options: SDL's software renderer (Xvfb has no GL worth testing; the software path
+// is deterministic), no vsync, virtual time (ticks of 1/fps, independent of the machine's speed),
+// started paused unless the test plays.
+WindowOptions test_window(bool paused = true) {
+  WindowOptions o;
+  o.software_renderer = true;
+  o.vsync = false;
+  o.paused = paused;
+  o.virtual_time = true;
+  return o;
+}
+
 class WindowTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -131,11 +143,7 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
                            "t=0.40 key=Tab\nt=0.50 key=Period\nt=0.60 key=Period\n"
                            "t=0.70 key=+\nt=0.80 key=0\nt=0.90 key=F1\nt=1.00 key=F1\n"
                            "t=1.05 key=S\nt=1.10 key=R\n";
-  WindowOptions o;
-  o.software_renderer = true;  // Xvfb has no GL worth testing; SDL's software path is deterministic
-  o.vsync = false;
-  o.paused = true;
-  o.virtual_time = true;
+  WindowOptions o = test_window();
   o.script = script;
   o.width = kW;  // a window of the frame's size shows it 1:1 at zoom 1
   o.height = kH;
@@ -234,11 +242,7 @@ TEST_F(WindowTest, MouseDragSnapsWheelZoomsAroundTheCursorRightDragPans) {
     e.button.y = y;
     push(e);
   };
-  WindowOptions o;
-  o.software_renderer = true;
-  o.vsync = false;
-  o.paused = true;
-  o.virtual_time = true;
+  WindowOptions o = test_window();
   o.width = kW;
   o.height = kH;
   o.camera = 1;  // at longitude 90°, looking along -y with z up: screen right is -x
@@ -284,10 +288,7 @@ TEST_F(WindowTest, MissingStreamShowsThePlaceholderAndPlaybackGoesOn) {
   std::filesystem::copy(dir_->path / "db", db, std::filesystem::copy_options::recursive);
   const auto movie = store::Database::open(db).stream_path(3, 0);
   ASSERT_TRUE(std::filesystem::remove(movie));
-  WindowOptions o;
-  o.software_renderer = true;
-  o.vsync = false;
-  o.virtual_time = true;  // playing: 20 ticks of 1/30 s at 30 fps advance 19 frames (looping over 6)
+  WindowOptions o = test_window(/*paused=*/false);  // playing: 20 ticks of 1/30 s at 30 fps advance 19 frames (looping over 6)
   o.width = kW;
   o.height = kH;
   o.speed = 1;  // not the automatic slow-down of a short run
@@ -407,11 +408,7 @@ TEST_F(WindowTest, DemoAt1280x1024FillsTheWindowTheHudStaysSmallAndUpGoesToTheSk
   auto run = [&](const std::string& name, const std::string& script_text) {
     const auto script = dir_->path / (name + ".txt");
     std::ofstream(script) << script_text;
-    WindowOptions o;
-    o.software_renderer = true;
-    o.vsync = false;
-    o.paused = true;
-    o.virtual_time = true;
+    WindowOptions o = test_window();
     o.script = script;
     o.max_frames = 8;
     o.screenshot_on_exit = dir_->path / (name + ".png");
@@ -489,11 +486,7 @@ TEST_F(WindowTest, LatticeLookAroundWalksWithTheArrowsRelativeToTheView) {
                            "t=0.30 key=Up\n"          // (1,1,0) = 4
                            "t=0.40 key=PageUp\n"      // (1,1,1) = 13
                            "t=0.50 key=Right\n";      // right of +x is -y: (1,0,1) = 10
-  WindowOptions o;
-  o.software_renderer = true;
-  o.vsync = false;
-  o.paused = true;
-  o.virtual_time = true;
+  WindowOptions o = test_window();
   o.script = script;
   o.width = 320, o.height = 240;
   o.max_frames = 20;
