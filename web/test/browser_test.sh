@@ -20,15 +20,26 @@ trap cleanup EXIT
 rm "$tmp/db/movies/c5/t1.mp4"                                   # missing
 head -c 3000 /dev/urandom > "$tmp/db/movies/c4/t0.mp4"          # corrupt
 
-"$panoptes" serve "$tmp/db" --port 0 --token t0k3n > "$tmp/serve.log" 2>&1 &
-pids+=($!)
-url=""
-for _ in $(seq 100); do
-  url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$tmp/serve.log")
-  [ -n "$url" ] && break
-  sleep 0.1
-done
-[ -n "$url" ] || { echo "serve did not start:"; cat "$tmp/serve.log"; exit 1; }
+# start_serve LOG ARGS...: starts `panoptes serve ARGS` in the background (logging to LOG) and sets
+# served_url to the URL it prints once it listens.
+start_serve() {
+  local log=$1
+  shift
+  "$panoptes" serve "$@" > "$log" 2>&1 &
+  pids+=($!)
+  served_url=""
+  for _ in $(seq 100); do
+    served_url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$log")
+    [ -n "$served_url" ] && return 0
+    sleep 0.1
+  done
+  echo "serve $* did not start:"
+  cat "$log"
+  exit 1
+}
+
+start_serve "$tmp/serve.log" "$tmp/db" --port 0 --token t0k3n
+url=$served_url
 
 "$panoptes" export-web "$tmp/db" "$tmp/site" >/dev/null
 
@@ -37,15 +48,8 @@ done
 "$panoptes" synth-db "$tmp/live" --cameras 2 --tasks 1 --frames 16 --size 160x120 --gop 1 >/dev/null
 exec 9>"$tmp/live/.panoptes.lock"
 flock -x 9
-"$panoptes" serve "$tmp/live" --port 0 > "$tmp/live.log" 2>&1 &
-pids+=($!)
-live_url=""
-for _ in $(seq 100); do
-  live_url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$tmp/live.log")
-  [ -n "$live_url" ] && break
-  sleep 0.1
-done
-[ -n "$live_url" ] || { echo "serve (live) did not start:"; cat "$tmp/live.log"; exit 1; }
+start_serve "$tmp/live.log" "$tmp/live" --port 0
+live_url=$served_url
 
 export NODE_PATH=$node_modules
 if ! node "$here/browser_test.mjs" "$url" "$tmp/site" "$chromium" "$node_modules" "$live_url" "$tmp/live"; then
