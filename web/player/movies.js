@@ -79,6 +79,7 @@ export class FrameCache {
   }
   has(key) { return this.map.has(key); }
   put(key, frame) {
+    if (this.onPut) this.onPut(key);
     const old = this.map.get(key);
     if (old) { old.close(); this.map.delete(key); }
     this.map.set(key, frame);
@@ -255,13 +256,7 @@ export class Stream {
     const f = this.index.fragments, n = list[0];
     if (list.every((k) => cache.has(`${this.camera}/${this.task}/${f[k][2]}`))) return;  // decoded meanwhile
     // Configured before the samples are awaited: the codec's set-up overlaps the range request.
-    if (!this.decoder || this.decoder.state === "closed") {
-      this.decoder = new VideoDecoder({
-        output: (vf) => cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf),
-        error: (e) => { this.decodeError = e; },
-      });
-      this.decoder.configure(this.config);
-    }
+    this.warm(cache);
     for (const k of list) {
       if (this.status !== "ok") break;
       if (!this.samples.has(k)) await this.fetchAhead(f[k][2], fetchFrames);
@@ -287,6 +282,24 @@ export class Stream {
       this.message = `${this.url}: fragments ${n}..${list[list.length - 1]}: ${e.message || e}`;
       if (this.decoder && this.decoder.state !== "closed") this.decoder.close();
     }
+  }
+
+  /// Creates and configures the stream's VideoDecoder if it has none, without decoding anything: a
+  /// neighbour decoded only when a switch comes to it (player.js, `nbdecode=switch`) then pays one
+  /// decode, not the decoder's set-up as well.
+  warm(cache) {
+    if (this.status !== "ok" || (this.decoder && this.decoder.state !== "closed")) return;
+    this.decoder = new VideoDecoder({
+      output: (vf) => cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf),
+      error: (e) => { this.decodeError = e; },
+    });
+    this.decoder.configure(this.config);
+  }
+
+  /// Whether the compressed samples of `frame` are in memory (a decode of it need not wait for the network).
+  hasSamples(frame) {
+    const n = this.status === "ok" ? this.fragmentOf(frame) : -1;
+    return n >= 0 && this.samples.has(n);
   }
 
   close() {

@@ -18,7 +18,12 @@ const options = {
   nbBatch: Number(params.get("nbbatch") || 4),  // the same for a neighbour's prefetch
   ahead: Number(params.get("ahead") || 6),  // frames past the playhead kept decoded, current stream
   nbAhead: Number(params.get("nbahead") || 3),  // the same for every neighbour
-  nbStride: Number(params.get("nbstride") || 2),  // a neighbour of keyframes only: every stride-th frame decoded
+  // A playing neighbour of keyframes only: "switch" = samples fetched ahead, decoder configured, the
+  // one frame the playhead needs decoded when a switch comes to it; "ahead" = decoded ahead like any
+  // neighbour, at every nbstride-th frame.
+  nbDecode: params.get("nbdecode") === "ahead" ? "ahead" : "switch",
+  nbStride: Number(params.get("nbstride") || 2),  // nbdecode=ahead: every stride-th frame decoded
+  switchBatch: Number(params.get("switchbatch") || 1),  // the first batch of a switch's new stream: its first frame alone
   fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
   warmTasks: params.get("warmtasks") !== "0",  // fetch ahead the graph neighbours of the task neighbours
 };
@@ -31,6 +36,11 @@ const minimap = document.getElementById("minimap");
 const mapCtx = minimap.getContext("2d");
 
 const cache = new FrameCache(options.cacheFrames);
+// Diagnostics: when the first decoded frame of a pending switch's stream arrived (ms after the key).
+cache.onPut = (key) => {
+  const p = S.pending;
+  if (p && p.diag.decodedMs === undefined && key.startsWith(`${S.camera}/${S.task}/`)) p.diag.decodedMs = performance.now() - p.t0;
+};
 const streams = new Map();  // "c/t" → Stream, LRU
 const MAX_STREAMS = 96;  // the neighbours and their neighbours (opened ahead) stay open
 const drag = new DragRotation();
@@ -130,6 +140,8 @@ function select(camera, task, command) {
     frameReady: cache.has(`${camera}/${task}/${f}`),
     nextReady: cache.has(`${camera}/${task}/${(f + 1) % S.db.frames}`),
     inflight: st ? st.inflight.size : 0,
+    samples: st ? st.hasSamples(f) : false,  // the playhead's compressed frame in memory
+    warm: !!(st && st.decoder && st.decoder.state === "configured"),
     maxTickGap: 0,
   };
   S.pending = { t0: performance.now(), command, from: [S.camera, S.task], diag };
@@ -211,14 +223,35 @@ function pump() {
   // Decoding every neighbour at every frame was more than a loaded machine could do.
   const nbStride = S.playing ? options.nbStride : 1;
   for (const [c, t] of nb) hot.push([c, t, S.playing ? options.nbAhead : 1, options.nbBatch, nbStride]);
+  // Decode on switch: while playing, a neighbour of keyframes only is not decoded at all. Its samples
+  // are kept in memory and its decoder configured; a switch to it decodes the frame at the playhead
+  // (one intra decode), shown at the next display frame, and the frames after it as the current
+  // stream. The neighbours' continuous decoding (~210 frames/s of 528x512 on the demo) was what a
+  // 2-core machine could not keep up with; between switches the CPU now idles.
+  const onSwitch = options.nbDecode === "switch" && S.playing;
   for (const [c, t, ahead, batch, stride] of hot) {
     if (inflight >= options.connections && c !== S.camera) return;  // the current stream may exceed it
-    if (busy.has(`${c}/${t}`)) continue;
-    const st = streams.get(`${c}/${t}`);
+    const key = `${c}/${t}`;
+    if (busy.has(key)) continue;
+    const st = streams.get(key);
     if (st && (st.status === "missing" || st.status === "unreadable")) continue;
+    if (onSwitch && !(c === S.camera && t === S.task)) {
+      if (!st || st.status === "new") {  // opened first: whether it is keyframes only is in its index
+        busy.add(key);
+        inflight++;
+        stream(c, t).open().finally(() => { busy.delete(key); inflight--; });
+        continue;
+      }
+      if (st.intraOnly()) {
+        st.warm(cache);
+        fetchAhead(st, f);
+        continue;
+      }
+    }
     const g = firstMissing(c, t, f, ahead, stride > 1 && st && st.status === "ok" && st.intraOnly() ? stride : 1);
     // The very first frame is decoded alone: a batch of 8 before the first picture is 8 decodes of waiting.
-    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, S.firstFrameMs === null ? 1 : batch, stride);
+    const first = S.firstFrameMs === null ? 1 : c === S.camera && t === S.task && g === f ? options.switchBatch : batch;
+    if (g >= 0 && !(st && st.status === "ok" && st.fragmentOf(g) < 0)) startBatch(c, t, g, first, stride);
     else if (g < 0 && st && st.status === "ok" && S.playing) fetchAhead(st, f);
   }
   if (!nb.length) return;
@@ -579,6 +612,11 @@ window.panoptes = {
   neighbour: (c, direction) => graphNeighbour(c, direction),
   camerasLoaded: () => S.cams !== null,
   options,
+  /// A stream's state: status, decoder state, fragments whose compressed samples are in memory.
+  streamInfo: (camera, task) => {
+    const st = streams.get(`${camera}/${task}`);
+    return st ? { status: st.status, decoder: st.decoder ? st.decoder.state : "none", samples: st.samples.size } : null;
+  },
   /// The stamp in the canvas pixels (zoom 1 only), or null.
   readStamp: () => {
     const w = canvas.width, h = canvas.height, b = stampBlock(w, h);

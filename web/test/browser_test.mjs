@@ -255,13 +255,19 @@ await check("live database: new frames of a running simulation play without a re
   const { page, errors } = await open(liveUrl + "?play=1");
   assert.equal(await page.evaluate(() => window.panoptes.state().frames), 8);
   await expectShown(page, 0, 0, null, "live, 8 frames");
-  // Keyframes only: the playing neighbour (camera 1) is decoded at even frames only, and a switch to
-  // it shows its stamp (a frame at most one behind the playhead), then it is decoded at every frame.
+  // Keyframes only, default (nbdecode=switch): the playing neighbour (camera 1) gets its samples
+  // fetched and its decoder configured, but no frame decoded until a switch comes to it.
+  await page.waitForFunction(() => { const i = window.panoptes.streamInfo(1, 0); return i && i.samples >= 2 && i.decoder === "configured"; }, { timeout: 5000 });
+  await new Promise((r) => setTimeout(r, 300));  // ~9 frames of playback: a decode ahead would show
+  assert.deepEqual(await page.evaluate(() => window.panoptes.cachedFrames(1, 0)), [], "neighbour decoded ahead with nbdecode=switch");
+  // nbdecode=ahead: the neighbour is decoded at even frames only (nbstride 2).
+  await page.evaluate(() => { window.panoptes.options.nbDecode = "ahead"; });
   await page.waitForFunction(() => window.panoptes.cachedFrames(1, 0).length >= 2, { timeout: 5000 });
   const nbFrames = await page.evaluate(() => window.panoptes.cachedFrames(1, 0));
   assert.ok(nbFrames.every((f) => f % 2 === 0), `neighbour decoded at frames ${nbFrames}, expected even ones only`);
-  await page.evaluate(() => window.panoptes.select(1, 0));
-  await expectShown(page, 1, 0, null, "switch to a stride-decoded neighbour while playing");
+  // A switch to it shows its stamp, then it is decoded at every frame.
+  await page.evaluate(() => { window.panoptes.options.nbDecode = "switch"; window.panoptes.select(1, 0); });
+  await expectShown(page, 1, 0, null, "switch to a neighbour while playing");
   await page.waitForFunction(() => window.panoptes.cachedFrames(1, 0).some((f) => f % 2 === 1), { timeout: 5000 });
   await page.evaluate(() => window.panoptes.select(0, 0));
   checkpoint(16);
