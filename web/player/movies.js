@@ -263,7 +263,7 @@ export class Stream {
     }
     if (this.status !== "ok") return;
     try {
-      const t0 = performance.now();
+      const t0 = (this.decodeCalled = performance.now());
       let count = 0;
       for (const k of list) {
         const samples = this.samples.get(k);

@@ -39,7 +39,11 @@ const cache = new FrameCache(options.cacheFrames);
 // Diagnostics: when the first decoded frame of a pending switch's stream arrived (ms after the key).
 cache.onPut = (key) => {
   const p = S.pending;
-  if (p && p.diag.decodedMs === undefined && key.startsWith(`${S.camera}/${S.task}/`)) p.diag.decodedMs = performance.now() - p.t0;
+  if (p && p.diag.decodedMs === undefined && key.startsWith(`${S.camera}/${S.task}/`)) {
+    p.diag.decodedMs = performance.now() - p.t0;
+    const st = streams.get(`${S.camera}/${S.task}`);
+    if (st && st.decodeCalled >= p.t0) p.diag.decodeCalledMs = st.decodeCalled - p.t0;  // when its decode() was called
+  }
 };
 const streams = new Map();  // "c/t" → Stream, LRU
 const MAX_STREAMS = 96;  // the neighbours and their neighbours (opened ahead) stay open
@@ -557,6 +561,7 @@ async function main() {
   S.db = db;
   // Playback rate: ?fps=N, else the database's preferred rate (the desktop player's rule), else the movies'.
   S.fps = Number(params.get("fps")) || (db.playback_fps > 0 ? db.playback_fps : db.fps);
+  pump();  // the first stream's open starts now, not at the first display frame (up to 16 ms later)
   requestAnimationFrame(tick);
   // The first frame does not need the cameras: it is fetched meanwhile. Navigation by the graph, the
   // mini-map and drag start when the table is in (at 10^6 cameras it is tens of MB).
