@@ -278,6 +278,7 @@ export class Stream {
       traffic.batches++; traffic.frames += count; traffic.decodeMs += performance.now() - t0;
       if (this.decodeError) throw this.decodeError;
     } catch (e) {
+      if (e.name === "AbortError") return;  // abortDecodes(): not decoded, the pump asks again if needed
       this.status = "unreadable";
       this.message = `${this.url}: fragments ${n}..${list[list.length - 1]}: ${e.message || e}`;
       if (this.decoder && this.decoder.state !== "closed") this.decoder.close();
@@ -293,6 +294,15 @@ export class Stream {
       output: (vf) => cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf),
       error: (e) => { this.decodeError = e; },
     });
+    this.decoder.configure(this.config);
+  }
+
+  /// Drops the decodes queued on the stream's decoder and configures it again: a switch away from a
+  /// keyframe-only stream makes its frames ahead useless (a neighbour is decoded on switch only), and
+  /// on two cores they would take the CPU from the new stream's first decode.
+  abortDecodes() {
+    if (!this.decoder || this.decoder.state !== "configured" || this.inflight.size === 0) return;
+    this.decoder.reset();
     this.decoder.configure(this.config);
   }
 

@@ -23,6 +23,7 @@ const options = {
   // neighbour, at every nbstride-th frame.
   nbDecode: params.get("nbdecode") === "ahead" ? "ahead" : "switch",
   nbStride: Number(params.get("nbstride") || 2),  // nbdecode=ahead: every stride-th frame decoded
+  abortOnSwitch: params.get("abort") !== "0",  // a switch drops the old stream's decodes (nbdecode=switch)
   switchBatch: Number(params.get("switchbatch") || 1),  // the first batch of a switch's new stream: its first frame alone
   fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
   warmTasks: params.get("warmtasks") !== "0",  // fetch ahead the graph neighbours of the task neighbours
@@ -149,6 +150,8 @@ function select(camera, task, command) {
     maxTickGap: 0,
   };
   S.pending = { t0: performance.now(), command, from: [S.camera, S.task], diag };
+  const old = streams.get(`${S.camera}/${S.task}`);
+  if (options.nbDecode === "switch" && options.abortOnSwitch && S.playing && old && old.status === "ok" && old.intraOnly()) old.abortDecodes();
   S.camera = camera;
   S.task = task;
   releaseDecoders();
