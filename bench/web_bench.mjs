@@ -16,11 +16,11 @@ const keys = ["ArrowRight", "ArrowRight", "Tab", "ArrowUp", "ArrowLeft", "Tab", 
 const median = (a) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.floor((s.length - 1) / 2)] : NaN; };
 const pct = (a, p) => { const s = [...a].sort((x, y) => x - y); return s[Math.min(s.length - 1, Math.ceil((p / 100) * s.length) - 1)]; };
 
-async function run(browser, prefetch) {
+async function run(browser, prefetch, extra = "") {
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 900 });
   const t0 = Date.now();
-  await page.goto(url + `?play=1&fps=30&prefetch=${prefetch ? 1 : 0}${process.env.WEB_BENCH_QUERY || ""}`);
+  await page.goto(url + `?play=1&fps=30&prefetch=${prefetch ? 1 : 0}${process.env.WEB_BENCH_QUERY || ""}${extra}`);
   await page.waitForFunction(() => window.panoptes && window.panoptes.firstFrameMs() !== null, { timeout: 30000 });
   const firstFrame = await page.evaluate(() => window.panoptes.firstFrameMs());  // since navigation start
   const marks = await page.evaluate(() => (window.panoptes.marks ? window.panoptes.marks() : {}));
@@ -42,7 +42,7 @@ async function run(browser, prefetch) {
     for (const s of switches) if (!s.hit) console.error(`miss ${s.command} ${s.from}->${s.to} ms=${s.ms === null ? "superseded" : s.ms.toFixed(1)} lag=${s.lag} ${JSON.stringify(s.diag)}`);
   // WEB_BENCH_DUMP=FILE appends every switch of the run as a JSON line (pooling runs of separate invocations).
   if (process.env.WEB_BENCH_DUMP)
-    fs.appendFileSync(process.env.WEB_BENCH_DUMP, JSON.stringify({ query: process.env.WEB_BENCH_QUERY || "", prefetch, load: os.loadavg()[0], switches }) + "\n");
+    fs.appendFileSync(process.env.WEB_BENCH_DUMP, JSON.stringify({ query: (process.env.WEB_BENCH_QUERY || "") + extra, prefetch, load: os.loadavg()[0], switches }) + "\n");
   // A switch overtaken by the next key before it was shown took longer than the 330 ms between keys:
   // it counts as +Infinity in the percentiles (printed as "> 330").
   const shown = switches.filter((s) => s.ms !== null), ms = switches.map((s) => (s.ms === null ? Infinity : s.ms));
@@ -61,9 +61,19 @@ async function run(browser, prefetch) {
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox", "--disable-dev-shm-usage"] });
 const db = await (await fetch(url + "api/database.json")).json();
 const rows = [], rowsData = [];
-for (const prefetch of (process.env.WEB_BENCH_ONLY_ON ? [true] : [true, false])) {
-  const runs = [];
-  for (let r = 0; r < reps; r++) runs.push(await run(browser, prefetch));
+// Rows: prefetch on with the player's defaults; prefetch on with the other neighbour rule
+// (WEB_BENCH_COMPARE, default "&nbdecode=ahead", empty to skip), so that one run on an idle machine
+// compares them; prefetch off. Runs alternate between the rows (run r of every row, then r + 1) so
+// that a change of the machine's load falls on all rows alike.
+const compare = process.env.WEB_BENCH_COMPARE ?? "&nbdecode=ahead";
+const configs = [{ label: "on", prefetch: true, extra: "" }];
+if (compare) configs.push({ label: `on, \`${compare.replace(/^&/, "")}\``, prefetch: true, extra: compare });
+if (!process.env.WEB_BENCH_ONLY_ON) configs.push({ label: "off", prefetch: false, extra: "" });
+const runsOf = configs.map(() => []);
+for (let r = 0; r < reps; r++)
+  for (const [i, c] of configs.entries()) runsOf[i].push(await run(browser, c.prefetch, c.extra));
+for (const [i, { label, prefetch }] of configs.entries()) {
+  const runs = runsOf[i];
   const m = (k) => median(runs.map((x) => x[k]));
   // p99 of one run of 40 switches is its worst switch; pooled over the runs it is the 99th percentile
   // of all their switches (120 for 3 runs: the second worst).
@@ -72,10 +82,10 @@ for (const prefetch of (process.env.WEB_BENCH_ONLY_ON ? [true] : [true, false]))
   const steps = Object.keys(runs[0].marks).sort((a, b) => runs[0].marks[a] - runs[0].marks[b]);
   const startup = steps.map((k) => `${k} ${median(runs.map((x) => x.marks[k] ?? NaN)).toFixed(0)}`).join(", ");
   const decoded = median(runs.flatMap((x) => x.decoded));
-  rowsData.push({ pooled, decoded, settings: runs[0].settings, hits: m("hits"), atPlayhead: m("atPlayhead"), p50: m("p50"), p99: m("p99"), firstFrame: m("firstFrame"), bytesPerSwitch: m("bytesPerSwitch"), startup });
+  rowsData.push({ label, prefetch, pooled, decoded, settings: runs[0].settings, hits: m("hits"), atPlayhead: m("atPlayhead"), p50: m("p50"), p99: m("p99"), firstFrame: m("firstFrame"), bytesPerSwitch: m("bytesPerSwitch"), startup });
   const f = (v, d = 1) => (Number.isFinite(v) ? v.toFixed(d) : "> 330");
   const range = (k) => `${f(Math.min(...runs.map((x) => x[k])))}–${f(Math.max(...runs.map((x) => x[k])))}`;
-  rows.push(`| ${prefetch ? "on" : "off"} | ${runs[0].n} | ${m("superseded")} | ${f(m("p50"))} | ${f(m("p99"))} (${range("p99")}) | ${f(pooled)} | ${f(m("max"))} | ` +
+  rows.push(`| ${label} | ${runs[0].n} | ${m("superseded")} | ${f(m("p50"))} | ${f(m("p99"))} (${range("p99")}) | ${f(pooled)} | ${f(m("max"))} | ` +
             `${(100 * m("hits")).toFixed(0)} % | ${m("firstFrame").toFixed(0)} | ${(m("bytesPerSwitch") / 1024).toFixed(1)} | ${m("requestsPerSwitch").toFixed(1)} |`);
 }
 
@@ -116,9 +126,10 @@ if (on) {
   const verdict = (ok) => (ok ? "met" : "NOT met");
   console.log("");
   const ms = (v) => (Number.isFinite(v) ? v.toFixed(1) + " ms" : "> 330 ms");
-  const off = rowsData[1];
+  const off = rowsData.find((x) => !x.prefetch), other = compare ? rowsData[1] : null;
   console.log(`Targets: switch p99 with prefetch < 33 ms: ${ms(on.pooled)} pooled over all runs' switches (${verdict(on.pooled < 33)}; ` +
               `${ms(on.p99)} median of the runs' p99); p50 ${ms(on.p50)}` +
+              (other ? `; with \`${compare.replace(/^&/, "")}\`: p50 ${ms(other.p50)}, p99 ${ms(other.pooled)} pooled (${verdict(other.pooled < 33)})` : "") +
               (off ? `; prefetch off: p50 ${ms(off.p50)}, p99 ${ms(off.pooled)} pooled` : "") +
               `; time to first frame ${on.firstFrame.toFixed(0)} ms; ${(on.bytesPerSwitch / 1024).toFixed(1)} kB fetched per switch ` +
               `(player settings: ${on.settings}). ` +
