@@ -43,6 +43,7 @@ struct Args {
   std::string out;
   bool overwrite = false;
   double sample_distance = 0.5;
+  bool adaptive = true;  // pays where images have more pixels than voxels across (docs/rendering.md, Round 4)
   double percentile = 0.999;
   std::string spacing, origin, background = "0,0,0";
   bool no_outline = false;
@@ -80,6 +81,7 @@ std::string recorded_command_line(const Args& a) {
   for (const auto& t : a.tasks) cl += " --task " + shell_word(t);
   cl += " --size " + shell_word(a.size);
   cl += " --sample-distance " + number_text(a.sample_distance);
+  cl += a.adaptive ? " --adaptive" : " --no-adaptive";
   cl += " --percentile " + number_text(a.percentile);
   if (!a.spacing.empty()) cl += " --spacing " + shell_word(a.spacing);
   if (!a.origin.empty()) cl += " --origin " + shell_word(a.origin);
@@ -342,6 +344,7 @@ void run(const Args& a, const std::string& command_line) {
   const auto t0 = std::chrono::steady_clock::now();
   render::RenderOptions opt;
   opt.sample_distance = a.sample_distance;
+  opt.adaptive = a.adaptive;
   render::OutlineStyle outline;
   outline.enabled = !a.no_outline && projection == camera::Projection::perspective;  // box edges curve in 360° frames
   const render::Rgb background{float(bg[0]), float(bg[1]), float(bg[2])};
@@ -433,6 +436,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in --out");
   sub->add_option("--sample-distance", args->sample_distance, "Ray sample distance in voxels")
       ->check(CLI::Range(0.01, 16.0))->capture_default_str();
+  sub->add_flag("--adaptive,!--no-adaptive", args->adaptive,
+                "Adaptive image-space sampling: march every 4th pixel and interpolate where the image is smooth "
+                "(default: on; --no-adaptive marches every pixel)");
   sub->add_option("--percentile", args->percentile, "Reference for relative windows: this quantile of |v|")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   sub->add_option("--spacing", args->spacing, "Grid spacing sx,sy,sz (default: from the file, or 1,1,1)");

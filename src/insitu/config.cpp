@@ -286,7 +286,8 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     }
   }
   if (const auto* r = table(c, root, "render")) {
-    only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha"});
+    only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
+                                      "adaptive_tolerance"});
     const std::string ref = str(c, *r, "reference", "render.", "snapshot");
     if (ref != "snapshot" && ref != "running-max")
       c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\" or \"running-max\"");
@@ -300,6 +301,11 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.render.termination_alpha = float(num(c, *r, "termination_alpha", "render.", s.render.termination_alpha));
     if (!(s.render.termination_alpha > 0.5f && s.render.termination_alpha <= 1.0f))
       c.fail("render.termination_alpha", "expected a value in (0.5, 1]");
+    s.render.adaptive = boolean(c, *r, "adaptive", "render.", false);
+    // In the final image's units (1/255) in the file: what users see.
+    const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
+    if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");
+    s.render.adaptive_tolerance = float(tol / 255);
   }
   if (const auto* r = table(c, root, "resources")) {
     only_keys(c, *r, "resources", {"check_memory"});
@@ -378,7 +384,9 @@ const char* config_keys_help() {
 [render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid:
             the reference "ref" of relative windows); reference = "snapshot" (this snapshot's quantile)
             | "running-max" (running maximum over snapshots: colours comparable across frames, but
-            decaying waves fade); skip_empty = true; termination_alpha = 0.998
+            decaying waves fade); skip_empty = true; termination_alpha = 0.998;
+            adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
+            corners agree within adaptive_tolerance = 2 (units of 1/255), refine elsewhere)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
             available: MemAvailable or the cgroup limit; false = panoptes run --force)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |

@@ -78,6 +78,7 @@ every_steps = 1
 crf = 18
 [render]
 sample_distance = 0.5
+adaptive = true  # as panoptes render's default
 [[task]]
 name = "hot"
 type = "volume"

@@ -1,5 +1,7 @@
 #include "render/renderer.hpp"
 
+#include "render/adaptive_sampling.hpp"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -873,6 +875,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       stats.rays = std::max(stats.rays, s.rays);
       stats.samples += s.samples;
       stats.marched_samples += s.marched_samples;
+      stats.interpolated_pixels = std::max(stats.interpolated_pixels, s.interpolated_pixels);
     }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return stats;
@@ -1060,72 +1063,123 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   if (tasks.empty()) return stats;
 
   const int tile = opt.tile;
-  const int ntx = (rect.width() + tile - 1) / tile, nty = (rect.height() + tile - 1) / tile;
+  // Tiles lie on multiples of the tile edge in image coordinates (clipped to the rect), so the
+  // bricks of a decomposition cut their footprints into the same tiles where they overlap: with
+  // adaptive sampling their lattices, and so most refinement decisions, then coincide.
+  const int tx_first = rect.x0 / tile, ty_first = rect.y0 / tile;
+  const int ntx = rect.empty() ? 0 : (rect.x1 - 1) / tile - tx_first + 1;
+  const int nty = rect.empty() ? 0 : (rect.y1 - 1) / tile - ty_first + 1;
   const int K = int(tasks.size());
   const double glo[3] = {0, 0, 0};
   const double ghi[3] = {double(S.grid.dims[0] - 1), double(S.grid.dims[1] - 1), double(S.grid.dims[2] - 1)};
   const double blo[3] = {double(S.brick.lo[0]), double(S.brick.lo[1]), double(S.brick.lo[2])};
   const double bhi[3] = {double(S.brick.hi[0]), double(S.brick.hi[1]), double(S.brick.hi[2])};
-  std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0;
+  if (opt.adaptive && opt.adaptive_stride < 2)
+    throw Error("render: adaptive stride " + std::to_string(opt.adaptive_stride) + "; expected >= 2");
+  if (opt.adaptive && !(opt.adaptive_tolerance >= 0))
+    throw Error("render: adaptive tolerance " + std::to_string(opt.adaptive_tolerance) + "; expected >= 0");
+  std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0, n_interpolated = 0;
 
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : n_rays, n_eff, n_marched)
-  for (int ti = 0; ti < ntx * nty; ++ti) {
+  // Where the ray of pixel (x, y) meets the domain and the brick; false when it misses the brick.
+  struct PixelRay {
+    double O[3], D[3];  // origin and direction in index coordinates
+    Vec3 dir;
+    double t0, tg1, tb0, tb1;
+    float depth;
+  };
+  auto locate = [&](int x, int y, PixelRay& r) {
+    const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
+    for (int a = 0; a < 3; ++a) {
+      r.O[a] = (ray.origin[a] - S.grid.origin[a]) / S.spacing[a];
+      r.D[a] = ray.direction[a] / S.spacing[a];
+    }
+    r.dir = ray.direction;
+    double tg0;
+    if (!slab(r.O, r.D, glo, ghi, tg0, r.tg1)) return false;
+    r.t0 = std::max(tg0, 0.0);
+    if (r.tg1 <= r.t0) return false;
+    if (!slab(r.O, r.D, blo, bhi, r.tb0, r.tb1)) return false;
+    r.tb0 = std::max(r.tb0, r.t0);
+    r.tb1 = std::min(r.tb1, r.tg1);
+    if (r.tb1 < r.tb0) return false;
+    // A camera inside the domain may sit exactly on a face this brick shares with its upper neighbour
+    // (e.g. a lattice node on an MPI cut): a ray leaving through that face has its t = 0 sample owned
+    // by the neighbour (half-open extents), so this brick's part lies just behind it in depth.
+    r.depth = float(r.tb0);
+    if (r.tb0 == 0)
+      for (int a = 0; a < 3; ++a)
+        if (r.O[a] == bhi[a] && bhi[a] != ghi[a] && r.D[a] < 0) r.depth = std::nextafter(0.0f, 1.0f);
+    return true;
+  };
+  // Marches a located ray for every task and writes pixel (x, y) of every image.
+  auto shade = [&](int x, int y, const PixelRay& r, float (*acc)[4], std::uint64_t& eff, std::uint64_t& marched) {
+    for (int i = 0; i < K; ++i) acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
+    if (S.march_mask) march_ray(S, r.O, r.D, r.dir, r.t0, r.tg1, r.tb0, r.tb1, acc, eff, marched);
+    for (int i : S.slices) {
+      const TaskRt& rt = S.rt[std::size_t(i)];
+      const int a = rt.axis;
+      if (r.D[a] == 0) continue;
+      const double t = (rt.plane - r.O[a]) / r.D[a];
+      if (!(t >= r.t0)) continue;
+      double p[3] = {r.O[0] + t * r.D[0], r.O[1] + t * r.D[1], r.O[2] + t * r.D[2]};
+      p[a] = rt.plane;
+      bool in = true;  // the march's ownership rule: half-open, closed at the domain's upper faces
+      for (int b = 0; b < 3; ++b)
+        in = in && p[b] >= blo[b] && (p[b] < bhi[b] || (p[b] == bhi[b] && bhi[b] == ghi[b]));
+      if (!in) continue;
+      const float v = interp_clamped(S.acc[std::size_t(rt.s1)], p[0], p[1], p[2]);
+      const LutEntry& e = rt.lut1[lut_bin(v, rt.lo1, rt.sc1, rt.last1, rt.abs1)];
+      acc[i][0] = e.r * rt.opacity, acc[i][1] = e.g * rt.opacity, acc[i][2] = e.b * rt.opacity, acc[i][3] = rt.opacity;
+    }
+    for (int i = 0; i < K; ++i) {
+      PartialImage& o = out[std::size_t(i)];
+      float* dst = o.rgba_at(x, y);
+      dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
+      o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = r.depth;
+    }
+  };
+
+#pragma omp parallel reduction(+ : n_rays, n_eff, n_marched, n_interpolated)
+  {
     alignas(64) float acc[kMaxTasksPerMarch][4];
-    const int tx0 = rect.x0 + (ti % ntx) * tile, ty0 = rect.y0 + (ti / ntx) * tile;
-    const int tx1 = std::min(tx0 + tile, rect.x1), ty1 = std::min(ty0 + tile, rect.y1);
-    for (int y = ty0; y < ty1; ++y)
-      for (int x = tx0; x < tx1; ++x) {
-        const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
-        double O[3], D[3];
-        for (int a = 0; a < 3; ++a) {
-          O[a] = (ray.origin[a] - S.grid.origin[a]) / S.spacing[a];
-          D[a] = ray.direction[a] / S.spacing[a];
+    AdaptiveTile refiner(opt.adaptive_stride, opt.adaptive_tolerance);
+#pragma omp for schedule(dynamic, 1)
+    for (int ti = 0; ti < ntx * nty; ++ti) {
+      const int tx0 = std::max(rect.x0, (tx_first + ti % ntx) * tile), ty0 = std::max(rect.y0, (ty_first + ti / ntx) * tile);
+      const int tx1 = std::min((tx_first + ti % ntx + 1) * tile, rect.x1), ty1 = std::min((ty_first + ti / ntx + 1) * tile, rect.y1);
+      PixelRay r;
+      if (!opt.adaptive) {
+        for (int y = ty0; y < ty1; ++y)
+          for (int x = tx0; x < tx1; ++x) {
+            if (!locate(x, y, r)) continue;
+            ++n_rays;
+            shade(x, y, r, acc, n_eff, n_marched);
+          }
+        continue;
+      }
+      auto march = [&](int x, int y) {
+        if (locate(x, y, r)) {
+          ++n_rays;
+          shade(x, y, r, acc, n_eff, n_marched);
+          return;
         }
-        double tg0, tg1, tb0, tb1;
-        if (!slab(O, D, glo, ghi, tg0, tg1)) continue;
-        const double t0 = std::max(tg0, 0.0);
-        if (tg1 <= t0) continue;
-        if (!slab(O, D, blo, bhi, tb0, tb1)) continue;
-        tb0 = std::max(tb0, t0);
-        tb1 = std::min(tb1, tg1);
-        if (tb1 < tb0) continue;
-        // A camera inside the domain may sit exactly on a face this brick shares with its upper neighbour
-        // (e.g. a lattice node on an MPI cut): a ray leaving through that face has its t = 0 sample owned
-        // by the neighbour (half-open extents), so this brick's part lies just behind it in depth.
-        float depth = float(tb0);
-        if (tb0 == 0)
-          for (int a = 0; a < 3; ++a)
-            if (O[a] == bhi[a] && bhi[a] != ghi[a] && D[a] < 0) depth = std::nextafter(0.0f, 1.0f);
-        ++n_rays;
-        for (int i = 0; i < K; ++i) acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
-        if (S.march_mask) march_ray(S, O, D, ray.direction, t0, tg1, tb0, tb1, acc, n_eff, n_marched);
-        for (int i : S.slices) {
-          const TaskRt& r = S.rt[std::size_t(i)];
-          const int a = r.axis;
-          if (D[a] == 0) continue;
-          const double t = (r.plane - O[a]) / D[a];
-          if (!(t >= t0)) continue;
-          double p[3] = {O[0] + t * D[0], O[1] + t * D[1], O[2] + t * D[2]};
-          p[a] = r.plane;
-          bool in = true;  // the march's ownership rule: half-open, closed at the domain's upper faces
-          for (int b = 0; b < 3; ++b)
-            in = in && p[b] >= blo[b] && (p[b] < bhi[b] || (p[b] == bhi[b] && bhi[b] == ghi[b]));
-          if (!in) continue;
-          const float v = interp_clamped(S.acc[std::size_t(r.s1)], p[0], p[1], p[2]);
-          const LutEntry& e = r.lut1[lut_bin(v, r.lo1, r.sc1, r.last1, r.abs1)];
-          acc[i][0] = e.r * r.opacity, acc[i][1] = e.g * r.opacity, acc[i][2] = e.b * r.opacity, acc[i][3] = r.opacity;
-        }
-        for (int i = 0; i < K; ++i) {
+        for (int i = 0; i < K; ++i) {  // a pixel interpolated earlier may be re-marched
           PartialImage& o = out[std::size_t(i)];
           float* dst = o.rgba_at(x, y);
-          dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
-          o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = depth;
+          dst[0] = dst[1] = dst[2] = dst[3] = 0;
+          o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = PartialImage::kNoDepth;
         }
-      }
+      };
+      auto depth_of = [&](int x, int y) { return locate(x, y, r) ? r.depth : PartialImage::kNoDepth; };
+      const std::uint64_t before = refiner.interpolated();
+      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of);
+      n_interpolated += refiner.interpolated() - before;
+    }
   }
   stats.rays = n_rays;
   stats.samples = n_eff;
   stats.marched_samples = n_marched;
+  stats.interpolated_pixels = n_interpolated;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }

@@ -58,6 +58,14 @@ struct RenderOptions {
   bool skip_empty = true;            ///< empty-space skipping with macro-cells
   float termination_alpha = 0.998f;  ///< early ray termination (the rest adds < 1/255)
   int tile = 16;                     ///< tile edge in pixels (OpenMP dynamic schedule over tiles)
+  /// Image-space adaptive sampling (render/adaptive_sampling.hpp): march a lattice of every
+  /// `adaptive_stride`-th pixel, interpolate the pixels of cells whose corners agree within
+  /// `adaptive_tolerance` (premultiplied RGBA, per task and channel), refine the others down to
+  /// single pixels. Off by default: the library's images stay one march per pixel; the product's
+  /// configurations switch it on (docs/rendering.md, Round 4, for its measured cost and quality).
+  bool adaptive = false;
+  int adaptive_stride = 4;               ///< coarse lattice spacing in pixels (>= 2), refined by halves
+  float adaptive_tolerance = 2.0f / 255;  ///< largest corner range interpolated
 };
 
 /// Counters of one render_brick() call.
@@ -66,6 +74,7 @@ struct RenderStats {
   std::uint64_t samples = 0;           ///< effective samples: inside the brick along those rays, marched or skipped
   std::uint64_t marched_samples = 0;   ///< samples actually interpolated and classified
   double seconds = 0;
+  std::uint64_t interpolated_pixels = 0;  ///< adaptive sampling: pixels filled from their cell's corners, not marched
 };
 
 /// Maximum tasks served by one march; longer task lists are processed in groups of this size.
