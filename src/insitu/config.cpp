@@ -386,7 +386,7 @@ const char* config_keys_help() {
             | "running-max" (running maximum over snapshots: colours comparable across frames, but
             decaying waves fade); skip_empty = true; termination_alpha = 0.998;
             adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
-            corners agree within adaptive_tolerance = 2 (units of 1/255), refine elsewhere)
+            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
             available: MemAvailable or the cgroup limit; false = panoptes run --force)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |

@@ -65,7 +65,7 @@ struct RenderOptions {
   /// configurations switch it on (docs/rendering.md, Round 4, for its measured cost and quality).
   bool adaptive = false;
   int adaptive_stride = 4;               ///< coarse lattice spacing in pixels (>= 2), refined by halves
-  float adaptive_tolerance = 2.0f / 255;  ///< largest corner range interpolated
+  float adaptive_tolerance = 4.0f / 255;  ///< largest corner range interpolated (4/255: Round 4 of docs/rendering.md)
 };
 
 /// Counters of one render_brick() call.
