@@ -92,6 +92,8 @@ sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) a
 percentile = 0.999     # 34 dB (the view down onto the surface, whose thin dark gaps between saturated p rings thin
                        # out slightly; they look alike). 1.5 voxel: min 26 dB, 2.0: min 22 dB, and the gaps fill in
                        # visibly (docs/insitu.md). 0.5 voxel would cost more march for no visible gain.
+adaptive = true        # 3-4 px per voxel: interpolate smooth cells of every 4th pixel's rays; frames within
+                       # 65.6 dB (min) of marching every pixel, the thin gaps kept (docs/rendering.md, Round 4)
 
 [[task]]
 name = "p-wave"
