@@ -12,6 +12,8 @@
 //                        by side. Targets: paper3 <= 1.5x, tf10 <= 3x, iso8 <= 2x.
 //   BM_ParaViewAnchor    128x256x80 float32 dense volume, 8 cameras at 1.1x the diagonal, 920x896, one
 //                        volume task: CPU-seconds per image next to ParaView 5.11 "Ray Cast Only"'s 1.46.
+//   BM_DemoAdaptive      examples/demo.toml's snapshot at step 240 through the in-situ session with adaptive
+//                        sampling off and on, alternately: CPU-s of render + composite + encode.
 //   BM_Quality           PSNR of render_brick at 1.0 voxel, without and with adaptive sampling (examples/paper.toml)
 //                        against the plain reference path at the old default sample distance of 0.5 voxel,
 //                        on the big dense scene.
@@ -320,5 +322,48 @@ BENCHMARK(BM_Quality)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime
 
 }  // namespace
 
+
+
+// The demo (examples/demo.toml: 64x128x40, 528x512, 130 cameras x 3 tasks) at its step 240, one
+// snapshot rendered by the in-situ session with adaptive sampling off and on, alternately: CPU
+// seconds of session.snapshot() (render, composite, encode; the simulation is run once, outside).
+void BM_DemoAdaptive(benchmark::State& state) {
+  const std::string path = std::string(PANOPTES_SOURCE_DIR) + "/examples/demo.toml";
+  std::string seis_text;
+  insitu::SessionConfig cfg = insitu::parse_combined_config(read_file(path), path, kSeismicSections, seis_text);
+  const seismic::RunConfig rc = seismic::parse_run_config(seis_text, path, std::string(PANOPTES_SOURCE_DIR) + "/examples");
+  static std::vector<float> p, s;
+  if (p.empty()) {
+    seismic::Solver solver(rc.solver);
+    solver.run(240);
+    solver.compute_derived();
+    p = solver.gather_field("phi_p");
+    s = solver.gather_field("phi_s");
+  }
+  const auto& g = rc.solver.grid;
+  const GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
+  cfg.output_dir = (std::filesystem::temp_directory_path() / ("demo_adaptive_bench_" + std::to_string(::getpid()))).string();
+  cfg.overwrite = true;
+  double cpu[2] = {0, 0}, render[2] = {0, 0};
+  for (auto _ : state)
+    for (int on = 0; on < 2; ++on) {
+      cfg.render.adaptive = on != 0;
+      insitu::Session session(cfg, grid, insitu::LocalBlock::whole(grid));
+      const double c0 = cpu_seconds();
+      session.snapshot(0.0, {insitu::FieldInput{"phi_p", p.data(), insitu::ScalarType::f32, {0, 0, 0}},
+                             insitu::FieldInput{"phi_s", s.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+      cpu[on] += cpu_seconds() - c0;
+      render[on] += session.stats().time.render;
+      session.finalize();
+    }
+  std::filesystem::remove_all(cfg.output_dir);
+  const double n = double(state.iterations());
+  state.counters["cpu_s_off"] = cpu[0] / n;
+  state.counters["cpu_s_on"] = cpu[1] / n;
+  state.counters["on_over_off"] = cpu[1] / cpu[0];
+  state.counters["render_s_off"] = render[0] / n;
+  state.counters["render_s_on"] = render[1] / n;
+}
+BENCHMARK(BM_DemoAdaptive)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 BENCHMARK_MAIN();
