@@ -70,7 +70,7 @@ struct RenderOptions {
 
 /// Counters of one render_brick() call.
 struct RenderStats {
-  std::uint64_t rays = 0;              ///< rays that have samples in the brick
+  std::uint64_t rays = 0;              ///< rays marched that meet the brick (adaptive: not the interpolated pixels)
   std::uint64_t samples = 0;           ///< effective samples: inside the brick along those rays, marched or skipped
   std::uint64_t marched_samples = 0;   ///< samples actually interpolated and classified
   double seconds = 0;
