@@ -243,6 +243,7 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
                 el, solver.ranks(), sim, st.time.render + st.time.copy, st.time.composite, st.time.encode,
                 st.time.checkpoint, el > 0 ? frames / el : 0.0, human_bytes(double(st.peak_rss_bytes)).c_str());
     std::fputs(insitu::overhead_report(overhead).c_str(), stdout);
+    if (!options.overhead_note.empty()) std::printf("%s\n", options.overhead_note.c_str());
     std::printf("open it with: panoptes play %s\n", cfg.output_dir.c_str());
   }
 }

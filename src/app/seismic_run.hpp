@@ -11,6 +11,7 @@ struct SeismicRunOptions {
   bool quiet = false;
   std::string command_line;
   bool force = false;  ///< start even when the memory estimate exceeds what a rank has available
+  std::string overhead_note;  ///< printed under the in-situ overhead line (the demo explains its ratio)
 };
 
 /// Runs the solver with in-situ visualization from TOML text (defined in cmd_run.cpp).

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -742,9 +743,19 @@ void Session::Impl::encode_batch() {
   store::DatabaseWriter& w = *writer;
   // Frames of several cameras in one parallel loop: appends to different streams may run
   // concurrently, and batch_n × K frames share the threads evenly where K alone would not.
+  // An exception must not leave an OpenMP region (the process would terminate): the first one is
+  // kept and rethrown after the loop, e.g. a full disk as the FileError naming the movie.
+  std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic)
-  for (int f = 0; f < batch_n * K; ++f)
-    w.append(batch_camera[std::size_t(f / K)], f % K, batch[std::size_t(f / K)][std::size_t(f % K)]);
+  for (int f = 0; f < batch_n * K; ++f) {
+    try {
+      w.append(batch_camera[std::size_t(f / K)], f % K, batch[std::size_t(f / K)][std::size_t(f % K)]);
+    } catch (...) {
+#pragma omp critical(panoptes_encode_error)
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
   frames_encoded += std::int64_t(batch_n) * K;
   batch_n = 0;
   time.encode += since(t0);

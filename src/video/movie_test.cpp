@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "video/intra_encoder_pool.hpp"
 #include "video/movie_reader.hpp"
 #include "video/movie_test_util.hpp"
 #include "video/movie_writer.hpp"
@@ -163,6 +164,10 @@ TEST_F(MovieTest, FlushMakesFramesVisibleWhileWriting) {
     MovieReader reader(path);
     ASSERT_EQ(reader.frame_count(), 12);
     for (int i : {11, 0, 8, 7}) EXPECT_EQ(read_test_frame_number(reader.read_rgba(i)), i);
+    // flush() did not have to drain and reopen the encoder: keyframes stay at multiples of the GOP
+    // (an x264 that held a frame back made frame 7 a keyframe, so in situ, flushing every snapshot,
+    // no movie ever had a P-frame).
+    for (int i = 0; i < 12; ++i) EXPECT_EQ(reader.is_keyframe(i), i % gop == 0) << "frame " << i;
   }
 }
 
@@ -486,6 +491,54 @@ TEST_F(MovieTest, OutOfRangeReadIsAnError) {
   EXPECT_NE(msg.find("frame 3 is out of range (the movie has 3 frames)"), std::string::npos) << msg;
   EXPECT_THROW(reader.read_rgba(-1), Error);
   EXPECT_EQ(read_test_frame_number(reader.read_rgba(2)), 2);  // still usable
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Intra-only movies of one size and settings share x264 encoders instead of opening one per frame,
+// and a movie does not depend on which encoder made which frame or on what the other movies wrote in
+// between: written alone or interleaved with others, it decodes to the same pictures. (Its bytes may
+// differ in two places that do not change a picture: the slice header's idr_pic_id, and a padding bit
+// x264 takes from its own frame counter.)
+TEST_F(MovieTest, IntraOnlyMoviesShareEncodersAndDecodeTheSame) {
+  const int w = 96, h = 64, n = 5, movies = 12, mine = 7;
+  VideoSettings s;
+  s.crf = 31;  // settings no other test uses: this test's pool is its own
+  const std::string alone = file("alone.mp4");
+  write_movie(alone, w, h, n, s);
+  {
+    std::vector<std::unique_ptr<MovieWriter>> writers;
+    for (int k = 0; k < movies; ++k) writers.push_back(std::make_unique<MovieWriter>(file("m" + std::to_string(k) + ".mp4"), w, h, s));
+    auto pool = IntraEncoderPool::shared(w, h, s, "test");
+    // Every writer gets frame i before any gets i + 1 (as the in-situ session appends), in an order
+    // that changes from frame to frame; the other movies get other pictures.
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < movies; ++j) {
+        const int k = (j * 5 + i * 3) % movies;
+        writers[std::size_t(k)]->append(make_test_frame(w, h, k == mine ? i : 40 + k + i));
+      }
+    for (auto& wr : writers) wr->close();
+    EXPECT_EQ(pool->encoders_opened(), 1);  // one frame at a time: one encoder for all 60 frames
+  }
+  MovieReader a(alone), b(file("m" + std::to_string(mine) + ".mp4"));
+  ASSERT_EQ(b.frame_count(), n);
+  for (int i = 0; i < n; ++i) {
+    const Image x = a.read_rgba(i), y = b.read_rgba(i);
+    EXPECT_EQ(read_test_frame_number(y), i);
+    EXPECT_TRUE(x.pixels == y.pixels) << "frame " << i;
+  }
+  MovieReader other(file("m3.mp4"));
+  EXPECT_EQ(read_test_frame_number(other.read_rgba(2)), 40 + 3 + 2);
+  // x264's version SEI: once per movie, in its first packet, whichever encoder made that.
+  for (const auto& path : {alone, file("m3.mp4")}) {
+    const std::string bytes = file_bytes(path);
+    std::size_t copies = 0;
+    for (auto at = bytes.find("x264 - core"); at != std::string::npos; at = bytes.find("x264 - core", at + 1)) ++copies;
+    EXPECT_EQ(copies, 1u) << path;
+  }
 }
 
 std::string run(const std::string& cmd, int* status) {

@@ -12,9 +12,10 @@ namespace panoptes::video {
 /// One movie being written. Frames must all have the size given at construction. Odd sizes are
 /// padded (edge pixels repeated) to the even size H.264 4:2:0 needs; padded_width()/padded_height()
 /// report it so the manifest can record the padding and readers crop it off.
-/// Memory: an intra-only writer (gop 1) creates its encoder inside each append() and frees it
-/// afterwards, so an open writer holds ~1 MB; with gop > 1 the encoder lives as long as the writer
-/// (~18-25 MB at 920x896). See docs/formats.md.
+/// Memory: an intra-only writer (gop 1) borrows an x264 encoder for each append() from a pool shared
+/// by every intra-only movie of its size and settings (one encoder per frame being encoded at once,
+/// e.g. per thread), so an open writer holds ~1 MB; with gop > 1 the encoder lives as long as the
+/// writer (~18-25 MB at 920x896). Appends to different writers may run concurrently. See docs/formats.md.
 class MovieWriter {
  public:
   /// Creates (or truncates) the file. Throws FileError if it cannot be created, Error on bad settings.
