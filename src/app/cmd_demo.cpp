@@ -81,8 +81,8 @@ up_axis = "z_down"     # z is depth: the sky is -z (poles, latitudes, image up a
 [schedule]
 every_steps = 10       # 48 snapshots
 
-[video]                # measured on the demo's frames (docs/insitu.md): P-frames (gop > 1) save
-gop = 1                # 3 % here for 3 MB per open writer; crf 23 saves 14 % over 20 at 45 dB
+[video]                # intra-only: the player's fastest random access, ~1 MB per open writer (P-frames keep a
+gop = 1                # 3 MB encoder per writer; their size gain is unmeasured: docs/insitu.md); crf 23: -14 %, 45 dB
 crf = 23
 preset = "superfast"
 playback_fps = 10      # the player shows the 48 snapshots in ~5 s (the movies themselves are 30 fps)
