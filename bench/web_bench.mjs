@@ -62,10 +62,10 @@ const browser = await puppeteer.launch({ executablePath: chromium, headless: tru
 const db = await (await fetch(url + "api/database.json")).json();
 const rows = [], rowsData = [];
 // Rows: prefetch on with the player's defaults; prefetch on with the other neighbour rule
-// (WEB_BENCH_COMPARE, default "&nbdecode=ahead", empty to skip), so that one run on an idle machine
+// (WEB_BENCH_COMPARE, default "&nbdecode=switch", empty to skip), so that one run on an idle machine
 // compares them; prefetch off. Runs alternate between the rows (run r of every row, then r + 1) so
 // that a change of the machine's load falls on all rows alike.
-const compare = process.env.WEB_BENCH_COMPARE ?? "&nbdecode=ahead";
+const compare = process.env.WEB_BENCH_COMPARE ?? "&nbdecode=switch";
 const configs = [{ label: "on", prefetch: true, extra: "" }];
 if (compare) configs.push({ label: `on, \`${compare.replace(/^&/, "")}\``, prefetch: true, extra: compare });
 if (!process.env.WEB_BENCH_ONLY_ON) configs.push({ label: "off", prefetch: false, extra: "" });

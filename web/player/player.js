@@ -21,7 +21,7 @@ const options = {
   // A playing neighbour of keyframes only: "switch" = samples fetched ahead, decoder configured, the
   // one frame the playhead needs decoded when a switch comes to it; "ahead" = decoded ahead like any
   // neighbour, at every nbstride-th frame.
-  nbDecode: params.get("nbdecode") === "ahead" ? "ahead" : "switch",
+  nbDecode: params.get("nbdecode") === "switch" ? "switch" : "ahead",  // idle 2-core: ahead p99 41 ms, switch 87 ms (docs/web.md)
   nbStride: Number(params.get("nbstride") || 2),  // nbdecode=ahead: every stride-th frame decoded
   abortOnSwitch: params.get("abort") !== "0",  // a switch drops the old stream's decodes (nbdecode=switch)
   switchBatch: Number(params.get("switchbatch") || 1),  // the first batch of a switch's new stream: its first frame alone

@@ -252,10 +252,10 @@ await check("live database: new frames of a running simulation play without a re
     fs.renameSync(manifestPath + ".tmp", manifestPath);
   };
   checkpoint(8);
-  const { page, errors } = await open(liveUrl + "?play=1");
+  const { page, errors } = await open(liveUrl + "?play=1&nbdecode=switch");
   assert.equal(await page.evaluate(() => window.panoptes.state().frames), 8);
   await expectShown(page, 0, 0, null, "live, 8 frames");
-  // Keyframes only, default (nbdecode=switch): the playing neighbour (camera 1) gets its samples
+  // Keyframes only, nbdecode=switch: the playing neighbour (camera 1) gets its samples
   // fetched and its decoder configured, but no frame decoded until a switch comes to it.
   await page.waitForFunction(() => { const i = window.panoptes.streamInfo(1, 0); return i && i.samples >= 2 && i.decoder === "configured"; }, { timeout: 5000 });
   await new Promise((r) => setTimeout(r, 300));  // ~9 frames of playback: a decode ahead would show
