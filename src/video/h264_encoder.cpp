@@ -9,6 +9,7 @@ extern "C" {
 #include <cstring>
 
 #include "core/error.hpp"
+#include "video/annex_b.hpp"
 #include "video/ffmpeg_util.hpp"
 
 namespace panoptes::video {
@@ -104,13 +105,9 @@ void H264Encoder::convert(const std::uint8_t* pixels, int stride, int channels) 
 void remove_sei(AVPacket* pkt, std::vector<std::uint8_t>* removed) {
   std::uint8_t* d = pkt->data;
   const int n = pkt->size;
-  auto start_code = [&](int from) {
-    for (int k = from; k + 2 < n; ++k)
-      if (d[k] == 0 && d[k + 1] == 0 && d[k + 2] == 1) return k;
-    return n;
-  };
+  auto start_code = [&](int from) { return next_start_code(d, n, from); };
   int sc = start_code(0);
-  if (sc > 1 || (sc == 1 && d[0] != 0)) return;  // not Annex B: leave it alone
+  if (!is_annex_b(d, sc)) return;  // leave it alone
   int out = 0;
   while (sc < n) {
     const int begin = sc > 0 && d[sc - 1] == 0 ? sc - 1 : sc;  // a 4-byte start code's zero_byte

@@ -9,6 +9,8 @@ extern "C" {
 #include <libavutil/mem.h>
 }
 
+#include "video/annex_b.hpp"
+
 namespace panoptes::video {
 
 namespace {
@@ -53,13 +55,9 @@ bool is_checksum_sei(const std::uint8_t* nal, std::size_t n, std::uint32_t* crc)
 bool append_packet_checksum(AVPacket* pkt) {
   const std::uint8_t* d = pkt->data;
   const int n = pkt->size;
-  auto start_code = [&](int from) {
-    for (int k = from; k + 2 < n; ++k)
-      if (d[k] == 0 && d[k + 1] == 0 && d[k + 2] == 1) return k;
-    return n;
-  };
+  auto start_code = [&](int from) { return next_start_code(d, n, from); };
   int sc = start_code(0);
-  if (n < 4 || sc > 1 || (sc == 1 && d[0] != 0)) return false;  // not Annex B
+  if (n < 4 || !is_annex_b(d, sc)) return false;
   std::uint32_t crc = 0;
   int first_vcl = -1;  // where the SEI goes: SEI must precede the first slice of an access unit
   while (sc < n) {
