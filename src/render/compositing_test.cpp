@@ -99,6 +99,36 @@ TEST(Compositing, OneMarchForKTasksEqualsKMarches) {
   EXPECT_LT(st.marched_samples, separate_marched);
 }
 
+// Volume tasks on p and s: in one march both fields' corner copies are read with one shared
+// geometry (interp_block_corners_n<2>), alone with their own; a field without a corner copy (gathered
+// floats) must not be paired. Every task's image must be its one-task image, bit for bit.
+TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
+  const Scene sc;
+  const std::vector<TaskSpec> tasks{
+      TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
+      TaskSpec::volume(1, TransferFunction::preset("s-wave", 2), ValueWindow::absolute(0, 0.9)),
+      TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
+                        TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 0.9)),
+  };
+  for (const FieldCopy s_copy : {FieldCopy::corners16, FieldCopy::none}) {
+    std::vector<PreparedField> fields{PreparedField(sc.views[0]),
+                                      PreparedField(sc.views[1], MacroCells::kDefaultSize, s_copy)};
+    ASSERT_FALSE(fields[0].corners.empty());
+    for (const auto& cam : kCams) {
+      std::vector<PartialImage> together(tasks.size());
+      render_brick(cam, fields, tasks, together);
+      for (std::size_t t = 0; t < tasks.size(); ++t) {
+        std::vector<PartialImage> one(1);
+        render_brick(cam, fields, std::span(&tasks[t], 1), one);
+        EXPECT_EQ(one[0].rgba, together[t].rgba) << "task " << t << ", s corner copy " << (s_copy == FieldCopy::corners16);
+      }
+      float peak = 0;  // the scene must give the tasks something to composite
+      for (float a : together[2].rgba) peak = std::max(peak, a);
+      EXPECT_GT(peak, 0.1f);
+    }
+  }
+}
+
 TEST(Compositing, EmptySpaceSkippingDoesNotChangeImagesAndSkips) {
   const Scene sc;
   const auto& cam = kCams[1];

@@ -139,6 +139,21 @@ inline float interp_clamped(const FieldAcc& f, double x, double y, double z) {
 
 enum class RtKind : std::uint8_t { volume1, volume2, iso, slice };
 
+// A LUT row of one field of a two-field volume task (see composite_volume2()): τ·rgb, τ and 1 − α.
+struct alignas(32) MixEntry {
+  float tr, tg, tb, tau;
+  float om;
+};
+
+std::vector<MixEntry> mix_entries(const TransferLut& lut) {
+  std::vector<MixEntry> m(std::size_t(lut.bins()));
+  for (int b = 0; b < lut.bins(); ++b) {
+    const LutEntry& e = lut.entry(b);
+    m[std::size_t(b)] = {e.tau * e.r, e.tau * e.g, e.tau * e.b, e.tau, 1.0f - e.alpha};
+  }
+  return m;
+}
+
 // A task prepared for the hot loop: field slots, LUT pointers and windows, isovalue, slice plane.
 struct TaskRt {
   RtKind kind;
@@ -146,6 +161,8 @@ struct TaskRt {
   std::uint32_t slots = 0;  // bit mask of the slots the march reads for this task
   const LutEntry* lut1 = nullptr;
   const LutEntry* lut2 = nullptr;
+  const MixEntry* mix1 = nullptr;  // volume2: the rows of lut1 and lut2 as MixEntry
+  const MixEntry* mix2 = nullptr;
   float lo1 = 0, sc1 = 1, last1 = 0, lo2 = 0, sc2 = 1, last2 = 0;
   bool abs1 = false, abs2 = false;
   float iso = 0;
@@ -186,6 +203,9 @@ struct Shared {
   Brick brick;
   std::vector<FieldAcc> acc;  // per march slot
   std::vector<const MacroCells*> cells;
+  // Slots read from a corner copy, and per slot the other slots of the same corner layout.
+  std::uint32_t corner_slots = 0;
+  std::array<std::uint32_t, 8> corner_mates{};
   std::vector<TaskRt> rt;
   std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
   std::uint64_t march_mask = 0, iso_mask = 0;
@@ -295,11 +315,19 @@ inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
   }
 }
 
-// The same block from the field's CornerField: per sample one 16-byte load of the cell's eight
-// quantized corners, weighted by the trilinear weights (1 − f or f per axis) and summed. Lanes
-// l ≥ n repeat sample k0 + n − 1, as in interp_block().
-inline void interp_block_corners(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, float* v) {
+// The same block from the CornerFields of N fields that share one corner layout (same ilo, ihi, ccx,
+// ccxy: fields of one grid and brick), e.g. p and s of a two-field task: the sample positions, cell
+// records and the eight trilinear weights are computed once for all N, and per field and sample
+// only the 16-byte load of the cell's quantized corners, its widening and one multiply by the
+// weights remain (then eight horizontal sums at once). Per field the operations are the same
+// whatever N is, so a field's values do not depend on which other fields were read with it (one
+// march for K tasks = K marches, bit for bit). Lanes l ≥ n repeat sample k0 + n − 1, as in
+// interp_block().
+template <int N>
+inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0, int n,
+                                   float* const (&vs)[N]) {
 #ifdef PANOPTES_RENDER_AVX2
+  const FieldAcc& f = *fs[0];
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i kk =
       _mm256_min_epi32(_mm256_add_epi32(_mm256_set1_epi32(int(k0)), lane), _mm256_set1_epi32(int(k0) + n - 1));
@@ -326,36 +354,60 @@ inline void interp_block_corners(const FieldAcc& f, const RayPos& P, std::int64_
   const __m256 sx = _mm256_setr_ps(-1, 1, -1, 1, -1, 1, -1, 1), ox = _mm256_setr_ps(1, 0, 1, 0, 1, 0, 1, 0);
   const __m256 sy = _mm256_setr_ps(-1, -1, 1, 1, -1, -1, 1, 1), oy = _mm256_setr_ps(1, 1, 0, 0, 1, 1, 0, 0);
   const __m256 sz = _mm256_setr_ps(-1, -1, -1, -1, 1, 1, 1, 1), oz = _mm256_setr_ps(1, 1, 1, 1, 0, 0, 0, 0);
-  __m256 p[kBlock];
+  __m256 p[N][kBlock];
   for (int l = 0; l < kBlock; ++l) {
-    const __m128i q = _mm_loadu_si128(reinterpret_cast<const __m128i*>(f.corners + 8 * std::int64_t(id[l])));
-    const __m256 c = _mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q));
     const __m256 wx = _mm256_fmadd_ps(_mm256_broadcast_ss(&fx[l]), sx, ox);
     const __m256 wy = _mm256_fmadd_ps(_mm256_broadcast_ss(&fy[l]), sy, oy);
     const __m256 wz = _mm256_fmadd_ps(_mm256_broadcast_ss(&fz[l]), sz, oz);
-    p[l] = _mm256_mul_ps(_mm256_mul_ps(c, wx), _mm256_mul_ps(wy, wz));
+    const __m256 w = _mm256_mul_ps(wx, _mm256_mul_ps(wy, wz));
+    const std::int64_t o = 8 * std::int64_t(id[l]);
+    for (int s = 0; s < N; ++s) {
+      const __m128i q = _mm_loadu_si128(reinterpret_cast<const __m128i*>(fs[s]->corners + o));
+      p[s][l] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q)), w);
+    }
   }
-  // Eight horizontal sums at once: lanes of a = samples 0–3 (corners 0–3 | 4–7), of b = samples 4–7.
-  const __m256 a = _mm256_hadd_ps(_mm256_hadd_ps(p[0], p[1]), _mm256_hadd_ps(p[2], p[3]));
-  const __m256 b = _mm256_hadd_ps(_mm256_hadd_ps(p[4], p[5]), _mm256_hadd_ps(p[6], p[7]));
-  const __m256 t = _mm256_add_ps(_mm256_permute2f128_ps(a, b, 0x20), _mm256_permute2f128_ps(a, b, 0x31));
-  _mm256_storeu_ps(v, _mm256_fmadd_ps(t, _mm256_set1_ps(f.qscale), _mm256_set1_ps(f.qoff)));
+  for (int s = 0; s < N; ++s) {
+    // Eight horizontal sums at once: lanes of a = samples 0–3 (corners 0–3 | 4–7), of b = samples 4–7.
+    const __m256 a = _mm256_hadd_ps(_mm256_hadd_ps(p[s][0], p[s][1]), _mm256_hadd_ps(p[s][2], p[s][3]));
+    const __m256 b = _mm256_hadd_ps(_mm256_hadd_ps(p[s][4], p[s][5]), _mm256_hadd_ps(p[s][6], p[s][7]));
+    const __m256 t = _mm256_add_ps(_mm256_permute2f128_ps(a, b, 0x20), _mm256_permute2f128_ps(a, b, 0x31));
+    _mm256_storeu_ps(vs[s], _mm256_fmadd_ps(t, _mm256_set1_ps(fs[s]->qscale), _mm256_set1_ps(fs[s]->qoff)));
+  }
 #else
-  for (int l = 0; l < kBlock; ++l) {
-    const float fk = float(k0 + std::min(l, n - 1));
-    const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
-    const int i = std::min(std::max(int(x), f.ilo[0]), f.ihi[0]);
-    const int j = std::min(std::max(int(y), f.ilo[1]), f.ihi[1]);
-    const int k = std::min(std::max(int(z), f.ilo[2]), f.ihi[2]);
-    const float fx = x - float(i), fy = y - float(j), fz = z - float(k);
-    const std::uint16_t* c =
-        f.corners + 8 * (std::int64_t(i - f.ilo[0]) + std::int64_t(j - f.ilo[1]) * f.ccx + std::int64_t(k - f.ilo[2]) * f.ccxy);
-    const float c00 = c[0] + fx * (c[1] - c[0]), c10 = c[2] + fx * (c[3] - c[2]);
-    const float c01 = c[4] + fx * (c[5] - c[4]), c11 = c[6] + fx * (c[7] - c[6]);
-    const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-    v[l] = f.qoff + f.qscale * (c0 + fz * (c1 - c0));
+  for (int s = 0; s < N; ++s) {
+    const FieldAcc& f = *fs[s];
+    float* v = vs[s];
+    for (int l = 0; l < kBlock; ++l) {
+      const float fk = float(k0 + std::min(l, n - 1));
+      const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
+      const int i = std::min(std::max(int(x), f.ilo[0]), f.ihi[0]);
+      const int j = std::min(std::max(int(y), f.ilo[1]), f.ihi[1]);
+      const int k = std::min(std::max(int(z), f.ilo[2]), f.ihi[2]);
+      const float fx = x - float(i), fy = y - float(j), fz = z - float(k);
+      const std::uint16_t* c = f.corners + 8 * (std::int64_t(i - f.ilo[0]) + std::int64_t(j - f.ilo[1]) * f.ccx +
+                                                std::int64_t(k - f.ilo[2]) * f.ccxy);
+      const float c00 = c[0] + fx * (c[1] - c[0]), c10 = c[2] + fx * (c[3] - c[2]);
+      const float c01 = c[4] + fx * (c[5] - c[4]), c11 = c[6] + fx * (c[7] - c[6]);
+      const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+      v[l] = f.qoff + f.qscale * (c0 + fz * (c1 - c0));
+    }
   }
 #endif
+}
+
+inline void interp_block_corners(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, float* v) {
+  const FieldAcc* const fs[1] = {&f};
+  float* const vs[1] = {v};
+  interp_block_corners_n<1>(fs, P, k0, n, vs);
+}
+
+// Whether two fields' corner copies have the same layout, so interp_block_corners_n() may share
+// their geometry.
+inline bool same_corner_layout(const FieldAcc& a, const FieldAcc& b) {
+  if (!a.corners || !b.corners || a.ccx != b.ccx || a.ccxy != b.ccxy) return false;
+  for (int k = 0; k < 3; ++k)
+    if (a.ilo[k] != b.ilo[k] || a.ihi[k] != b.ihi[k]) return false;
+  return true;
 }
 
 // Volume classification's values: from the corner copy when the field has one.
@@ -432,24 +484,27 @@ inline int composite_volume1(const LutEntry* lut, const int* bin, int n, std::in
   return composite_volume1_scalar(lut, bin, n, k0, k_partial, partial, tr_stop, c0, c1, c2, tr);
 }
 
-// The same for a two-field volume task (extinctions add, colours mix by extinction).
-inline int composite_volume2_scalar(const LutEntry* lut1, const LutEntry* lut2, const int* bin1, const int* bin2,
-                                    int n, std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop,
-                                    float* a) {
+// The same for a two-field volume task (extinctions add, colours mix by extinction): per sample
+// α = 1 − (1 − α1)(1 − α2) and colour (τ1·c1 + τ2·c2)·α/(τ1 + τ2). Rows of MixEntry hold τ·rgb, τ and
+// 1 − α, so the numerator and τ are one 4-lane add of the two rows, and no per-sample branch is left:
+// τ1 + τ2 = 0 means α1 = α2 = 0, so 1 − om = 0 and the sample adds 0·finite (the divisor is kept
+// ≥ FLT_MIN). The division does not depend on the transmittance, so it stays off the loop-carried
+// chain (T ← T·om, one multiply).
+inline int composite_volume2_scalar(const MixEntry* m1, const MixEntry* m2, const int* bin1, const int* bin2, int n,
+                                    std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop, float* a) {
   float c0 = a[0], c1 = a[1], c2 = a[2], tr = a[3];
   int stop = -1;
   for (int l = 0; l < n; ++l) {
-    const LutEntry& e1 = lut1[bin1[l]];
-    const LutEntry& e2 = lut2[bin2[l]];
+    const MixEntry& e1 = m1[bin1[l]];
+    const MixEntry& e2 = m2[bin2[l]];
     const float tau = e1.tau + e2.tau;
-    if (tau <= 0) continue;
-    float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);  // = 1 − exp(−(τ1 + τ2))
-    if (k0 + l == k_partial) [[unlikely]] al = 1.0f - std::pow(1.0f - al, partial);
-    const float s = tr * al / tau;
-    c0 = std::fma(s, std::fma(e1.tau, e1.r, e2.tau * e2.r), c0);
-    c1 = std::fma(s, std::fma(e1.tau, e1.g, e2.tau * e2.g), c1);
-    c2 = std::fma(s, std::fma(e1.tau, e1.b, e2.tau * e2.b), c2);
-    tr = tr * (1.0f - al);
+    float om = e1.om * e2.om;  // = exp(−(τ1 + τ2))
+    if (k0 + l == k_partial) [[unlikely]] om = std::pow(om, partial);
+    const float s = tr * ((1.0f - om) / std::max(tau, std::numeric_limits<float>::min()));
+    c0 = std::fma(s, e1.tr + e2.tr, c0);
+    c1 = std::fma(s, e1.tg + e2.tg, c1);
+    c2 = std::fma(s, e1.tb + e2.tb, c2);
+    tr = tr * om;
     if (tr <= tr_stop) [[unlikely]] {
       stop = l;
       break;
@@ -459,25 +514,22 @@ inline int composite_volume2_scalar(const LutEntry* lut1, const LutEntry* lut2, 
   return stop;
 }
 
-inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const int* bin1, const int* bin2, int n,
+inline int composite_volume2(const MixEntry* m1, const MixEntry* m2, const int* bin1, const int* bin2, int n,
                              std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop, float* a) {
 #ifdef PANOPTES_RENDER_AVX2
-  // As composite_volume1(): colours mixed and accumulated as 4-lane vectors (the same fused
-  // operations as the scalar loop, so the same bits), termination tested once per block.
+  // As composite_volume1(): the colour accumulated as a 4-lane vector (the same operations as the
+  // scalar loop, so the same bits; lane 3 collects s·τ, unused), termination tested once per block.
   if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
     __m128 c = _mm_setr_ps(a[0], a[1], a[2], 0.0f);
     float tr = a[3];
     for (int l = 0; l < n; ++l) {
-      const LutEntry& e1 = lut1[bin1[l]];
-      const LutEntry& e2 = lut2[bin2[l]];
+      const MixEntry& e1 = m1[bin1[l]];
+      const MixEntry& e2 = m2[bin2[l]];
       const float tau = e1.tau + e2.tau;
-      if (tau <= 0) continue;
-      const float al = 1.0f - (1.0f - e1.alpha) * (1.0f - e2.alpha);
-      const float s = tr * al / tau;
-      const __m128 mix = _mm_fmadd_ps(_mm_broadcast_ss(&e1.tau), _mm_loadu_ps(&e1.r),
-                                      _mm_mul_ps(_mm_broadcast_ss(&e2.tau), _mm_loadu_ps(&e2.r)));
-      c = _mm_fmadd_ps(_mm_set1_ps(s), mix, c);
-      tr = tr * (1.0f - al);
+      const float om = e1.om * e2.om;
+      const float s = tr * ((1.0f - om) / std::max(tau, std::numeric_limits<float>::min()));
+      c = _mm_fmadd_ps(_mm_set1_ps(s), _mm_add_ps(_mm_load_ps(&e1.tr), _mm_load_ps(&e2.tr)), c);
+      tr = tr * om;
     }
     if (tr > tr_stop) [[likely]] {
       alignas(16) float cc[4];
@@ -487,7 +539,7 @@ inline int composite_volume2(const LutEntry* lut1, const LutEntry* lut2, const i
     }
   }
 #endif
-  return composite_volume2_scalar(lut1, lut2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
+  return composite_volume2_scalar(m1, m2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
 }
 
 // The single-volume-task loop over samples kb … kend with field, LUT and accumulator in registers.
@@ -598,11 +650,26 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         const TaskRt& T = S.rt[std::size_t(std::countr_zero(m))];
         (T.kind == RtKind::iso ? smask : vmask) |= T.slots;
       }
-      for (std::uint32_t m = vmask; m; m &= m - 1) {
-        const int s = std::countr_zero(m);
-        if (fa[s].corners)
+      // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_pairs: slot s1's
+      // partner s2, found at setup).
+      std::uint32_t cm = vmask & S.corner_slots;
+      while (cm) {
+        const int s = std::countr_zero(cm);
+        cm &= cm - 1;
+        const std::uint32_t mates = cm & S.corner_mates[std::size_t(s)];
+        if (mates) {
+          const int s2 = std::countr_zero(mates);
+          cm &= ~(1u << s2);
+          const FieldAcc* const fs[2] = {&fa[s], &fa[s2]};
+          float* const vs[2] = {vq[s], vq[s2]};
+          interp_block_corners_n<2>(fs, P, k0, n, vs);
+        } else {
           interp_block_corners(fa[s], P, k0, n, vq[s]);
-        else if (smask >> s & 1)
+        }
+      }
+      for (std::uint32_t m = vmask & ~S.corner_slots; m; m &= m - 1) {
+        const int s = std::countr_zero(m);
+        if (smask >> s & 1)
           vq_from_vb |= 1u << s;  // the same float values as the isosurface's: copied below
         else
           interp_block(fa[s], P, k0, n, safe, vq[s]);
@@ -639,7 +706,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
             alignas(32) int bin1[kBlock], bin2[kBlock];
             lut_bin_block(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin1);
             lut_bin_block(vq[T.s2], T.lo2, T.sc2, T.last2, T.abs2, bin2);
-            stop = composite_volume2(T.lut1, T.lut2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
+            stop = composite_volume2(T.mix1, T.mix2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
             break;
           }
           case RtKind::iso: {
@@ -917,6 +984,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   };
 
   std::vector<TransferLut> luts(2 * tasks.size());
+  std::vector<std::vector<MixEntry>> mixes(2 * tasks.size());
   S.rt.resize(tasks.size());
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     const TaskSpec& t = tasks[i];
@@ -940,6 +1008,10 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
           const TransferLut& l2 = bake(t.tf2, t.window2, t.reference2, 1);
           r.lut2 = &l2.entry(0);
           r.lo2 = l2.lo(), r.sc2 = l2.scale(), r.last2 = float(l2.bins() - 1), r.abs2 = l2.absolute_value();
+          mixes[2 * i] = mix_entries(l1);
+          mixes[2 * i + 1] = mix_entries(l2);
+          r.mix1 = mixes[2 * i].data();
+          r.mix2 = mixes[2 * i + 1].data();
         }
         S.march_mask |= bit;
         break;
@@ -974,6 +1046,11 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
   }
   if (S.acc.size() > 8) throw Error("render: tasks of one call read " + std::to_string(S.acc.size()) + " fields; at most 8");
+  for (std::size_t s = 0; s < S.acc.size(); ++s) {
+    if (S.acc[s].corners) S.corner_slots |= 1u << s;
+    for (std::size_t u = 0; u < S.acc.size(); ++u)
+      if (u != s && same_corner_layout(S.acc[s], S.acc[u])) S.corner_mates[s] |= 1u << u;
+  }
   // Macro-cells whose samples cannot reach a data face: cell index c0 − 1 … c1 readable with its
   // upper neighbour in every field (samples are placed within a small fraction of a voxel of their
   // macro-cell, so one cell of margin is plenty).
