@@ -150,6 +150,14 @@ struct alignas(32) MixEntry {
   float om;
 };
 
+constexpr int kRowShift = 4, kMixShift = 5;  // log2 of sizeof(VolRow), sizeof(MixEntry)
+static_assert(sizeof(VolRow) == 1 << kRowShift && sizeof(MixEntry) == 1 << kMixShift);
+
+template <class Row>
+inline const Row& row_at(const Row* table, int byte_offset) {
+  return *reinterpret_cast<const Row*>(reinterpret_cast<const char*>(table) + byte_offset);
+}
+
 std::vector<MixEntry> mix_entries(const TransferLut& lut) {
   std::vector<MixEntry> m(std::size_t(lut.bins()));
   for (int b = 0; b < lut.bins(); ++b) {
@@ -424,7 +432,10 @@ inline void volume_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
     interp_block(f, P, k0, n, safe, v);
 }
 
-// LUT bins of a block of values: lut_bin() lane by lane (same operations, so the same bins).
+// LUT bins of a block of values: lut_bin() lane by lane (same operations, so the same bins), as byte
+// offsets bin·2^kShift of rows of 2^kShift bytes (the compositing loops then address a row with
+// one add: x86 scales indices by at most 8).
+template <int kShift>
 inline void lut_bin_block(const float* v, float lo, float sc, float last, bool absv, int* bin) {
 #ifdef PANOPTES_RENDER_AVX2
   __m256 u = _mm256_loadu_ps(v);
@@ -432,9 +443,9 @@ inline void lut_bin_block(const float* v, float lo, float sc, float last, bool a
   u = _mm256_mul_ps(_mm256_sub_ps(u, _mm256_set1_ps(lo)), _mm256_set1_ps(sc));
   u = _mm256_max_ps(u, _mm256_setzero_ps());  // NaN → 0, as in lut_bin()
   u = _mm256_min_ps(u, _mm256_set1_ps(last));
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(bin), _mm256_cvttps_epi32(u));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(bin), _mm256_slli_epi32(_mm256_cvttps_epi32(u), kShift));
 #else
-  for (int l = 0; l < kBlock; ++l) bin[l] = lut_bin(v[l], lo, sc, last, absv);
+  for (int l = 0; l < kBlock; ++l) bin[l] = lut_bin(v[l], lo, sc, last, absv) << kShift;
 #endif
 }
 
@@ -450,13 +461,13 @@ std::vector<VolRow> vol_rows(const TransferLut& lut) {
   return m;
 }
 
-// Composites lanes 0 … n−1 of a block (sample k0 + l, LUT bins `bin`) of one single-field volume
+// Composites lanes 0 … n−1 of a block (sample k0 + l, LUT bins `bin` as byte offsets of rows) of one single-field volume
 // task into the accumulator (colour c0..c2, transmittance tr). Returns the lane where the ray became
 // opaque, or −1. Shared by the fast path and the general path, so both give the same bits.
 inline int composite_volume1_scalar(const VolRow* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
                                     float partial, float tr_stop, float& c0, float& c1, float& c2, float& tr) {
   for (int l = 0; l < n; ++l) {
-    const VolRow& e = lut[bin[l]];
+    const VolRow& e = row_at(lut, bin[l]);
     float pr = e.pr, pg = e.pg, pb = e.pb, om = e.om;
     if (k0 + l == k_partial) [[unlikely]] {
       const float al = 1.0f - om;
@@ -487,7 +498,7 @@ inline int composite_volume1(const VolRow* lut, const int* bin, int n, std::int6
     __m128 c = _mm_setr_ps(c0, c1, c2, 0.0f);
     __m128 t = _mm_set1_ps(tr);
     for (int l = 0; l < n; ++l) {
-      const __m128 r = _mm_load_ps(&lut[bin[l]].pr);
+      const __m128 r = _mm_load_ps(&row_at(lut, bin[l]).pr);
       c = _mm_fmadd_ps(t, r, c);
       t = _mm_mul_ps(t, _mm_permute_ps(r, 0xFF));
     }
@@ -513,8 +524,8 @@ inline int composite_volume2_scalar(const MixEntry* m1, const MixEntry* m2, cons
   float c0 = a[0], c1 = a[1], c2 = a[2], tr = a[3];
   int stop = -1;
   for (int l = 0; l < n; ++l) {
-    const MixEntry& e1 = m1[bin1[l]];
-    const MixEntry& e2 = m2[bin2[l]];
+    const MixEntry& e1 = row_at(m1, bin1[l]);
+    const MixEntry& e2 = row_at(m2, bin2[l]);
     const float tau = e1.tau + e2.tau;
     float om = e1.om * e2.om;  // = exp(−(τ1 + τ2))
     if (k0 + l == k_partial) [[unlikely]] om = std::pow(om, partial);
@@ -541,8 +552,8 @@ inline int composite_volume2(const MixEntry* m1, const MixEntry* m2, const int* 
     __m128 c = _mm_setr_ps(a[0], a[1], a[2], 0.0f);
     float tr = a[3];
     for (int l = 0; l < n; ++l) {
-      const MixEntry& e1 = m1[bin1[l]];
-      const MixEntry& e2 = m2[bin2[l]];
+      const MixEntry& e1 = row_at(m1, bin1[l]);
+      const MixEntry& e2 = row_at(m2, bin2[l]);
       const float tau = e1.tau + e2.tau;
       const float om = e1.om * e2.om;
       const float s = tr * ((1.0f - om) / std::max(tau, std::numeric_limits<float>::min()));
@@ -573,7 +584,7 @@ std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::in
   for (std::int64_t k0 = kb; k0 <= kend; k0 += kBlock) {
     const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
     volume_block(f, P, k0, n, safe, v);
-    lut_bin_block(v, T.lo1, T.sc1, T.last1, T.abs1, bin);
+    lut_bin_block<kRowShift>(v, T.lo1, T.sc1, T.last1, T.abs1, bin);
     const int stop = composite_volume1(T.row1, bin, n, k0, k_partial, partial, tr_stop, a0, a1, a2, tr);
     if (stop >= 0) [[unlikely]] {
       opaque = true;
@@ -716,14 +727,14 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         switch (T.kind) {
           case RtKind::volume1: {
             alignas(32) int bin[kBlock];
-            lut_bin_block(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin);
+            lut_bin_block<kRowShift>(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin);
             stop = composite_volume1(T.row1, bin, n, k0, k_partial, partial, tr_stop, a[0], a[1], a[2], a[3]);
             break;
           }
           case RtKind::volume2: {
             alignas(32) int bin1[kBlock], bin2[kBlock];
-            lut_bin_block(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin1);
-            lut_bin_block(vq[T.s2], T.lo2, T.sc2, T.last2, T.abs2, bin2);
+            lut_bin_block<kMixShift>(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin1);
+            lut_bin_block<kMixShift>(vq[T.s2], T.lo2, T.sc2, T.last2, T.abs2, bin2);
             stop = composite_volume2(T.mix1, T.mix2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
             break;
           }
