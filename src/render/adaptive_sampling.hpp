@@ -5,22 +5,28 @@
 // bilinear interpolation, otherwise it is split at its midpoints (stride 4 → 2 → 1) and the new
 // lattice points are marched. The images of the in-situ paper settings carry 1.2–4 pixels per voxel,
 // so most of a smooth image is interpolated instead of marched.
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "render/partial_image.hpp"
 
 namespace panoptes::render {
 
-/// Refines one tile of a brick's partial images (all tasks of one march share the decisions, so
-/// one march serves the K images also here). `march(x, y)` traces pixel (x, y) exactly and writes
-/// every image's RGBA and depth (transparent and +∞ on a miss); `locate(x, y)` returns only the
-/// pixel's exact entry depth (+∞ on a miss) — the slab test, far cheaper than a march — so an
-/// interpolated pixel's depth is never interpolated. Tiles are independent: the lattice includes
-/// their first and last rows and columns. Lattice lines lie on multiples of `stride` in image
-/// coordinates, so bricks of one decomposition sample the same pixels wherever their tiles overlap.
+/// Refines one tile of a brick's partial images. All K tasks of a march (K ≤ 64) share the coarse
+/// lattice, marched once for all of them; every refinement decision is then taken per task (a cell
+/// is split for the tasks whose corners disagree and filled for the others), and the points of a
+/// split are marched for those tasks only, so a volume task's image is exactly its one-task adaptive
+/// image and a K-task march marches no ray for a task that does not need it (see `follow` in run()). `march(x, y, mask)` traces
+/// pixel (x, y) exactly for the tasks in `mask` (bit i = out[i]) and writes their RGBA (transparent on
+/// a miss) and every image's depth (+∞ on a miss); `locate(x, y)` returns only the pixel's exact entry
+/// depth (+∞ on a miss) — the slab test, far cheaper than a march — so an interpolated pixel's depth
+/// is never interpolated. Tiles are independent: the lattice includes their first and last rows and
+/// columns. Lattice lines lie on multiples of `stride` in image coordinates, so bricks of one
+/// decomposition sample the same pixels wherever their tiles overlap.
 class AdaptiveTile {
  public:
   /// `stride` is the coarse lattice spacing (2 or 4; larger values work, refining by halves);
@@ -28,79 +34,95 @@ class AdaptiveTile {
   /// interpolated (the final image's units: 1/255 ≈ 0.0039).
   AdaptiveTile(int stride, float tolerance) : stride_(stride), tolerance_(tolerance) {}
 
-  /// Counters of the pixels handled so far.
+  /// Counters of the pixels handled so far: marched (for at least one task), and interpolated for
+  /// every task (marched for none).
   std::uint64_t marched() const { return marched_; }
   std::uint64_t interpolated() const { return interpolated_; }
 
+  /// `follow`: the tasks refined wherever any task is (isosurfaces and slices: their thin edges may
+  /// fall between four agreeing corners, and the finer lattice of the volume tasks catches many of
+  /// them, as before per-task decisions); the others decide alone.
   template <class March, class Locate>
-  void run(const PixelRect& tile, std::span<PartialImage> out, March&& march, Locate&& locate) {
+  void run(const PixelRect& tile, std::span<PartialImage> out, March&& march, Locate&& locate,
+           std::uint64_t follow = 0) {
+    if (out.size() > 64) throw std::invalid_argument("AdaptiveTile: more than 64 images in one march");
     tile_ = tile;
+    follow_ = follow;
     out_ = out;
-    state_.assign(std::size_t(tile.width()) * std::size_t(tile.height()), kUnknown);
+    const std::uint64_t all = out.size() == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << out.size()) - 1;
+    const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
+    marched_for_.assign(n, 0);
+    filled_.assign(n, 0);
     // The coarse lattice: the tile's borders and the multiples of the stride between them.
     xs_.clear();
     ys_.clear();
     lattice(tile.x0, tile.x1, xs_);
     lattice(tile.y0, tile.y1, ys_);
     for (int y : ys_)
-      for (int x : xs_) mark_marched(x, y, march);
+      for (int x : xs_) mark_marched(x, y, all, march);
     for (std::size_t j = 0; j + 1 < ys_.size(); ++j)
-      for (std::size_t i = 0; i + 1 < xs_.size(); ++i) refine(xs_[i], ys_[j], xs_[i + 1], ys_[j + 1], march, locate);
+      for (std::size_t i = 0; i + 1 < xs_.size(); ++i)
+        refine(xs_[i], ys_[j], xs_[i + 1], ys_[j + 1], all, march, locate);
+    for (std::size_t i = 0; i < n; ++i) interpolated_ += filled_[i] && !marched_for_[i];
   }
 
  private:
-  static constexpr std::uint8_t kUnknown = 0, kMarched = 1, kInterpolated = 2;
-
   void lattice(int a0, int a1, std::vector<int>& v) const {
     v.push_back(a0);
     for (int a = (a0 / stride_ + 1) * stride_; a < a1 - 1; a += stride_) v.push_back(a);
     v.push_back(a1 - 1);  // == a0 for a tile one pixel wide: cells of width 0 then cover its column
   }
-  std::uint8_t& state(int x, int y) {
-    return state_[std::size_t(y - tile_.y0) * std::size_t(tile_.width()) + std::size_t(x - tile_.x0)];
+  std::size_t at(int x, int y) const {
+    return std::size_t(y - tile_.y0) * std::size_t(tile_.width()) + std::size_t(x - tile_.x0);
   }
   float depth(const PartialImage& o, int x, int y) const {
     return o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)];
   }
+  // Marches pixel (x, y) for the tasks of `mask` it was not marched for yet.
   template <class March>
-  void mark_marched(int x, int y, March& march) {
-    std::uint8_t& s = state(x, y);
-    if (s == kMarched) return;
-    if (s == kInterpolated) --interpolated_;
-    march(x, y);
-    s = kMarched;
-    ++marched_;
+  void mark_marched(int x, int y, std::uint64_t mask, March& march) {
+    std::uint64_t& s = marched_for_[at(x, y)];
+    const std::uint64_t m = mask & ~s;
+    if (!m) return;
+    march(x, y, m);
+    if (!s) ++marched_;
+    s |= m;
   }
 
-  // Do the four corners of cell [x0, x1] × [y0, y1] agree closely enough to interpolate between them?
-  bool smooth(int x0, int y0, int x1, int y1) const {
+  // The tasks of `mask` whose four corners of cell [x0, x1] × [y0, y1] do not agree closely enough
+  // to interpolate between them (all of them where the corners' hit/miss status differs).
+  std::uint64_t rough(int x0, int y0, int x1, int y1, std::uint64_t mask) const {
     const PartialImage& o0 = out_[0];
     const bool hit = depth(o0, x0, y0) != PartialImage::kNoDepth;
     if ((depth(o0, x1, y0) != PartialImage::kNoDepth) != hit || (depth(o0, x0, y1) != PartialImage::kNoDepth) != hit ||
         (depth(o0, x1, y1) != PartialImage::kNoDepth) != hit)
-      return false;
-    if (!hit) return true;
-    for (const PartialImage& o : out_) {
+      return mask;
+    if (!hit) return 0;
+    std::uint64_t r = 0;
+    for (std::uint64_t m = mask; m; m &= m - 1) {
+      const PartialImage& o = out_[std::size_t(std::countr_zero(m))];
       const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *d = o.rgba_at(x1, y1);
       for (int k = 0; k < 4; ++k) {
         const float lo = std::fmin(std::fmin(a[k], b[k]), std::fmin(c[k], d[k]));
         const float hi = std::fmax(std::fmax(a[k], b[k]), std::fmax(c[k], d[k]));
-        if (hi - lo > tolerance_) return false;
+        if (hi - lo > tolerance_) {
+          r |= m & -m;
+          break;
+        }
       }
     }
-    return true;
+    return r ? r | (mask & follow_) : 0;
   }
 
   template <class March, class Locate>
-  void refine(int x0, int y0, int x1, int y1, March& march, Locate& locate) {
+  void refine(int x0, int y0, int x1, int y1, std::uint64_t mask, March& march, Locate& locate) {
     if (x1 - x0 <= 1 && y1 - y0 <= 1) return;  // no pixels inside
-    if (smooth(x0, y0, x1, y1)) {
-      fill(x0, y0, x1, y1, march, locate);
-      return;
-    }
+    const std::uint64_t r = rough(x0, y0, x1, y1, mask);
+    if (mask & ~r) fill(x0, y0, x1, y1, mask & ~r, march, locate);
+    if (!r) return;
     if (x1 - x0 <= 2 && y1 - y0 <= 2) {
       for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) mark_marched(x, y, march);
+        for (int x = x0; x <= x1; ++x) mark_marched(x, y, r, march);
       return;
     }
     // Split at the midpoints (an axis already down to one pixel is not split).
@@ -109,45 +131,49 @@ class AdaptiveTile {
     if (nx == 2) xv[1] = x1;
     if (ny == 2) yv[1] = y1;
     for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) mark_marched(xv[i], yv[j], march);
+      for (int i = 0; i < nx; ++i) mark_marched(xv[i], yv[j], r, march);
     for (int j = 0; j + 1 < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) refine(xv[i], yv[j], xv[i + 1], yv[j + 1], march, locate);
+      for (int i = 0; i + 1 < nx; ++i) refine(xv[i], yv[j], xv[i + 1], yv[j + 1], r, march, locate);
   }
 
-  // Bilinear interpolation of the cell's pixels that were not marched. A pixel whose exact hit/miss
-  // status differs from its corners' (the brick's silhouette crossing a cell, e.g. a thin brick
-  // seen edge-on between four misses) is marched instead.
+  // Bilinear interpolation, for the tasks of `mask`, of the cell's pixels not marched for them. A
+  // pixel whose exact hit/miss status differs from its corners' (the brick's silhouette crossing a
+  // cell, e.g. a thin brick seen edge-on between four misses) is marched instead.
   template <class March, class Locate>
-  void fill(int x0, int y0, int x1, int y1, March& march, Locate& locate) {
+  void fill(int x0, int y0, int x1, int y1, std::uint64_t mask, March& march, Locate& locate) {
     const bool hit = depth(out_[0], x0, y0) != PartialImage::kNoDepth;
     const float sx = x1 > x0 ? 1.0f / float(x1 - x0) : 0.0f, sy = y1 > y0 ? 1.0f / float(y1 - y0) : 0.0f;
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
-        std::uint8_t& s = state(x, y);
-        if (s == kMarched) continue;
+        const std::size_t p = at(x, y);
+        const std::uint64_t todo = mask & ~marched_for_[p];
+        if (!todo) continue;
         const float d = locate(x, y);
         if ((d != PartialImage::kNoDepth) != hit) {
-          mark_marched(x, y, march);
+          mark_marched(x, y, todo, march);
           continue;
         }
-        if (s == kUnknown) ++interpolated_;
-        s = kInterpolated;
+        filled_[p] = 1;
         const float u = float(x - x0) * sx, v = float(y - y0) * sy;
         const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
-        for (PartialImage& o : out_) {
+        for (std::uint64_t m = todo; m; m &= m - 1) {
+          PartialImage& o = out_[std::size_t(std::countr_zero(m))];
           const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *e = o.rgba_at(x1, y1);
-          float* p = o.rgba_at(x, y);
-          for (int k = 0; k < 4; ++k) p[k] = hit ? w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k] : 0.0f;
-          o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)] = d;
+          float* q = o.rgba_at(x, y);
+          for (int k = 0; k < 4; ++k) q[k] = hit ? w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k] : 0.0f;
         }
+        for (PartialImage& o : out_)  // the same exact depth for every image
+          o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)] = d;
       }
   }
 
   int stride_;
   float tolerance_;
+  std::uint64_t follow_ = 0;
   PixelRect tile_;
   std::span<PartialImage> out_;
-  std::vector<std::uint8_t> state_;
+  std::vector<std::uint64_t> marched_for_;  // per pixel of the tile: the tasks it was marched for
+  std::vector<std::uint8_t> filled_;        // per pixel: interpolated for some task
   std::vector<int> xs_, ys_;
   std::uint64_t marched_ = 0, interpolated_ = 0;
 };

@@ -129,6 +129,37 @@ TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
   }
 }
 
+// Adaptive sampling decides per volume task (a cell is split only for the tasks whose corners
+// disagree), so a volume task's image from a K-task march is its one-task adaptive image, bit for
+// bit, and the K-task march marches fewer samples than the K one-task marches together.
+TEST(Compositing, AdaptiveVolumeTasksInOneMarchGiveTheirOneTaskImages) {
+  const Scene sc;
+  const std::vector<TaskSpec> tasks{
+      TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
+      TaskSpec::volume(1, TransferFunction::preset("s-wave", 2), ValueWindow::absolute(0, 0.9)),
+      TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
+                        TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 0.9)),
+      TaskSpec::volume(0, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1)),
+  };
+  std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  RenderOptions opt;
+  opt.adaptive = true;
+  opt.sample_distance = 1.0;
+  for (const auto& cam : kCams) {
+    std::vector<PartialImage> together(tasks.size());
+    const RenderStats st = render_brick(cam, fields, tasks, together, opt);
+    EXPECT_GT(st.interpolated_pixels, 0u);
+    std::uint64_t separate_marched = 0;
+    for (std::size_t t = 0; t < tasks.size(); ++t) {
+      std::vector<PartialImage> one(1);
+      separate_marched += render_brick(cam, fields, std::span(&tasks[t], 1), one, opt).marched_samples;
+      EXPECT_EQ(one[0].rgba, together[t].rgba) << "task " << t;
+      EXPECT_EQ(one[0].depth, together[t].depth) << "task " << t;
+    }
+    EXPECT_LT(st.marched_samples, separate_marched);
+  }
+}
+
 TEST(Compositing, EmptySpaceSkippingDoesNotChangeImagesAndSkips) {
   const Scene sc;
   const auto& cam = kCams[1];

@@ -596,10 +596,12 @@ std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::in
   return kend + 1;
 }
 
-// Marches one ray through the brick for all march tasks; fills acc[i] (premultiplied) per task.
+// Marches one ray through the brick for the march tasks in `tasks`; fills acc[i] (premultiplied) per task.
 // Returns the effective and marched sample counts through the references.
 void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3& dir, double t0, double tg1,
-               double tb0, double tb1, float (*acc)[4], std::uint64_t& effective, std::uint64_t& marched) {
+               double tb0, double tb1, std::uint64_t tasks, float (*acc)[4], std::uint64_t& effective,
+               std::uint64_t& marched) {
+  const std::uint64_t mm = S.march_mask & tasks;  // the march tasks of this ray
   const double dt = S.dt;
   const Brick& B = S.brick;
   const std::int64_t kg_last = std::int64_t(std::ceil((tg1 - t0) / dt)) - 1;
@@ -622,7 +624,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   effective += std::uint64_t(ke - ks + 1);
   // During the march acc[i][3] holds the TRANSMITTANCE T = 1 − α: the loop-carried chain per
   // sample is then one multiply, T ← T·(1 − α_s), and colour accumulates as C ← C + T·c_s·α_s.
-  for (std::uint64_t m = S.march_mask; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
+  for (std::uint64_t m = mm; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
   FieldAcc fa[8];  // local copies: no aliasing with the accumulators, so no reloads per sample
   for (std::size_t s = 0; s < S.acc.size(); ++s) fa[s] = S.acc[s];
   // The last sample of the ray in the whole domain stands for a shorter segment.
@@ -636,7 +638,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     }
   }
 
-  std::uint64_t live = S.march_mask;
+  std::uint64_t live = mm;
   // vb[s][0] holds slot s's value at the sample before the current block, vb[s][1 + l] the block's
   // values; prev_valid: slots whose vb[s][0] is that previous sample (isosurface crossings need it).
   alignas(32) float vb[8][2 * kBlock];
@@ -822,8 +824,8 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     if (clear) {
       // One run over the whole ray: the samples and their order are those of the merged walk, so
       // images are the same bits; `safe` = false only means clamped indices (same bits, see interp()).
-      run(ks, ke, S.march_mask, false);
-      for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
+      run(ks, ke, mm, false);
+      for (std::uint64_t m = mm; m; m &= m - 1) {
         float* a = acc[std::countr_zero(m)];
         a[3] = 1.0f - a[3];
       }
@@ -938,7 +940,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
     tenter = texit;
   }
   if (queued) flush(false);
-  for (std::uint64_t m = S.march_mask; m; m &= m - 1) {
+  for (std::uint64_t m = mm; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
   }
@@ -1190,6 +1192,12 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   if (opt.adaptive && !(opt.adaptive_tolerance >= 0))
     throw Error("render: adaptive tolerance " + std::to_string(opt.adaptive_tolerance) + "; expected >= 0");
   std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0, n_interpolated = 0;
+  const std::uint64_t all_tasks = K == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << K) - 1;
+  // Adaptive sampling: isosurfaces and slices are refined wherever any task is (their edges are thin).
+  std::uint64_t edge_tasks = 0;
+  for (int i = 0; i < K; ++i)
+    if (S.rt[std::size_t(i)].kind == RtKind::iso || S.rt[std::size_t(i)].kind == RtKind::slice)
+      edge_tasks |= std::uint64_t(1) << i;
 
   // Where the ray of pixel (x, y) meets the domain and the brick; false when it misses the brick.
   struct PixelRay {
@@ -1223,10 +1231,13 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     return true;
   };
   // Marches a located ray for every task and writes pixel (x, y) of every image.
-  auto shade = [&](int x, int y, const PixelRay& r, float (*acc)[4], std::uint64_t& eff, std::uint64_t& marched) {
+  // Marches a located ray for the tasks in `tasks` and writes their pixel (x, y); every image's depth.
+  auto shade = [&](int x, int y, const PixelRay& r, std::uint64_t tasks, float (*acc)[4], std::uint64_t& eff,
+                   std::uint64_t& marched) {
     for (int i = 0; i < K; ++i) acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
-    if (S.march_mask) march_ray(S, r.O, r.D, r.dir, r.t0, r.tg1, r.tb0, r.tb1, acc, eff, marched);
+    if (S.march_mask & tasks) march_ray(S, r.O, r.D, r.dir, r.t0, r.tg1, r.tb0, r.tb1, tasks, acc, eff, marched);
     for (int i : S.slices) {
+      if (!(tasks >> i & 1)) continue;
       const TaskRt& rt = S.rt[std::size_t(i)];
       const int a = rt.axis;
       if (r.D[a] == 0) continue;
@@ -1244,8 +1255,10 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
     for (int i = 0; i < K; ++i) {
       PartialImage& o = out[std::size_t(i)];
-      float* dst = o.rgba_at(x, y);
-      dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
+      if (tasks >> i & 1) {
+        float* dst = o.rgba_at(x, y);
+        dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
+      }
       o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = r.depth;
     }
   };
@@ -1264,26 +1277,28 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
           for (int x = tx0; x < tx1; ++x) {
             if (!locate(x, y, r)) continue;
             ++n_rays;
-            shade(x, y, r, acc, n_eff, n_marched);
+            shade(x, y, r, all_tasks, acc, n_eff, n_marched);
           }
         continue;
       }
-      auto march = [&](int x, int y) {
+      auto march = [&](int x, int y, std::uint64_t tasks) {
         if (locate(x, y, r)) {
           ++n_rays;
-          shade(x, y, r, acc, n_eff, n_marched);
+          shade(x, y, r, tasks, acc, n_eff, n_marched);
           return;
         }
         for (int i = 0; i < K; ++i) {  // a pixel interpolated earlier may be re-marched
           PartialImage& o = out[std::size_t(i)];
-          float* dst = o.rgba_at(x, y);
-          dst[0] = dst[1] = dst[2] = dst[3] = 0;
+          if (tasks >> i & 1) {
+            float* dst = o.rgba_at(x, y);
+            dst[0] = dst[1] = dst[2] = dst[3] = 0;
+          }
           o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = PartialImage::kNoDepth;
         }
       };
       auto depth_of = [&](int x, int y) { return locate(x, y, r) ? r.depth : PartialImage::kNoDepth; };
       const std::uint64_t before = refiner.interpolated();
-      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of);
+      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks);
       n_interpolated += refiner.interpolated() - before;
     }
   }
