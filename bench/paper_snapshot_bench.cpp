@@ -9,7 +9,9 @@
 //                        (p volume, s volume, p+s), 920x896, encode included. Target: <= 40 s wall.
 //   BM_ManyImages        one march, many images on the same dense scene, 2 Yin-Yang cameras: the K-task
 //                        mix and its single task are rendered alternately, so the ratio is measured side
-//                        by side. Targets: paper3 <= 1.5x, tf10 <= 3x, iso8 <= 2x.
+//                        by side. Targets: paper3 <= 1.5x, tf10 <= 3x, iso8 <= 2x. marched_K / marched_one:
+//                        the part of the ratio due to the K-task march going further.
+//   BM_ManyImagesPaperOptions  mixes 0 and 1 at examples/paper.toml's options (1.0 voxel, adaptive sampling).
 //   BM_ParaViewAnchor    128x256x80 float32 dense volume, 8 cameras at 1.1x the diagonal, 920x896, one
 //                        volume task: CPU-seconds per image next to ParaView 5.11 "Ray Cast Only"'s 1.46.
 //   BM_DemoAdaptive      examples/demo.toml's snapshot at step 240 through the in-situ session with adaptive
