@@ -513,6 +513,31 @@ inline int composite_volume1(const VolRow* lut, const int* bin, int n, std::int6
   return composite_volume1_scalar(lut, bin, n, k0, k_partial, partial, tr_stop, c0, c1, c2, tr);
 }
 
+// composite_volume1() on an accumulator row a = {c0, c1, c2, tr} in memory (the general path: one
+// 16-byte load and store per task and block instead of three scalar inserts and extracts). Lane 3 of
+// the colour vector starts at tr and collects junk; lanes 0–2 see the same operations, so the same bits.
+inline int composite_volume1_row(const VolRow* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
+                                 float partial, float tr_stop, float* a) {
+#ifdef PANOPTES_RENDER_AVX2
+  if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
+    __m128 c = _mm_load_ps(a);
+    __m128 t = _mm_broadcast_ss(a + 3);
+    for (int l = 0; l < n; ++l) {
+      const __m128 r = _mm_load_ps(&row_at(lut, bin[l]).pr);
+      c = _mm_fmadd_ps(t, r, c);
+      t = _mm_mul_ps(t, _mm_permute_ps(r, 0xFF));
+    }
+    const float tr = _mm_cvtss_f32(t);
+    if (tr > tr_stop) [[likely]] {
+      _mm_store_ps(a, c);
+      a[3] = tr;
+      return -1;
+    }
+  }
+#endif
+  return composite_volume1_scalar(lut, bin, n, k0, k_partial, partial, tr_stop, a[0], a[1], a[2], a[3]);
+}
+
 // The same for a two-field volume task (extinctions add, colours mix by extinction): per sample
 // α = 1 − (1 − α1)(1 − α2) and colour (τ1·c1 + τ2·c2)·α/(τ1 + τ2). Rows of MixEntry hold τ·rgb, τ and
 // 1 − α, so the numerator and τ are one 4-lane add of the two rows, and no per-sample branch is left:
@@ -549,7 +574,7 @@ inline int composite_volume2(const MixEntry* m1, const MixEntry* m2, const int* 
   // As composite_volume1(): the colour accumulated as a 4-lane vector (the same operations as the
   // scalar loop, so the same bits; lane 3 collects s·τ, unused), termination tested once per block.
   if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
-    __m128 c = _mm_setr_ps(a[0], a[1], a[2], 0.0f);
+    __m128 c = _mm_load_ps(a);  // lane 3 (tr) collects junk, as in composite_volume1_row()
     float tr = a[3];
     for (int l = 0; l < n; ++l) {
       const MixEntry& e1 = row_at(m1, bin1[l]);
@@ -561,9 +586,8 @@ inline int composite_volume2(const MixEntry* m1, const MixEntry* m2, const int* 
       tr = tr * om;
     }
     if (tr > tr_stop) [[likely]] {
-      alignas(16) float cc[4];
-      _mm_store_ps(cc, c);
-      a[0] = cc[0], a[1] = cc[1], a[2] = cc[2], a[3] = tr;
+      _mm_store_ps(a, c);
+      a[3] = tr;
       return -1;
     }
   }
@@ -730,7 +754,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
           case RtKind::volume1: {
             alignas(32) int bin[kBlock];
             lut_bin_block<kRowShift>(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin);
-            stop = composite_volume1(T.row1, bin, n, k0, k_partial, partial, tr_stop, a[0], a[1], a[2], a[3]);
+            stop = composite_volume1_row(T.row1, bin, n, k0, k_partial, partial, tr_stop, a);
             break;
           }
           case RtKind::volume2: {
