@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "render/iso_shading.hpp"
 
 namespace panoptes::render {
 
@@ -46,12 +47,17 @@ void render_reference(const camera::Camera& cam, std::span<const FieldView> fiel
   std::vector<TransferLut> l1(tasks.size()), l2(tasks.size());
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     const TaskSpec& t = tasks[i];
-    if (t.kind != TaskKind::volume) throw Error("reference renderer: only volume tasks are supported");
+    if (t.kind != TaskKind::volume && t.kind != TaskKind::isosurface)
+      throw Error("reference renderer: only volume and isosurface tasks are supported");
     auto check = [&](int f) {
       if (f < 0 || std::size_t(f) >= fields.size())
         throw Error("reference renderer: task refers to field " + std::to_string(f));
     };
     check(t.field);
+    if (t.kind == TaskKind::isosurface) {
+      if (!std::isfinite(t.isovalue)) throw Error("reference renderer: isovalue is not finite");
+      continue;
+    }
     l1[i] = TransferLut(t.tf, t.window.resolve(t.reference), opt.sample_distance);
     if (t.field2 >= 0) {
       check(t.field2);
@@ -90,6 +96,33 @@ void render_reference(const camera::Camera& cam, std::span<const FieldView> fiel
       const float s[3] = {float(dt * D[0]), float(dt * D[1]), float(dt * D[2])};
       for (std::size_t i = 0; i < tasks.size(); ++i) {
         const TaskSpec& t = tasks[i];
+        if (t.kind == TaskKind::isosurface) {
+          // The first segment (sample k − 1 … k) whose ends lie on different sides of the isovalue:
+          // linear estimate, one regula-falsi step, then the pre-issue-10 shading.
+          const FieldView& f = fields[std::size_t(t.field)];
+          const float iso = t.isovalue;
+          float prev = sample(f, b[0], b[1], b[2]);
+          float* dst = out[i].rgba_at(x, y);
+          for (std::int64_t k = 1; k <= last; ++k) {
+            const float fk = float(k);
+            const float v = sample(f, b[0] + fk * s[0], b[1] + fk * s[1], b[2] + fk * s[2]);
+            if ((prev - iso < 0) != (v - iso < 0)) {
+              double ta = t0 + double(k - 1) * dt, tb = ta + dt;
+              double dpa = prev - iso, dpb = v - iso;
+              double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+              const double vh = sample(f, float(O[0] + th * D[0]), float(O[1] + th * D[1]), float(O[2] + th * D[2])) - iso;
+              if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+              else tb = th, dpb = vh;
+              if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+              const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+              shade_isosurface_hit(f, ph, ray.direction, t.surface_colour, false, dst);
+              break;
+            }
+            prev = v;
+          }
+          out[i].depth[std::size_t(y) * W + x] = float(t0);
+          continue;
+        }
         float c[3] = {0, 0, 0}, tr = 1;
         for (std::int64_t k = 0; k <= last; ++k) {
           const float fk = float(k);

@@ -1,0 +1,18 @@
+#pragma once
+// Isosurface hit shading on a field view: the renderer's evaluation and the scalar formula it used
+// before issue 10, side by side for tests and for the reference renderer.
+#include "core/vec3.hpp"
+#include "render/field_view.hpp"
+#include "render/renderer.hpp"
+
+namespace panoptes::render {
+
+/// Lit, opaque RGBA (alpha 1) of an isosurface hit at index-space position p of v's grid, seen along
+/// world direction dir: gradient by central differences (±0.5 voxel, one-sided at the domain's
+/// faces), two-sided headlight diffuse 0.15 + 0.85·|n·l| plus specular 0.25·|n·l|^32.
+/// `renderer` = true: the renderer's evaluation (the six interpolations as one 8-lane gather,
+/// |n·l|^32 by squarings); false: the pre-issue-10 scalar formula (six interpolations, std::pow).
+void shade_isosurface_hit(const FieldView& v, const double p[3], const Vec3& dir, Rgb colour, bool renderer,
+                          float rgba[4]);
+
+}  // namespace panoptes::render
