@@ -10,7 +10,9 @@
 //   BM_ManyImages        one march, many images on the same dense scene, 2 Yin-Yang cameras: the K-task
 //                        mix and its single task are rendered alternately, so the ratio is measured side
 //                        by side. Targets: paper3 <= 1.5x, tf10 <= 3x, iso8 <= 2x. marched_K / marched_one:
-//                        the part of the ratio due to the K-task march going further.
+//                        the part of the ratio due to the K-task march going further. Also the same K
+//                        images by K separate marches (K_over_separate), samples marched per ray
+//                        (one, K, separate) and, for isosurfaces, hits per ray of the K images.
 //   BM_ManyImagesPaperOptions  mixes 0 and 1 at examples/paper.toml's options (1.0 voxel, adaptive sampling).
 //   BM_ParaViewAnchor    128x256x80 float32 dense volume, 8 cameras at 1.1x the diagonal, 920x896, one
 //                        volume task: CPU-seconds per image next to ParaView 5.11 "Ray Cast Only"'s 1.46.
@@ -213,6 +215,8 @@ void many_images(benchmark::State& state, const RenderOptions& opt) {
   double cpu1 = 0, cpuk = 0;
   RenderStats st1, stk;  // samples marched: how much further the K-task march goes
   double hits_k = 0;      // pixels (over all K images) whose ray hit its surface
+  std::vector<PartialImage> sep(many.size());
+  double cpus = 0, sep_marched = 0;
   const int cams[] = {12, 77};
   for (auto _ : state)
     for (int c : cams) {
@@ -225,6 +229,13 @@ void many_images(benchmark::State& state, const RenderOptions& opt) {
       cpuk += cpu_seconds() - c0;
       st1.rays += s1.rays, st1.marched_samples += s1.marched_samples;
       stk.rays += sk.rays, stk.marched_samples += sk.marched_samples;
+      // The same K images by K separate marches: what the shared march saves.
+      c0 = cpu_seconds();
+      for (std::size_t t = 0; t < many.size(); ++t) {
+        const RenderStats s = render_brick(cam, sc.fields, std::span(&many[t], 1), std::span(&sep[t], 1));
+        sep_marched += double(s.marched_samples);
+      }
+      cpus += cpu_seconds() - c0;
       for (const PartialImage& o : outk)
         for (std::size_t q = 3; q < o.rgba.size(); q += 4) hits_k += o.rgba[q] > 0;
     }
@@ -234,6 +245,9 @@ void many_images(benchmark::State& state, const RenderOptions& opt) {
   state.counters["cpu_s_K"] = cpuk / n;
   state.counters["marched_per_ray_one"] = double(st1.marched_samples) / double(std::max<std::uint64_t>(1, st1.rays));
   state.counters["marched_per_ray_K"] = double(stk.marched_samples) / double(std::max<std::uint64_t>(1, stk.rays));
+  state.counters["cpu_s_separate"] = cpus / n;
+  state.counters["K_over_separate"] = cpuk / cpus;
+  state.counters["marched_per_ray_separate"] = sep_marched / double(std::max<std::uint64_t>(1, stk.rays));
   state.counters["hits_per_ray_K"] = hits_k / double(std::max<std::uint64_t>(1, stk.rays));
   state.counters["K_over_one"] = cpuk / cpu1;  // targets: paper3 <= 1.5, tf10 <= 3, iso8 <= 2
   state.counters["marched_one"] = double(st1.marched_samples) / n;
