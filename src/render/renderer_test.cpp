@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "render/iso_shading.hpp"
@@ -291,4 +292,5 @@ TEST(Renderer, IsosurfaceHitShadingMatchesTheScalarFormula) {
   EXPECT_GT(faces, 100);
   // The same interpolated values; only |n·l|^32 rounds differently (a few ulps of a double).
   EXPECT_LE(worst, 1e-6);
+  std::printf("hit shading: renderer vs scalar formula, worst channel difference %.3g\n", worst);
 }
