@@ -232,7 +232,7 @@ void many_images(benchmark::State& state, const RenderOptions& opt) {
       // The same K images by K separate marches: what the shared march saves.
       c0 = cpu_seconds();
       for (std::size_t t = 0; t < many.size(); ++t) {
-        const RenderStats s = render_brick(cam, sc.fields, std::span(&many[t], 1), std::span(&sep[t], 1));
+        const RenderStats s = render_brick(cam, sc.fields, std::span(&many[t], 1), std::span(&sep[t], 1), opt);
         sep_marched += double(s.marched_samples);
       }
       cpus += cpu_seconds() - c0;
