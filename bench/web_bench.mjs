@@ -19,7 +19,16 @@ const pct = (a, p) => { const s = [...a].sort((x, y) => x - y); return s[Math.mi
 async function run(browser, prefetch, extra = "") {
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 900 });
-  const t0 = Date.now();
+  // WEB_BENCH_VERBOSE: long animation frames (> 50 ms, with the scripts that ran in them) are matched
+  // to the slow switches.
+  if (process.env.WEB_BENCH_VERBOSE)
+    await page.evaluateOnNewDocument(() => {
+      window.__loaf = [];
+      try {
+        new PerformanceObserver((l) => { for (const e of l.getEntries()) window.__loaf.push({ start: e.startTime, duration: e.duration, blocking: e.blockingDuration, render: e.renderStart, scripts: e.scripts.map((x) => `${x.invoker}:${x.sourceFunctionName}@${(x.sourceURL || "").split("/").pop()} ${x.duration.toFixed(0)}ms`) }); })
+          .observe({ type: "long-animation-frame", buffered: true });
+      } catch { /* not supported */ }
+    });
   await page.goto(url + `?play=1&fps=30&prefetch=${prefetch ? 1 : 0}${process.env.WEB_BENCH_QUERY || ""}${extra}`);
   await page.waitForFunction(() => window.panoptes && window.panoptes.firstFrameMs() !== null, { timeout: 30000 });
   const firstFrame = await page.evaluate(() => window.panoptes.firstFrameMs());  // since navigation start
@@ -32,12 +41,18 @@ async function run(browser, prefetch, extra = "") {
   }
   const after = await page.evaluate(() => window.panoptes.traffic());
   const switches = await page.evaluate(() => window.panoptes.switches());
+  const loaf = process.env.WEB_BENCH_VERBOSE ? await page.evaluate(() => window.__loaf || []) : [];
   const settings = await page.evaluate(() => { const o = window.panoptes.options; return `nbdecode=${o.nbDecode} nbstride=${o.nbStride}`; });
   await page.close();
   if (process.env.WEB_BENCH_VERBOSE) {
     const d = (k) => after[k] - before[k], b = Math.max(1, d("batches"));
-    console.error(`batches ${d("batches")} frames ${d("frames")} per request: fetch ${(d("fetchMs") / Math.max(1, d("requests"))).toFixed(1)} ms; per batch: decode ${(d("decodeMs") / b).toFixed(1)} ms`);
+    console.error(`batches ${d("batches")} frames ${d("frames")} per request: fetch ${(d("fetchMs") / Math.max(1, d("requests"))).toFixed(1)} ms; per batch: decode ${(d("decodeMs") / b).toFixed(1)} ms; main thread: demux ${d("demuxMs").toFixed(0)} ms, decoder outputs ${d("outputMs").toFixed(0)} ms`);
   }
+  if (process.env.WEB_BENCH_VERBOSE)
+    for (const s of switches) if (s.hit && s.ms > 25) {
+      const frames = loaf.filter((e) => e.start < s.diag.at + s.ms && e.start + e.duration > s.diag.at);
+      console.error(`slow ${s.command} ms=${s.ms.toFixed(1)} ${JSON.stringify(s.diag)} loaf=${JSON.stringify(frames)}`);
+    }
   if (process.env.WEB_BENCH_VERBOSE)
     for (const s of switches) if (!s.hit) console.error(`miss ${s.command} ${s.from}->${s.to} ms=${s.ms === null ? "superseded" : s.ms.toFixed(1)} lag=${s.lag} ${JSON.stringify(s.diag)}`);
   // WEB_BENCH_DUMP=FILE appends every switch of the run as a JSON line (pooling runs of separate invocations).

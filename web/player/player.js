@@ -27,6 +27,9 @@ const options = {
   switchBatch: Number(params.get("switchbatch") || 1),  // the first batch of a switch's new stream: its first frame alone
   fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
   warmTasks: params.get("warmtasks") !== "0",  // fetch ahead the graph neighbours of the task neighbours
+  // Until a switch is on screen the pump serves the new current stream only: the new neighbours'
+  // decodes start at the display frame that shows the switch, not in the key's handler.
+  switchFirst: params.get("switchfirst") === "1",
 };
 
 const canvas = document.getElementById("view");
@@ -149,13 +152,18 @@ function select(camera, task, command) {
     warm: !!(st && st.decoder && st.decoder.state === "configured"),
     maxTickGap: 0,
   };
-  S.pending = { t0: performance.now(), command, from: [S.camera, S.task], diag };
+  const t0 = performance.now();
+  diag.keyQueuedMs = lastKeyEvent ? t0 - lastKeyEvent : 0;
+  diag.at = t0;
+  // demux0, output0: main-thread time on demuxing and decoder outputs from the key to the first display frame.
+  S.pending = { t0, command, from: [S.camera, S.task], diag, demux0: traffic.demuxMs, output0: traffic.outputMs };
   const old = streams.get(`${S.camera}/${S.task}`);
   if (options.nbDecode === "switch" && options.abortOnSwitch && S.playing && old && old.status === "ok" && old.intraOnly()) old.abortDecodes();
   S.camera = camera;
   S.task = task;
   releaseDecoders();
   pump();
+  diag.selectMs = performance.now() - t0;
   return true;
 }
 
@@ -223,7 +231,7 @@ function pump() {
   const f = currentFrame();
   const hot = [[S.camera, S.task, S.playing ? options.ahead : 1, options.batch, 1]];
   // Until the first frame is on screen the current stream has the connections and the decoder to itself.
-  const nb = options.prefetch && S.firstFrameMs !== null ? neighbourSelections(S.camera, S.task) : [];
+  const nb = options.prefetch && S.firstFrameMs !== null && !(options.switchFirst && S.pending) ? neighbourSelections(S.camera, S.task) : [];
   // While playing, a neighbour of keyframes only (gop 1) is decoded at every stride-th frame: a switch
   // then shows, on the next display frame, the new stream's frame at most stride - 1 frames behind
   // the playhead (at 30 fps, 33 ms of simulated time for stride 2) and the frames after it in step.
@@ -329,6 +337,13 @@ function tick(now) {
   let drawn = false, status = "ok", shownFrame = frame;
   // A switch counts as a hit when the first display frame after the key shows the new stream.
   const firstTickAfterSwitch = S.pending !== null && !S.pending.seen;
+  if (S.pending && !S.pending.seen) {
+    const d = S.pending.diag, t = performance.now();
+    d.frameTimeMs = now - S.pending.t0;  // the display frame's begin time, after the key
+    d.firstTickMs = t - S.pending.t0;  // when its rAF callback ran
+    d.demuxMs = traffic.demuxMs - S.pending.demux0;
+    d.outputMs = traffic.outputMs - S.pending.output0;
+  }
   if (S.pending) S.pending.seen = true;
   if (!same) {
     const vf = cache.get(key);
@@ -496,8 +511,10 @@ const actions = {
   h: () => document.getElementById("help").classList.toggle("hidden"),
 };
 for (let k = 1; k <= 9; k++) actions[String(k)] = () => select(S.camera, k - 1, `task ${k}`);
+let lastKeyEvent = 0;  // the key's event time (diagnostics: how long it waited for the main thread)
 document.addEventListener("keydown", (e) => {
   if (!S.db) return;
+  lastKeyEvent = e.timeStamp;
   const action = actions[e.key] ?? actions[e.key.toLowerCase()];
   if (!action || e.ctrlKey || e.metaKey || e.altKey) return;
   e.preventDefault();
