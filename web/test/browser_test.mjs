@@ -282,6 +282,37 @@ await check("live database: new frames of a running simulation play without a re
   await page.close();
 });
 
+await check("fragments read by fragmentSamples equal mp4box.js's samples (gop 4 and gop 1)", async () => {
+  // Node side: the exported site's player modules (movies.js reads location.search at load).
+  globalThis.location = { search: "" };
+  const { fragmentSamples } = await import(path.join(siteDir, "movies.js"));
+  const { createFile, MP4BoxBuffer } = await import(path.join(siteDir, "vendor/mp4box/mp4box.all.mjs"));
+  const cases = [[fs.readFileSync(path.join(siteDir, "db/movies/c0/t0.mp4")), JSON.parse(fs.readFileSync(path.join(siteDir, "api/index/0/0.json"), "utf8")), 4],
+                 [fs.readFileSync(path.join(liveDir, "movies/c0/t0.mp4")), await (await fetch(liveUrl + "api/index/0/0.json")).json(), 1]];
+  for (const [file, index, gop] of cases) {
+    const ab = file.buffer.slice(file.byteOffset, file.byteOffset + file.byteLength), f = index.fragments;
+    assert.ok(f.length >= 4, `gop ${gop}: ${f.length} fragments`);
+    for (const [a, b] of [[0, f.length], [1, 3], [f.length - 1, f.length]]) {
+      const bytes = ab.slice(f[a][0], f[b - 1][0] + f[b - 1][1]);
+      const mp4 = createFile(), ref = [];
+      mp4.onReady = (i) => { mp4.setExtractionOptions(i.videoTracks[0].id, null, { nbSamples: 100000 }); mp4.start(); };
+      mp4.onSamples = (_id, _user, s) => ref.push(...s);
+      mp4.appendBuffer(MP4BoxBuffer.fromArrayBuffer(ab.slice(0, index.init_size), 0));
+      mp4.appendBuffer(MP4BoxBuffer.fromArrayBuffer(bytes, index.init_size));
+      mp4.flush();
+      const own = fragmentSamples(bytes);
+      assert.equal(own.length, ref.length, `gop ${gop}, fragments ${a}..${b - 1}: sample count`);
+      own.forEach((x, i) => {
+        assert.equal(x.key, ref[i].is_sync, `gop ${gop}, fragments ${a}..${b - 1}, sample ${i}: keyframe flag`);
+        assert.ok(Buffer.from(x.data).equals(Buffer.from(ref[i].data)), `gop ${gop}, fragments ${a}..${b - 1}, sample ${i}: bytes`);
+      });
+      assert.equal(own.filter((x) => x.key).length, b - a, `gop ${gop}: one keyframe per fragment`);
+    }
+    // A range cut short is refused with the reason, never read past its end.
+    assert.throws(() => fragmentSamples(ab.slice(f[0][0], f[0][0] + f[0][1] - 1)), /outside its mdat|past the end/);
+  }
+});
+
 await browser.close();
 staticServer.close();
 if (failures) {
