@@ -8,7 +8,7 @@ const INIT_GUESS = 2048;
 const ownDemux = new URLSearchParams(location.search).get("demux") !== "mp4box";  // bytes fetched with the fragment index, before init_size is known
 
 /// Byte and request counters (the benchmark reports bytes fetched per switch).
-export const traffic = { bytes: 0, requests: 0, batches: 0, fetchMs: 0, demuxMs: 0, decodeMs: 0, frames: 0, outputMs: 0 };
+export const traffic = { bytes: 0, requests: 0, batches: 0, fetchMs: 0, demuxMs: 0, decodeMs: 0, frames: 0, outputMs: 0, warmMs: 0, warms: 0 };
 
 /// When each step of opening the player first happened (performance.now() ms since navigation start):
 /// the benchmark's breakdown of the time to the first frame.
@@ -361,6 +361,7 @@ export class Stream {
   /// decode, not the decoder's set-up as well.
   warm(cache) {
     if (this.status !== "ok" || (this.decoder && this.decoder.state !== "closed")) return;
+    const t0 = performance.now();
     this.decoder = new VideoDecoder({
       output: (vf) => {
         const t = performance.now();
@@ -370,6 +371,8 @@ export class Stream {
       error: (e) => { this.decodeError = e; },
     });
     this.decoder.configure(this.config);
+    traffic.warmMs += performance.now() - t0;
+    traffic.warms++;
   }
 
   /// Drops the decodes queued on the stream's decoder and configures it again: a switch away from a

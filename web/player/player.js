@@ -28,8 +28,10 @@ const options = {
   fetchAhead: Number(params.get("fetchahead") || 16),  // frames past the playhead whose bytes are fetched
   warmTasks: params.get("warmtasks") !== "0",  // fetch ahead the graph neighbours of the task neighbours
   // Until a switch is on screen the pump serves the new current stream only: the new neighbours'
-  // decodes start at the display frame that shows the switch, not in the key's handler.
-  switchFirst: params.get("switchfirst") === "1",
+  // decoders are created and their decodes started at the display frame that shows the switch, not
+  // between the key and that frame (~3 decoders per switch, up to 11 ms of main thread; docs/web.md round 5).
+  switchFirst: params.get("switchfirst") !== "0",
+  releaseOnKey: params.get("release") === "key",  // close cold decoders in the key's handler (before round 5)
 };
 
 const canvas = document.getElementById("view");
@@ -155,15 +157,22 @@ function select(camera, task, command) {
   const t0 = performance.now();
   diag.keyQueuedMs = lastKeyEvent ? t0 - lastKeyEvent : 0;
   diag.at = t0;
-  // demux0, output0: main-thread time on demuxing and decoder outputs from the key to the first display frame.
-  S.pending = { t0, command, from: [S.camera, S.task], diag, demux0: traffic.demuxMs, output0: traffic.outputMs };
+  // demux0, output0, warm0: main-thread time on demuxing, decoder outputs and decoder creation from the key to the first display frame.
+  S.pending = { t0, command, from: [S.camera, S.task], diag, demux0: traffic.demuxMs, output0: traffic.outputMs, warm0: traffic.warmMs, warms0: traffic.warms };
   const old = streams.get(`${S.camera}/${S.task}`);
   if (options.nbDecode === "switch" && options.abortOnSwitch && S.playing && old && old.status === "ok" && old.intraOnly()) old.abortDecodes();
   S.camera = camera;
   S.task = task;
-  releaseDecoders();
+  // Closing a VideoDecoder costs the main thread several ms (5 of them took 35 ms of a switch's key
+  // handler at load 14): done after the switch is drawn, one per display frame (tick), unless
+  // ?release=key (the old place, for comparison).
+  const closed = options.releaseOnKey ? releaseDecoders() : 0;
+  S.releaseDue = true;
+  const t1 = performance.now();
   pump();
   diag.selectMs = performance.now() - t0;
+  diag.releaseMs = t1 - t0;
+  diag.closed = closed;
   return true;
 }
 
@@ -212,9 +221,14 @@ function startBatch(c, t, g, batch, stride = 1) {
 /// Closes the VideoDecoder of every stream that is neither current nor a neighbour any more and has
 /// no decode in flight (a decoder holds threads and buffers; 96 streams may be open). A stream that
 /// becomes hot again configures a new one.
-function releaseDecoders() {
+function releaseDecoders(max = Infinity) {
   const hot = new Set([`${S.camera}/${S.task}`, ...neighbourSelections(S.camera, S.task).map(([c, t]) => `${c}/${t}`)]);
-  for (const [key, st] of streams) if (!hot.has(key) && st.decoder && st.inflight.size === 0) st.close();
+  let closed = 0;
+  for (const [key, st] of streams) {
+    if (closed >= max) break;
+    if (!hot.has(key) && st.decoder && st.decoder.state !== "closed" && st.inflight.size === 0) { st.close(); closed++; }
+  }
+  return closed;
 }
 /// The streams a task switch makes neighbours: the graph neighbours of the current camera in the
 /// task-neighbour tasks (after Tab they all become neighbours at once, which was round 2's tail).
@@ -343,6 +357,8 @@ function tick(now) {
     d.firstTickMs = t - S.pending.t0;  // when its rAF callback ran
     d.demuxMs = traffic.demuxMs - S.pending.demux0;
     d.outputMs = traffic.outputMs - S.pending.output0;
+    d.warmMs = traffic.warmMs - S.pending.warm0;  // decoders created and configured meanwhile
+    d.warms = traffic.warms - S.pending.warms0;
   }
   if (S.pending) S.pending.seen = true;
   if (!same) {
@@ -389,6 +405,8 @@ function tick(now) {
     drawMinimap();
   }
   pump();
+  // The decoders a switch left cold, closed one per display frame once the switch is on screen.
+  if (S.releaseDue && !S.pending) S.releaseDue = releaseDecoders(1) > 0;
   updateHud(frame);
 }
 
