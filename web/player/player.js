@@ -155,7 +155,8 @@ function select(camera, task, command) {
     maxTickGap: 0,
   };
   const t0 = performance.now();
-  diag.keyQueuedMs = lastKeyEvent ? t0 - lastKeyEvent : 0;
+  diag.keyQueuedMs = lastKeyEvent ? t0 - lastKeyEvent : 0;  // 0 for a drag, a click or the API
+  lastKeyEvent = 0;
   diag.at = t0;
   // demux0, output0, warm0: main-thread time on demuxing, decoder outputs and decoder creation from the key to the first display frame.
   S.pending = { t0, command, from: [S.camera, S.task], diag, demux0: traffic.demuxMs, output0: traffic.outputMs, warm0: traffic.warmMs, warms0: traffic.warms };
@@ -244,7 +245,8 @@ function pump() {
   if (!S.db) return;
   const f = currentFrame();
   const hot = [[S.camera, S.task, S.playing ? options.ahead : 1, options.batch, 1]];
-  // Until the first frame is on screen the current stream has the connections and the decoder to itself.
+  // Until the first frame is on screen the current stream has the connections and the decoder to
+  // itself; so it has, with switchFirst, until a switch's first frame is on screen.
   const nb = options.prefetch && S.firstFrameMs !== null && !(options.switchFirst && S.pending) ? neighbourSelections(S.camera, S.task) : [];
   // While playing, a neighbour of keyframes only (gop 1) is decoded at every stride-th frame: a switch
   // then shows, on the next display frame, the new stream's frame at most stride - 1 frames behind
