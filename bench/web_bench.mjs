@@ -46,7 +46,7 @@ async function run(browser, prefetch, extra = "") {
   await page.close();
   if (process.env.WEB_BENCH_VERBOSE) {
     const d = (k) => after[k] - before[k], b = Math.max(1, d("batches"));
-    console.error(`batches ${d("batches")} frames ${d("frames")} per request: fetch ${(d("fetchMs") / Math.max(1, d("requests"))).toFixed(1)} ms; per batch: decode ${(d("decodeMs") / b).toFixed(1)} ms; main thread: demux ${d("demuxMs").toFixed(0)} ms, decoder outputs ${d("outputMs").toFixed(0)} ms`);
+    console.error(`batches ${d("batches")} frames ${d("frames")} per request: fetch ${(d("fetchMs") / Math.max(1, d("requests"))).toFixed(1)} ms; per batch: decode ${(d("decodeMs") / b).toFixed(1)} ms; main thread: demux ${d("demuxMs").toFixed(0)} ms, decoder outputs ${d("outputMs").toFixed(0)} ms, decoders created ${d("warms")}, reused ${d("reused")}`);
   }
   if (process.env.WEB_BENCH_VERBOSE)
     for (const s of switches) if (s.hit && s.ms > 25) {

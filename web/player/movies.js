@@ -5,10 +5,17 @@ import { createFile, DataStream, Endianness, MP4BoxBuffer } from "./vendor/mp4bo
 
 const MAX_FRAGMENTS_PER_STREAM = 256;
 const INIT_GUESS = 2048;
-const ownDemux = new URLSearchParams(location.search).get("demux") !== "mp4box";  // bytes fetched with the fragment index, before init_size is known
+const ownDemux = new URLSearchParams(location.search).get("demux") !== "mp4box";
+// Configured VideoDecoders of streams gone cold, by configuration (codec, size, avcC bytes), for the
+// next stream that needs one: a switch makes ~4.6 streams cold and ~3 hot, and closing one decoder
+// and creating another costs the main thread ms each (docs/web.md, round 5). Every batch starts at
+// a keyframe and ends with a flush, so a decoder carries nothing from one stream to the next.
+// ?decoderpool=0: closed and created as before.
+const DECODER_POOL = 8;
+const decoderPool = new URLSearchParams(location.search).get("decoderpool") === "0" ? null : new Map();  // bytes fetched with the fragment index, before init_size is known
 
 /// Byte and request counters (the benchmark reports bytes fetched per switch).
-export const traffic = { bytes: 0, requests: 0, batches: 0, fetchMs: 0, demuxMs: 0, decodeMs: 0, frames: 0, outputMs: 0, warmMs: 0, warms: 0 };
+export const traffic = { bytes: 0, requests: 0, batches: 0, fetchMs: 0, demuxMs: 0, decodeMs: 0, frames: 0, outputMs: 0, warmMs: 0, warms: 0, reused: 0 };
 
 /// When each step of opening the player first happened (performance.now() ms since navigation start):
 /// the benchmark's breakdown of the time to the first frame.
@@ -208,6 +215,7 @@ export class Stream {
         codedHeight: track.video.height,
         optimizeForLatency: true,
       };
+      this.configKey = `${track.codec} ${track.video.width}x${track.video.height} ${Array.from(this.config.description).join(",")}`;
       const support = await VideoDecoder.isConfigSupported(this.config);
       if (!support.supported) throw new Error(`this browser cannot decode ${track.codec}`);
       this.status = "ok";
@@ -362,17 +370,27 @@ export class Stream {
   warm(cache) {
     if (this.status !== "ok" || (this.decoder && this.decoder.state !== "closed")) return;
     const t0 = performance.now();
-    this.decoder = new VideoDecoder({
-      output: (vf) => {
-        const t = performance.now();
-        cache.put(`${this.camera}/${this.task}/${vf.timestamp}`, vf);
-        traffic.outputMs += performance.now() - t;
-      },
-      error: (e) => { this.decodeError = e; },
-    });
-    this.decoder.configure(this.config);
+    const pooled = decoderPool ? decoderPool.get(this.configKey) : null;
+    let d = pooled && pooled.pop();
+    if (d && d.state === "configured") {
+      traffic.reused++;
+    } else {
+      d = new VideoDecoder({
+        // The decoder may serve several streams in turn (decoderPool): frames go to its owner of the moment.
+        output: (vf) => {
+          if (!d.owner) return vf.close();
+          const t = performance.now();
+          cache.put(`${d.owner.camera}/${d.owner.task}/${vf.timestamp}`, vf);
+          traffic.outputMs += performance.now() - t;
+        },
+        error: (e) => { if (d.owner) d.owner.decodeError = e; },
+      });
+      d.configure(this.config);
+      traffic.warms++;
+    }
+    d.owner = this;
+    this.decoder = d;
     traffic.warmMs += performance.now() - t0;
-    traffic.warms++;
   }
 
   /// Drops the decodes queued on the stream's decoder and configures it again: a switch away from a
@@ -390,8 +408,18 @@ export class Stream {
     return n >= 0 && this.samples.has(n);
   }
 
+  /// Gives the stream's decoder up: idle and configured, it goes to decoderPool for the next stream of
+  /// the same configuration; otherwise (decodes in flight, an error, the pool full) it is closed.
   close() {
-    if (this.decoder && this.decoder.state !== "closed") this.decoder.close();
+    const d = this.decoder;
     this.decoder = null;
+    if (!d || d.state === "closed") return;
+    d.owner = null;
+    if (decoderPool && d.state === "configured" && this.inflight.size === 0 && d.decodeQueueSize === 0) {
+      const list = decoderPool.get(this.configKey) ?? [];
+      decoderPool.set(this.configKey, list);
+      if (list.length < DECODER_POOL) return void list.push(d);
+    }
+    d.close();
   }
 }
