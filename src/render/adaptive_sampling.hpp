@@ -27,6 +27,12 @@ namespace panoptes::render {
 /// is never interpolated. Tiles are independent: the lattice includes their first and last rows and
 /// columns. Lattice lines lie on multiples of `stride` in image coordinates, so bricks of one
 /// decomposition sample the same pixels wherever their tiles overlap.
+/// `march` returns the pixel's entry face: a non-zero id of the plane through which its ray enters
+/// the brick, or 0 (a miss, or an entry that is no plane, e.g. a camera inside, or a panorama);
+/// `locate(x, y, face)` with face == 0 is the full slab test, with face != 0 the four corners of the
+/// pixel's cell all entered through that plane, and since the pixels whose rays enter a convex brick
+/// through one face form a convex region of a perspective image, the pixel does too: `locate` then
+/// only intersects that plane (the same expression as the slab test, so the same bits).
 class AdaptiveTile {
  public:
   /// `stride` is the coarse lattice spacing (2 or 4; larger values work, refining by halves);
@@ -53,6 +59,7 @@ class AdaptiveTile {
     const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
     marched_for_.assign(n, 0);
     filled_.assign(n, 0);
+    face_.resize(n);  // read only at pixels marched for some task
     // The coarse lattice: the tile's borders and the multiples of the stride between them.
     xs_.clear();
     ys_.clear();
@@ -84,7 +91,7 @@ class AdaptiveTile {
     std::uint64_t& s = marched_for_[at(x, y)];
     const std::uint64_t m = mask & ~s;
     if (!m) return;
-    march(x, y, m);
+    face_[at(x, y)] = march(x, y, m);
     if (!s) ++marched_;
     s |= m;
   }
@@ -142,13 +149,16 @@ class AdaptiveTile {
   template <class March, class Locate>
   void fill(int x0, int y0, int x1, int y1, std::uint64_t mask, March& march, Locate& locate) {
     const bool hit = depth(out_[0], x0, y0) != PartialImage::kNoDepth;
+    // All four corners entered through one plane: the interior did too (see the class comment).
+    std::uint8_t face = face_[at(x0, y0)];
+    if (!hit || face_[at(x1, y0)] != face || face_[at(x0, y1)] != face || face_[at(x1, y1)] != face) face = 0;
     const float sx = x1 > x0 ? 1.0f / float(x1 - x0) : 0.0f, sy = y1 > y0 ? 1.0f / float(y1 - y0) : 0.0f;
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const std::size_t p = at(x, y);
         const std::uint64_t todo = mask & ~marched_for_[p];
         if (!todo) continue;
-        const float d = locate(x, y);
+        const float d = locate(x, y, face);
         if ((d != PartialImage::kNoDepth) != hit) {
           mark_marched(x, y, todo, march);
           continue;
@@ -174,6 +184,7 @@ class AdaptiveTile {
   std::span<PartialImage> out_;
   std::vector<std::uint64_t> marched_for_;  // per pixel of the tile: the tasks it was marched for
   std::vector<std::uint8_t> filled_;        // per pixel: interpolated for some task
+  std::vector<std::uint8_t> face_;          // per pixel: march()'s entry face
   std::vector<int> xs_, ys_;
   std::uint64_t marched_ = 0, interpolated_ = 0;
 };

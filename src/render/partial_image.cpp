@@ -10,7 +10,7 @@
 
 namespace panoptes::render {
 
-void PartialImage::reset(int w, int h, PixelRect r) {
+void PartialImage::resize(int w, int h, PixelRect r) {
   width = w;
   height = h;
   r.x0 = std::clamp(r.x0, 0, w);
@@ -19,8 +19,14 @@ void PartialImage::reset(int w, int h, PixelRect r) {
   r.y1 = std::clamp(r.y1, r.y0, h);
   rect = r;
   const std::size_t n = std::size_t(r.width()) * r.height();
-  rgba.assign(4 * n, 0.0f);
-  depth.assign(n, kNoDepth);
+  rgba.resize(4 * n);
+  depth.resize(n);
+}
+
+void PartialImage::reset(int w, int h, PixelRect r) {
+  resize(w, h, r);
+  std::fill(rgba.begin(), rgba.end(), 0.0f);
+  std::fill(depth.begin(), depth.end(), kNoDepth);
 }
 
 namespace {

@@ -195,10 +195,14 @@ inline int lut_bin(float v, float lo, float sc, float last, bool absv) {
   return int(u);
 }
 
-// Ray–box intersection in index space; returns false when the ray misses.
-inline bool slab(const double O[3], const double D[3], const double lo[3], const double hi[3], double& t0, double& t1) {
+// Ray–box intersection in index space; returns false when the ray misses. `axis` receives the axis
+// of the plane where the ray enters (-1 when t0 stays −∞); that plane is lo[axis] when
+// D[axis] > 0, else hi[axis], and t0 is exactly (plane − O[axis]) / D[axis].
+inline bool slab(const double O[3], const double D[3], const double lo[3], const double hi[3], double& t0, double& t1,
+                 int& axis) {
   t0 = -INFINITY;
   t1 = INFINITY;
+  axis = -1;
   for (int a = 0; a < 3; ++a) {
     if (D[a] == 0) {
       if (O[a] < lo[a] || O[a] > hi[a]) return false;
@@ -206,7 +210,7 @@ inline bool slab(const double O[3], const double D[3], const double lo[3], const
     }
     double ta = (lo[a] - O[a]) / D[a], tb = (hi[a] - O[a]) / D[a];
     if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
+    if (t0 < ta) t0 = ta, axis = a;  // the value of std::max(t0, ta)
     t1 = std::min(t1, tb);
   }
   return t1 >= t0;
@@ -1279,7 +1283,8 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     rect.y1 = std::max(rect.y1, int(std::ceil(std::min(py, H + 1.0))) + 1);
   }
   if (all) rect = {0, 0, W, H};
-  for (PartialImage& o : out) o.reset(W, H, rect);
+  // Every pixel of the rect is written below (a miss as transparent, +∞): no clearing first.
+  for (PartialImage& o : out) o.resize(W, H, rect);
   rect = out.empty() ? PixelRect{} : out[0].rect;
   if (tasks.empty()) return stats;
 
@@ -1308,12 +1313,17 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       edge_tasks |= std::uint64_t(1) << i;
 
   // Where the ray of pixel (x, y) meets the domain and the brick; false when it misses the brick.
+  // `face` (adaptive sampling's entry face, adaptive_sampling.hpp) is 1 + 4·axis + 2·global + side
+  // of the plane that sets the entry depth (the brick's or the domain's, side 1 = its upper face),
+  // 0 when none does (the camera inside) or the projection is not a perspective one.
   struct PixelRay {
     double O[3], D[3];  // origin and direction in index coordinates
     Vec3 dir;
     double t0, tg1, tb0, tb1;
     float depth;
+    std::uint8_t face;
   };
+  const bool planar = cam.projection() == camera::Projection::perspective;
   auto locate = [&](int x, int y, PixelRay& r) {
     const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
     for (int a = 0; a < 3; ++a) {
@@ -1322,10 +1332,14 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
     r.dir = ray.direction;
     double tg0;
-    if (!slab(r.O, r.D, glo, ghi, tg0, r.tg1)) return false;
+    int ag, ab;
+    if (!slab(r.O, r.D, glo, ghi, tg0, r.tg1, ag)) return false;
     r.t0 = std::max(tg0, 0.0);
     if (r.tg1 <= r.t0) return false;
-    if (!slab(r.O, r.D, blo, bhi, r.tb0, r.tb1)) return false;
+    if (!slab(r.O, r.D, blo, bhi, r.tb0, r.tb1, ab)) return false;
+    r.face = 0;
+    if (r.tb0 >= r.t0 && ab >= 0) r.face = std::uint8_t(1 + 4 * ab + (r.D[ab] < 0));
+    else if (tg0 > 0 && ag >= 0) r.face = std::uint8_t(3 + 4 * ag + (r.D[ag] < 0));
     r.tb0 = std::max(r.tb0, r.t0);
     r.tb1 = std::min(r.tb1, r.tg1);
     if (r.tb1 < r.tb0) return false;
@@ -1333,10 +1347,22 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     // (e.g. a lattice node on an MPI cut): a ray leaving through that face has its t = 0 sample owned
     // by the neighbour (half-open extents), so this brick's part lies just behind it in depth.
     r.depth = float(r.tb0);
-    if (r.tb0 == 0)
+    if (r.tb0 == 0) {
+      r.face = 0;
       for (int a = 0; a < 3; ++a)
         if (r.O[a] == bhi[a] && bhi[a] != ghi[a] && r.D[a] < 0) r.depth = std::nextafter(0.0f, 1.0f);
+    }
+    if (!planar) r.face = 0;
     return true;
+  };
+  // The entry depth of pixel (x, y) whose ray is known to enter through plane `face` (as locate()
+  // reported for the corners of its adaptive cell): that plane's term of the slab test, bit for bit.
+  auto face_depth = [&](int x, int y, std::uint8_t face) {
+    const int f = face - 1, a = f >> 2;
+    const double plane = f & 2 ? (f & 1 ? ghi[a] : glo[a]) : (f & 1 ? bhi[a] : blo[a]);
+    const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
+    const double O = (ray.origin[a] - S.grid.origin[a]) / S.spacing[a], D = ray.direction[a] / S.spacing[a];
+    return float((plane - O) / D);
   };
   // Marches a located ray for every task and writes pixel (x, y) of every image.
   // Marches a located ray for the tasks in `tasks` and writes their pixel (x, y); every image's depth.
@@ -1371,6 +1397,15 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
   };
 
+  auto clear_pixel = [&](int x, int y) {  // a miss
+    for (int i = 0; i < K; ++i) {
+      PartialImage& o = out[std::size_t(i)];
+      float* dst = o.rgba_at(x, y);
+      dst[0] = dst[1] = dst[2] = dst[3] = 0;
+      o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = PartialImage::kNoDepth;
+    }
+  };
+
 #pragma omp parallel reduction(+ : n_rays, n_eff, n_marched, n_interpolated)
   {
     alignas(64) float acc[kMaxTasksPerMarch][4];
@@ -1383,28 +1418,28 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       if (!opt.adaptive) {
         for (int y = ty0; y < ty1; ++y)
           for (int x = tx0; x < tx1; ++x) {
-            if (!locate(x, y, r)) continue;
+            if (!locate(x, y, r)) {
+              clear_pixel(x, y);
+              continue;
+            }
             ++n_rays;
             shade(x, y, r, all_tasks, acc, n_eff, n_marched);
           }
         continue;
       }
-      auto march = [&](int x, int y, std::uint64_t tasks) {
+      auto march = [&](int x, int y, std::uint64_t tasks) -> std::uint8_t {
         if (locate(x, y, r)) {
           ++n_rays;
           shade(x, y, r, tasks, acc, n_eff, n_marched);
-          return;
+          return r.face;
         }
-        for (int i = 0; i < K; ++i) {  // a pixel interpolated earlier may be re-marched
-          PartialImage& o = out[std::size_t(i)];
-          if (tasks >> i & 1) {
-            float* dst = o.rgba_at(x, y);
-            dst[0] = dst[1] = dst[2] = dst[3] = 0;
-          }
-          o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = PartialImage::kNoDepth;
-        }
+        clear_pixel(x, y);
+        return std::uint8_t(0);
       };
-      auto depth_of = [&](int x, int y) { return locate(x, y, r) ? r.depth : PartialImage::kNoDepth; };
+      auto depth_of = [&](int x, int y, std::uint8_t face) {
+        if (face) return face_depth(x, y, face);
+        return locate(x, y, r) ? r.depth : PartialImage::kNoDepth;
+      };
       const std::uint64_t before = refiner.interpolated();
       refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks);
       n_interpolated += refiner.interpolated() - before;
