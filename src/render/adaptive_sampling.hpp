@@ -5,16 +5,71 @@
 // bilinear interpolation, otherwise it is split at its midpoints (stride 4 → 2 → 1) and the new
 // lattice points are marched. The images of the in-situ paper settings carry 1.2–4 pixels per voxel,
 // so most of a smooth image is interpolated instead of marched.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <array>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "render/partial_image.hpp"
 
 namespace panoptes::render {
+
+/// A convex polygon of the image outside which no ray meets the brick: the convex hull of the brick's
+/// 8 projected corners (perspective cameras with the brick wholly in front). Pixel (x, y)'s centre is
+/// (x + 0.5, y + 0.5), as in Camera::ray.
+class Silhouette {
+ public:
+  /// The hull of `n` <= 8 points; empty() when fewer than 3 of them are in convex position.
+  Silhouette(const double* px, const double* py, int n) {
+    std::array<std::pair<double, double>, 8> p{};
+    for (int i = 0; i < n; ++i) p[std::size_t(i)] = {px[i], py[i]};
+    std::sort(p.begin(), p.begin() + n);
+    auto cross = [](const std::pair<double, double>& o, const std::pair<double, double>& a,
+                    const std::pair<double, double>& b) {
+      return (a.first - o.first) * (b.second - o.second) - (a.second - o.second) * (b.first - o.first);
+    };
+    std::array<std::pair<double, double>, 16> h{};
+    int k = 0;
+    for (int i = 0; i < n; ++i) {  // Andrew's monotone chain: lower hull, then upper
+      while (k >= 2 && cross(h[std::size_t(k - 2)], h[std::size_t(k - 1)], p[std::size_t(i)]) <= 0) --k;
+      h[std::size_t(k++)] = p[std::size_t(i)];
+    }
+    for (int i = n - 2, lower = k + 1; i >= 0; --i) {
+      while (k >= lower && cross(h[std::size_t(k - 2)], h[std::size_t(k - 1)], p[std::size_t(i)]) <= 0) --k;
+      h[std::size_t(k++)] = p[std::size_t(i)];
+    }
+    n_ = std::max(0, k - 1);  // the last point repeats the first
+    for (int i = 0; i < n_; ++i) x_[i] = h[std::size_t(i)].first, y_[i] = h[std::size_t(i)].second;
+    if (n_ < 3) n_ = 0;
+  }
+  bool empty() const { return n_ == 0; }
+  /// True when every pixel centre of [x0, x1] × [y0, y1] lies more than a pixel outside the polygon
+  /// (a margin far above any rounding of the projection), so none of their rays meets the brick.
+  bool excludes(int x0, int y0, int x1, int y1) const {
+    if (n_ == 0) return false;
+    const double ax = x0 - 0.5, bx = x1 + 1.5, ay = y0 - 0.5, by = y1 + 1.5;  // centres ± 1 pixel
+    const double cx[4] = {ax, bx, ax, bx}, cy[4] = {ay, ay, by, by};
+    for (int i = 0; i < n_; ++i) {  // separating axes: the polygon's edges (counter-clockwise) ...
+      const int j = i + 1 == n_ ? 0 : i + 1;
+      const double ex = x_[j] - x_[i], ey = y_[j] - y_[i];
+      bool out = true;
+      for (int c = 0; c < 4 && out; ++c) out = ex * (cy[c] - y_[i]) - ey * (cx[c] - x_[i]) < 0;
+      if (out) return true;
+    }
+    double lx = x_[0], hx = x_[0], ly = y_[0], hy = y_[0];  // ... and the image axes
+    for (int i = 1; i < n_; ++i) lx = std::min(lx, x_[i]), hx = std::max(hx, x_[i]), ly = std::min(ly, y_[i]), hy = std::max(hy, y_[i]);
+    return bx < lx || ax > hx || by < ly || ay > hy;
+  }
+
+ private:
+  int n_ = 0;
+  double x_[8] = {}, y_[8] = {};
+};
 
 /// Refines one tile of a brick's partial images. All K tasks of a march (K ≤ 64) share the coarse
 /// lattice, marched once for all of them; every refinement decision is then taken per task (a cell
@@ -45,15 +100,18 @@ class AdaptiveTile {
   std::uint64_t marched() const { return marched_; }
   std::uint64_t interpolated() const { return interpolated_; }
 
+  /// `silhouette` (may be null): cells of misses that it excludes are filled as misses without
+  /// locating their pixels.
   /// `follow`: the tasks refined wherever any task is (isosurfaces and slices: their thin edges may
   /// fall between four agreeing corners, and the finer lattice of the volume tasks catches many of
   /// them, as before per-task decisions); the others decide alone.
   template <class March, class Locate>
   void run(const PixelRect& tile, std::span<PartialImage> out, March&& march, Locate&& locate,
-           std::uint64_t follow = 0) {
+           std::uint64_t follow = 0, const Silhouette* silhouette = nullptr) {
     if (out.size() > 64) throw std::invalid_argument("AdaptiveTile: more than 64 images in one march");
     tile_ = tile;
     follow_ = follow;
+    silhouette_ = silhouette;
     out_ = out;
     const std::uint64_t all = out.size() == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << out.size()) - 1;
     const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
@@ -152,13 +210,15 @@ class AdaptiveTile {
     // All four corners entered through one plane: the interior did too (see the class comment).
     std::uint8_t face = face_[at(x0, y0)];
     if (!hit || face_[at(x1, y0)] != face || face_[at(x0, y1)] != face || face_[at(x1, y1)] != face) face = 0;
+    // Four misses well outside the brick's silhouette: no pixel between them can hit.
+    const bool outside = !hit && silhouette_ && silhouette_->excludes(x0, y0, x1, y1);
     const float sx = x1 > x0 ? 1.0f / float(x1 - x0) : 0.0f, sy = y1 > y0 ? 1.0f / float(y1 - y0) : 0.0f;
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const std::size_t p = at(x, y);
         const std::uint64_t todo = mask & ~marched_for_[p];
         if (!todo) continue;
-        const float d = locate(x, y, face);
+        const float d = outside ? PartialImage::kNoDepth : locate(x, y, face);
         if ((d != PartialImage::kNoDepth) != hit) {
           mark_marched(x, y, todo, march);
           continue;
@@ -182,6 +242,7 @@ class AdaptiveTile {
   std::uint64_t follow_ = 0;
   PixelRect tile_;
   std::span<PartialImage> out_;
+  const Silhouette* silhouette_ = nullptr;
   std::vector<std::uint64_t> marched_for_;  // per pixel of the tile: the tasks it was marched for
   std::vector<std::uint8_t> filled_;        // per pixel: interpolated for some task
   std::vector<std::uint8_t> face_;          // per pixel: march()'s entry face

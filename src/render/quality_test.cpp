@@ -13,6 +13,7 @@
 #include "core/image.hpp"
 #include "render/reference_renderer.hpp"
 #include "render/render_test_util.hpp"
+#include "render/adaptive_sampling.hpp"
 #include "render/renderer.hpp"
 #include "render/synthetic_fields.hpp"
 
@@ -262,4 +263,25 @@ TEST(Quality, AdaptiveSamplingKeepsExactDepthsAndWritesEveryPixel) {
         }
     EXPECT_GT(interpolated, 0u) << "stride " << stride;
   }
+}
+
+// The silhouette that lets adaptive cells of misses skip their rays: the hull of a brick's projected
+// corners (here a diamond with interior and duplicate points) excludes a cell only when every pixel
+// centre in it lies more than a pixel outside.
+TEST(Quality, SilhouetteExcludesOnlyCellsWellOutsideTheHull) {
+  const double px[8] = {50, 90, 50, 10, 50, 50, 60, 90}, py[8] = {10, 50, 90, 50, 50, 40, 55, 50};
+  const Silhouette s(px, py, 8);
+  ASSERT_FALSE(s.empty());
+  EXPECT_FALSE(s.excludes(45, 45, 49, 49));  // inside
+  EXPECT_FALSE(s.excludes(0, 0, 100, 100));  // contains the diamond
+  EXPECT_TRUE(s.excludes(0, 0, 20, 20));     // the corner cut off by the edge (10,50)-(50,10)
+  EXPECT_TRUE(s.excludes(80, 80, 99, 99));
+  EXPECT_TRUE(s.excludes(92, 40, 99, 60));   // right of the bounding box
+  // Pixel 29's centre (29.5, 29.5) lies 0.7 px outside the edge x + y = 60 (inside the margin):
+  // kept; pixel 28's (28.5, 28.5) lies 2.1 px outside: excluded.
+  EXPECT_FALSE(s.excludes(29, 29, 29, 29));
+  EXPECT_TRUE(s.excludes(28, 28, 28, 28));
+  const double lx[3] = {0, 10, 20}, ly[3] = {0, 10, 20};  // collinear: no polygon, excludes nothing
+  EXPECT_TRUE(Silhouette(lx, ly, 3).empty());
+  EXPECT_FALSE(Silhouette(lx, ly, 3).excludes(50, 0, 60, 5));
 }

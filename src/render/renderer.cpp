@@ -1268,6 +1268,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   PixelRect rect{W, H, 0, 0};
   // An equirectangular image wraps around the camera: corner projections bound nothing, march every pixel.
   bool all = cam.projection() != camera::Projection::perspective;
+  double cpx[8], cpy[8];
   for (int c = 0; c < 8 && !all; ++c) {
     Vec3 p;
     for (int a = 0; a < 3; ++a)
@@ -1277,12 +1278,15 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       all = true;
       break;
     }
+    cpx[c] = px, cpy[c] = py;
     rect.x0 = std::min(rect.x0, int(std::floor(std::max(px, -1.0))) - 1);
     rect.y0 = std::min(rect.y0, int(std::floor(std::max(py, -1.0))) - 1);
     rect.x1 = std::max(rect.x1, int(std::ceil(std::min(px, W + 1.0))) + 1);
     rect.y1 = std::max(rect.y1, int(std::ceil(std::min(py, H + 1.0))) + 1);
   }
   if (all) rect = {0, 0, W, H};
+  // The brick's silhouette, for adaptive cells of misses (only when every corner projected).
+  const Silhouette silhouette(cpx, cpy, all ? 0 : 8);
   // Every pixel of the rect is written below (a miss as transparent, +∞): no clearing first.
   for (PartialImage& o : out) o.resize(W, H, rect);
   rect = out.empty() ? PixelRect{} : out[0].rect;
@@ -1441,7 +1445,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
         return locate(x, y, r) ? r.depth : PartialImage::kNoDepth;
       };
       const std::uint64_t before = refiner.interpolated();
-      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks);
+      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks, silhouette.empty() ? nullptr : &silhouette);
       n_interpolated += refiner.interpolated() - before;
     }
   }
