@@ -4,7 +4,27 @@
 #include <cmath>
 #include <limits>
 
+#include <sys/mman.h>
+
+#include <cstdlib>
+
 namespace panoptes::render {
+
+void* allocate_huge(std::size_t bytes) {
+  constexpr std::size_t kHuge = std::size_t(2) << 20;
+  if (bytes < kHuge) {
+    void* p = std::malloc(bytes == 0 ? 1 : bytes);
+    if (!p) throw std::bad_alloc();
+    return p;
+  }
+  const std::size_t n = (bytes + kHuge - 1) / kHuge * kHuge;
+  void* p = std::aligned_alloc(kHuge, n);
+  if (!p) throw std::bad_alloc();
+  ::madvise(p, n, MADV_HUGEPAGE);  // advice only: without huge pages the copy works as before
+  return p;
+}
+void deallocate_huge(void* p) noexcept { std::free(p); }
+
 
 CornerField::CornerField(const FieldView& f) {
   f.validate();
