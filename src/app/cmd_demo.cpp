@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green, both together) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: about 3.3 min (197 s wall, 372 CPU-seconds), 2026-11-23 20:00 UTC on the idle 2-core machine (AMD EPYC): the whole demo as scripts/demo runs it (OpenMP waiting passively), of which render 161 s, encode 21 s, composite 12 s, simulation 1 s; above the 2-3 min target.
+# Measured: about 3.3 min (200 s wall, 383 CPU-seconds), 2026-11-25 19:24 UTC on the idle 2-core machine (AMD EPYC): the whole demo as scripts/demo runs it (OpenMP waiting passively), of which render 161 s, encode 24 s, composite 13 s, simulation 1 s; above the 2-3 min target.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
@@ -139,8 +139,8 @@ std::string measured_time() {
 // on purpose. The paper-scale figures are paper_snapshot_bench's (BENCHMARKS.md, 2026-11-23, f514d2c).
 const char* kOverheadNote =
     "  (the demo's grid, 64x128x40, is small so that the demo runs in minutes: its simulation is cheap and this\n"
-    "  ratio large. At the paper's 256x512x160 grid a snapshot's 40 solver steps take 10.7 s on 2 cores and its\n"
-    "  390 frames of 920x896 about 73 s: about 7x. BENCHMARKS.md, paper_snapshot_bench.)";
+    "  ratio large. At the paper's 256x512x160 grid a snapshot's 40 solver steps take 7.2 s on 2 cores and its\n"
+    "  390 frames of 920x896 about 38 s: about 5x. BENCHMARKS.md, paper_snapshot_bench.)";
 
 CommandRegistration reg([](CLI::App& root) {
   auto opt = std::make_shared<SeismicRunOptions>();
