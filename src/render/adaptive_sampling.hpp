@@ -26,6 +26,7 @@ class Silhouette {
  public:
   /// The hull of `n` <= 8 points; empty() when fewer than 3 of them are in convex position.
   Silhouette(const double* px, const double* py, int n) {
+    n = std::clamp(n, 0, 8);
     std::array<std::pair<double, double>, 8> p{};
     for (int i = 0; i < n; ++i) p[std::size_t(i)] = {px[i], py[i]};
     std::sort(p.begin(), p.begin() + n);

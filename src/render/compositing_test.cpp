@@ -99,17 +99,22 @@ TEST(Compositing, OneMarchForKTasksEqualsKMarches) {
   EXPECT_LT(st.marched_samples, separate_marched);
 }
 
-// Volume tasks on p and s: in one march both fields' corner copies are read with one shared
-// geometry (interp_block_corners_n<2>), alone with their own; a field without a corner copy (gathered
-// floats) must not be paired. Every task's image must be its one-task image, bit for bit.
-TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
-  const Scene sc;
-  const std::vector<TaskSpec> tasks{
+// The paper's three volume tasks on the test scene: p, s and the two-field p+s.
+std::vector<TaskSpec> p_s_and_ps_tasks() {
+  return {
       TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
       TaskSpec::volume(1, TransferFunction::preset("s-wave", 2), ValueWindow::absolute(0, 0.9)),
       TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
                         TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 0.9)),
   };
+}
+
+// Volume tasks on p and s: in one march both fields' corner copies are read with one shared
+// geometry (interp_block_corners_n<2>), alone with their own; a field without a corner copy (gathered
+// floats) must not be paired. Every task's image must be its one-task image, bit for bit.
+TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
+  const Scene sc;
+  const std::vector<TaskSpec> tasks = p_s_and_ps_tasks();
   for (const FieldCopy s_copy : {FieldCopy::corners16, FieldCopy::none}) {
     std::vector<PreparedField> fields{PreparedField(sc.views[0]),
                                       PreparedField(sc.views[1], MacroCells::kDefaultSize, s_copy)};
@@ -134,13 +139,8 @@ TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
 // bit, and the K-task march marches fewer samples than the K one-task marches together.
 TEST(Compositing, AdaptiveVolumeTasksInOneMarchGiveTheirOneTaskImages) {
   const Scene sc;
-  const std::vector<TaskSpec> tasks{
-      TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
-      TaskSpec::volume(1, TransferFunction::preset("s-wave", 2), ValueWindow::absolute(0, 0.9)),
-      TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
-                        TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 0.9)),
-      TaskSpec::volume(0, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1)),
-  };
+  std::vector<TaskSpec> tasks = p_s_and_ps_tasks();
+  tasks.push_back(TaskSpec::volume(0, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1)));
   std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
   RenderOptions opt;
   opt.adaptive = true;
