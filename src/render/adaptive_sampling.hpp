@@ -217,17 +217,17 @@ class AdaptiveTile {
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const std::size_t p = at(x, y);
-        const std::uint64_t todo = mask & ~marched_for_[p];
-        if (!todo) continue;
+        const std::uint64_t pending = mask & ~marched_for_[p];
+        if (!pending) continue;
         const float d = outside ? PartialImage::kNoDepth : locate(x, y, face);
         if ((d != PartialImage::kNoDepth) != hit) {
-          mark_marched(x, y, todo, march);
+          mark_marched(x, y, pending, march);
           continue;
         }
         filled_[p] = 1;
         const float u = float(x - x0) * sx, v = float(y - y0) * sy;
         const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
-        for (std::uint64_t m = todo; m; m &= m - 1) {
+        for (std::uint64_t m = pending; m; m &= m - 1) {
           PartialImage& o = out_[std::size_t(std::countr_zero(m))];
           const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *e = o.rgba_at(x1, y1);
           float* q = o.rgba_at(x, y);
