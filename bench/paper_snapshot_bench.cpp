@@ -165,21 +165,28 @@ void BM_PaperSimulation(benchmark::State& state) {
   const seismic::RunConfig rc = seismic::parse_run_config(seis_text, path, std::string(PANOPTES_SOURCE_DIR) + "/examples");
   seismic::Solver solver(rc.solver);
   solver.run(1);  // first touch of the arrays
+  // Steps and compute_derived() timed apart: `panoptes run` derives phi_p, phi_s once per snapshot
+  // (every_steps steps), not once per 4 timed steps.
   const int steps = 4;
-  double wall = 0, cpu = 0;
+  double wall = 0, cpu = 0, dwall = 0, dcpu = 0;
   for (auto _ : state) {
-    const double w0 = wall_seconds(), c0 = cpu_seconds();
+    double w0 = wall_seconds(), c0 = cpu_seconds();
     solver.run(steps);
-    solver.compute_derived();
     wall += wall_seconds() - w0;
     cpu += cpu_seconds() - c0;
+    w0 = wall_seconds(), c0 = cpu_seconds();
+    solver.compute_derived();
+    dwall += wall_seconds() - w0;
+    dcpu += cpu_seconds() - c0;
   }
-  const double per_step = wall / double(state.iterations()) / steps;
-  g_sim_s_per_snapshot = per_step * double(cfg.schedule.every_steps);
+  const double n = double(state.iterations());
+  const double per_step = wall / n / steps;
+  g_sim_s_per_snapshot = per_step * double(cfg.schedule.every_steps) + dwall / n;
   state.counters["s_per_step"] = per_step;
+  state.counters["derive_s"] = dwall / n;
   state.counters["steps_per_snapshot"] = double(cfg.schedule.every_steps);
   state.counters["sim_s_per_snapshot"] = g_sim_s_per_snapshot;
-  state.counters["sim_cpu_s_per_snapshot"] = cpu / double(state.iterations()) / steps * cfg.schedule.every_steps;
+  state.counters["sim_cpu_s_per_snapshot"] = cpu / n / steps * cfg.schedule.every_steps + dcpu / n;
 }
 BENCHMARK(BM_PaperSimulation)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
