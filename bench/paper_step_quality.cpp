@@ -25,6 +25,10 @@
 //       scene): every EVERY-th camera of the 130 x the 3 tasks at examples/paper.toml's render options,
 //       each camera rendered on the real fields of every STEP and on the dense scene in turn
 //       (render_brick only: no composite, no encode).
+//   paper_step_quality session DIR STEPS
+//       one snapshot of each real STEP and of the dense scene through the in-situ session exactly as
+//       BM_DenseSnapshot drives it (examples/paper.toml, 130 cameras x 3 tasks, encode included), in
+//       turn: CPU-s and the session's render / composite / encode / copy split.
 //   paper_step_quality synthetic CAMERAS CANDIDATES [PNG_DIR]
 //       the same on render::dense_wave_scene (256x512x160, spacing 1, BM_Quality's cameras 5,64,100)
 //       against the reference path (render_reference) at 0.5 voxel, as BM_Quality.
@@ -46,6 +50,7 @@
 #include "core/image.hpp"
 #include "core/png.hpp"
 #include "insitu/config.hpp"
+#include "insitu/session.hpp"
 #include "render/reference_renderer.hpp"
 #include "render/renderer.hpp"
 #include "render/synthetic_fields.hpp"
@@ -329,6 +334,32 @@ int cmd_cost(std::vector<Scene>& scenes, int every) {
   return 0;
 }
 
+int cmd_session(const std::vector<Scene>& scenes) {
+  std::string seis_text;
+  insitu::SessionConfig cfg = insitu::parse_combined_config(read_text(kPaper), kPaper, kSeismicSections, seis_text);
+  cfg.output_dir = (std::filesystem::temp_directory_path() / "paper_step_quality_session").string();
+  cfg.overwrite = true;
+  cfg.up = {0, 0, -1};  // as panoptes run: depth is +z
+  cfg.validate();
+  std::printf("| scene | wall s | CPU-s | render s | composite s | encode s | copy s |\n");
+  for (const Scene& sc : scenes) {
+    insitu::Session session(cfg, sc.grid, insitu::LocalBlock::whole(sc.grid));
+    auto input = [](const char* name, const std::vector<float>& v) {
+      return insitu::FieldInput{name, v.data(), insitu::ScalarType::f32, {0, 0, 0}};
+    };
+    const double w0 = omp_get_wtime(), c0 = cpu_seconds();
+    session.snapshot(0.0, {input("phi_p", sc.p), input("phi_s", sc.s)});
+    const double wall = omp_get_wtime() - w0, cpu = cpu_seconds() - c0;
+    const insitu::SessionStats st = session.stats();
+    session.finalize();
+    std::printf("| %s | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f |\n", sc.name.c_str(), wall, cpu, st.time.render,
+                st.time.composite, st.time.encode, st.time.copy);
+    std::fflush(stdout);
+  }
+  std::filesystem::remove_all(cfg.output_dir);
+  return 0;
+}
+
 std::vector<Candidate> parse_candidates(const std::string& s) {
   std::vector<Candidate> out;
   for (const std::string& item : split(s, ',')) {
@@ -377,7 +408,7 @@ int main(int argc, char** argv) {
       }
       return run_trials(scenes, parse_ints(a[3]), parse_candidates(a[4]), false, {0, 0, -1}, a.size() > 5 ? a[5] : "");
     }
-    if (a.size() >= 4 && a[0] == "cost") {
+    if ((a.size() >= 4 && a[0] == "cost") || (a.size() >= 3 && a[0] == "session")) {
       const auto g = paper_run_config().solver.grid;
       const GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
       const std::size_t n = std::size_t(g.nx) * std::size_t(g.ny) * std::size_t(g.nz);
@@ -397,6 +428,11 @@ int main(int argc, char** argv) {
       dense.p = std::move(w.p);
       dense.s = std::move(w.s);
       scenes.push_back(std::move(dense));
+      if (a[0] == "session") {
+        // The dense snapshot in the middle of the real ones, so load drifts hit both sides.
+        std::rotate(scenes.begin() + std::ptrdiff_t(scenes.size() / 2), scenes.end() - 1, scenes.end());
+        return cmd_session(scenes);
+      }
       return cmd_cost(scenes, std::stoi(a[3]));
     }
     if (a.size() >= 3 && a[0] == "synthetic") {
@@ -410,7 +446,7 @@ int main(int argc, char** argv) {
       return run_trials(scenes, parse_ints(a[1]), parse_candidates(a[2]), true, {0, 0, 0}, a.size() > 3 ? a[3] : "");
     }
     std::cerr << "usage: paper_step_quality fields DIR STEP... | real[-nosheet] DIR STEPS CAMERAS CANDIDATES [PNG_DIR] |"
-                 " cost DIR STEPS EVERY | synthetic CAMERAS CANDIDATES [PNG_DIR]\n";
+                 " cost DIR STEPS EVERY | session DIR STEPS | synthetic CAMERAS CANDIDATES [PNG_DIR]\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "paper_step_quality: " << e.what() << "\n";
