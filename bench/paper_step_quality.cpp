@@ -26,6 +26,7 @@
 //       each camera rendered on the real fields of every STEP and on the dense scene in turn
 //       (render_brick only: no composite, no encode).
 //   paper_step_quality session DIR STEPS
+//       (STEPS of cost and session: a step written 1200n is loaded without the free-surface sheet)
 //       one snapshot of each real STEP and of the dense scene through the in-situ session exactly as
 //       BM_DenseSnapshot drives it (examples/paper.toml, 130 cameras x 3 tasks, encode included), in
 //       turn: CPU-s and the session's render / composite / encode / copy split.
@@ -360,6 +361,31 @@ int cmd_session(const std::vector<Scene>& scenes) {
   return 0;
 }
 
+// The saved real snapshots named in `list` (e.g. "1200,2400"); a step written "1200n", or every step
+// when `nosheet`, gets the free-surface plane z = 0 replaced by z = 1 (the diagnosis of `real-nosheet`).
+std::vector<Scene> real_scenes(const std::string& dir, const std::string& list, bool nosheet) {
+  const auto g = paper_run_config().solver.grid;
+  const GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
+  const std::size_t n = std::size_t(g.nx) * std::size_t(g.ny) * std::size_t(g.nz);
+  std::vector<Scene> scenes;
+  for (const std::string& item : split(list, ',')) {
+    const int step = std::stoi(item);
+    Scene sc;
+    sc.name = "step" + std::to_string(step);
+    sc.grid = grid;
+    sc.p = read_floats(field_path(dir, "phi_p", step), n);
+    sc.s = read_floats(field_path(dir, "phi_s", step), n);
+    if (nosheet || item.back() == 'n') {
+      sc.name += "_nosheet";
+      const std::size_t plane = std::size_t(g.nx) * std::size_t(g.ny);
+      std::copy_n(sc.p.begin() + std::ptrdiff_t(plane), plane, sc.p.begin());
+      std::copy_n(sc.s.begin() + std::ptrdiff_t(plane), plane, sc.s.begin());
+    }
+    scenes.push_back(std::move(sc));
+  }
+  return scenes;
+}
+
 std::vector<Candidate> parse_candidates(const std::string& s) {
   std::vector<Candidate> out;
   for (const std::string& item : split(s, ',')) {
@@ -388,39 +414,11 @@ int main(int argc, char** argv) {
       return cmd_fields(a[1], steps);
     }
     if (a.size() >= 5 && (a[0] == "real" || a[0] == "real-nosheet")) {
-      const auto g = paper_run_config().solver.grid;
-      const GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
-      const std::size_t n = std::size_t(g.nx) * std::size_t(g.ny) * std::size_t(g.nz);
-      std::vector<Scene> scenes;
-      for (int s : parse_ints(a[2])) {
-        Scene sc;
-        sc.name = "step" + std::to_string(s);
-        sc.grid = grid;
-        sc.p = read_floats(field_path(a[1], "phi_p", s), n);
-        sc.s = read_floats(field_path(a[1], "phi_s", s), n);
-        if (a[0] == "real-nosheet") {
-          sc.name += "_nosheet";
-          const std::size_t plane = std::size_t(g.nx) * std::size_t(g.ny);
-          std::copy_n(sc.p.begin() + std::ptrdiff_t(plane), plane, sc.p.begin());
-          std::copy_n(sc.s.begin() + std::ptrdiff_t(plane), plane, sc.s.begin());
-        }
-        scenes.push_back(std::move(sc));
-      }
+      std::vector<Scene> scenes = real_scenes(a[1], a[2], a[0] == "real-nosheet");
       return run_trials(scenes, parse_ints(a[3]), parse_candidates(a[4]), false, {0, 0, -1}, a.size() > 5 ? a[5] : "");
     }
     if ((a.size() >= 4 && a[0] == "cost") || (a.size() >= 3 && a[0] == "session")) {
-      const auto g = paper_run_config().solver.grid;
-      const GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
-      const std::size_t n = std::size_t(g.nx) * std::size_t(g.ny) * std::size_t(g.nz);
-      std::vector<Scene> scenes;
-      for (int s : parse_ints(a[2])) {
-        Scene sc;
-        sc.name = "step" + std::to_string(s);
-        sc.grid = grid;
-        sc.p = read_floats(field_path(a[1], "phi_p", s), n);
-        sc.s = read_floats(field_path(a[1], "phi_s", s), n);
-        scenes.push_back(std::move(sc));
-      }
+      std::vector<Scene> scenes = real_scenes(a[1], a[2], false);
       Scene dense;
       dense.name = "dense";
       dense.grid = GridGeometry{{256, 512, 160}, {0, 0, 0}, {1, 1, 1}};
