@@ -483,6 +483,41 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
 #endif
 }
 
+// Software prefetch of the corner records of samples k0 … k0 + kBlock − 1 of the N fields (one
+// corner layout, as interp_block_corners_n(); the same clamped cell records). For the general
+// (K-task) path only: a block there composites several tasks, which fills the out-of-order window,
+// so the loads of the following blocks are issued only after this one retires and each block waits
+// for memory (the corner copies are far larger than L3). The single-task loop's blocks are short
+// enough for the window to run ahead by itself (prefetching there measured nothing, Round 5a).
+// Prefetches never fault and change no value, so images keep their bits.
+constexpr int kPrefetchBlocks = 2;  // distance in blocks: see Round 6k in docs/rendering.md for 1, 2 and 3
+template <int N>
+inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
+#ifdef PANOPTES_RENDER_AVX2
+  const FieldAcc& f = *fs[0];
+  const __m256 fk = _mm256_cvtepi32_ps(
+      _mm256_add_epi32(_mm256_set1_epi32(int(k0)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+  const __m256 x = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sx), _mm256_set1_ps(P.bx));
+  const __m256 y = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sy), _mm256_set1_ps(P.by));
+  const __m256 z = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sz), _mm256_set1_ps(P.bz));
+  auto cell = [](__m256 p, int lo, int hi) {
+    return _mm256_sub_epi32(
+        _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(p), _mm256_set1_epi32(lo)), _mm256_set1_epi32(hi)),
+        _mm256_set1_epi32(lo));
+  };
+  alignas(32) std::int32_t id[kBlock];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(id),
+                     _mm256_add_epi32(cell(x, f.ilo[0], f.ihi[0]),
+                                      _mm256_add_epi32(_mm256_mullo_epi32(cell(y, f.ilo[1], f.ihi[1]), _mm256_set1_epi32(f.ccx)),
+                                                       _mm256_mullo_epi32(cell(z, f.ilo[2], f.ihi[2]), _mm256_set1_epi32(f.ccxy)))));
+  for (int l = 0; l < kBlock; ++l)
+    for (int s = 0; s < N; ++s)
+      _mm_prefetch(reinterpret_cast<const char*>(fs[s]->corners + 8 * std::int64_t(id[l])), _MM_HINT_T0);
+#else
+  (void)fs, (void)P, (void)k0;
+#endif
+}
+
 inline void interp_block_corners(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, float* v) {
   const FieldAcc* const fs[1] = {&f};
   float* const vs[1] = {v};
@@ -782,6 +817,22 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_pairs: slot s1's
       // partner s2, found at setup).
       std::uint32_t cm = vmask & S.corner_slots;
+      if (k0 + kPrefetchBlocks * kBlock <= kend) {
+        for (std::uint32_t pm = cm; pm;) {
+          const int s = std::countr_zero(pm);
+          pm &= pm - 1;
+          const std::uint32_t mates = pm & S.corner_mates[std::size_t(s)];
+          if (mates) {
+            const int s2 = std::countr_zero(mates);
+            pm &= ~(1u << s2);
+            const FieldAcc* const fs[2] = {&fa[s], &fa[s2]};
+            prefetch_block_corners<2>(fs, P, k0 + kPrefetchBlocks * kBlock);
+          } else {
+            const FieldAcc* const fs[1] = {&fa[s]};
+            prefetch_block_corners<1>(fs, P, k0 + kPrefetchBlocks * kBlock);
+          }
+        }
+      }
       while (cm) {
         const int s = std::countr_zero(cm);
         cm &= cm - 1;
