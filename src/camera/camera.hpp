@@ -62,6 +62,7 @@ class Camera {
   static Vec3 fallback_up(const Vec3& forward);
 
  private:
+  friend class PixelRays;  // PixelRays (pixel_rays.hpp) repeats ray()'s expressions per column and row
   Vec3 position_{0, 0, 1}, look_at_{0, 0, 0};
   Vec3 forward_{0, 0, -1}, right_{1, 0, 0}, up_{0, 1, 0};
   double fov_y_deg_ = 45;

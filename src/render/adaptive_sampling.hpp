@@ -168,9 +168,13 @@ class AdaptiveTile {
     for (std::uint64_t m = mask; m; m &= m - 1) {
       const PartialImage& o = out_[std::size_t(std::countr_zero(m))];
       const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *d = o.rgba_at(x1, y1);
+      // Plain comparisons, not std::fmin/fmax (libm calls here, NaN-aware): the march writes finite
+      // colours (LUT entries times opacities), and the range of finite values is the same.
+      auto lower = [](float p, float q) { return q < p ? q : p; };
+      auto upper = [](float p, float q) { return p < q ? q : p; };
       for (int k = 0; k < 4; ++k) {
-        const float lo = std::fmin(std::fmin(a[k], b[k]), std::fmin(c[k], d[k]));
-        const float hi = std::fmax(std::fmax(a[k], b[k]), std::fmax(c[k], d[k]));
+        const float lo = lower(lower(a[k], b[k]), lower(c[k], d[k]));
+        const float hi = upper(upper(a[k], b[k]), upper(c[k], d[k]));
         if (hi - lo > tolerance_) {
           r |= m & -m;
           break;
@@ -214,7 +218,15 @@ class AdaptiveTile {
     // Four misses well outside the brick's silhouette: no pixel between them can hit.
     const bool outside = !hit && silhouette_ && silhouette_->excludes(x0, y0, x1, y1);
     const float sx = x1 > x0 ? 1.0f / float(x1 - x0) : 0.0f, sy = y1 > y0 ? 1.0f / float(y1 - y0) : 0.0f;
-    for (int y = y0; y <= y1; ++y)
+    // The cell's corners in every image of `mask`, looked up once per cell instead of once per pixel.
+    std::array<std::array<const float*, 4>, 64> corners;
+    for (std::uint64_t m = mask; m; m &= m - 1) {
+      const std::size_t i = std::size_t(std::countr_zero(m));
+      const PartialImage& o = out_[i];
+      corners[i] = {o.rgba_at(x0, y0), o.rgba_at(x1, y0), o.rgba_at(x0, y1), o.rgba_at(x1, y1)};
+    }
+    for (int y = y0; y <= y1; ++y) {
+      const float v = float(y - y0) * sy;
       for (int x = x0; x <= x1; ++x) {
         const std::size_t p = at(x, y);
         const std::uint64_t pending = mask & ~marched_for_[p];
@@ -225,17 +237,25 @@ class AdaptiveTile {
           continue;
         }
         filled_[p] = 1;
-        const float u = float(x - x0) * sx, v = float(y - y0) * sy;
-        const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
-        for (std::uint64_t m = pending; m; m &= m - 1) {
-          PartialImage& o = out_[std::size_t(std::countr_zero(m))];
-          const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *e = o.rgba_at(x1, y1);
-          float* q = o.rgba_at(x, y);
-          for (int k = 0; k < 4; ++k) q[k] = hit ? w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k] : 0.0f;
+        if (hit) {
+          const float u = float(x - x0) * sx;
+          const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
+          for (std::uint64_t m = pending; m; m &= m - 1) {
+            const std::size_t i = std::size_t(std::countr_zero(m));
+            const auto& [a, b, c, e] = corners[i];
+            float* q = out_[i].rgba_at(x, y);
+            for (int k = 0; k < 4; ++k) q[k] = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k];
+          }
+        } else {
+          for (std::uint64_t m = pending; m; m &= m - 1) {
+            float* q = out_[std::size_t(std::countr_zero(m))].rgba_at(x, y);
+            q[0] = q[1] = q[2] = q[3] = 0.0f;
+          }
         }
         for (PartialImage& o : out_)  // the same exact depth for every image
           o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)] = d;
       }
+    }
   }
 
   int stride_;

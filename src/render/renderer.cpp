@@ -2,6 +2,7 @@
 
 #include "render/adaptive_sampling.hpp"
 #include "render/iso_shading.hpp"
+#include "camera/pixel_rays.hpp"
 
 #include <algorithm>
 #include <array>
@@ -1365,13 +1366,21 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     std::uint8_t face;
   };
   const bool planar = cam.projection() == camera::Projection::perspective;
+  // Camera::ray of the rect's pixels from per-column and per-row terms (the same bits); the origin in
+  // index coordinates is every ray's.
+  // The tables live per calling thread (reused capacity); the OpenMP threads below share this one
+  // through the reference (a thread_local named inside the region would be each thread's own).
+  thread_local camera::PixelRays caller_rays;
+  const camera::PixelRays& rays = caller_rays;
+  caller_rays.reset(cam, rect.x0, rect.y0, rect.x1, rect.y1);
+  double O_index[3];
+  for (int a = 0; a < 3; ++a) O_index[a] = (rays.origin()[a] - S.grid.origin[a]) / S.spacing[a];
   auto locate = [&](int x, int y, PixelRay& r) {
-    const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
+    r.dir = rays.direction(x, y);
     for (int a = 0; a < 3; ++a) {
-      r.O[a] = (ray.origin[a] - S.grid.origin[a]) / S.spacing[a];
-      r.D[a] = ray.direction[a] / S.spacing[a];
+      r.O[a] = O_index[a];
+      r.D[a] = r.dir[a] / S.spacing[a];
     }
-    r.dir = ray.direction;
     double tg0;
     int ag, ab;
     if (!slab(r.O, r.D, glo, ghi, tg0, r.tg1, ag)) return false;
@@ -1401,9 +1410,8 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   auto face_depth = [&](int x, int y, std::uint8_t face) {
     const int f = face - 1, a = f >> 2;
     const double plane = f & 2 ? (f & 1 ? ghi[a] : glo[a]) : (f & 1 ? bhi[a] : blo[a]);
-    const camera::Ray ray = cam.ray(x + 0.5, y + 0.5);
-    const double O = (ray.origin[a] - S.grid.origin[a]) / S.spacing[a], D = ray.direction[a] / S.spacing[a];
-    return float((plane - O) / D);
+    const double D = rays.direction(x, y, a) / S.spacing[a];
+    return float((plane - O_index[a]) / D);
   };
   // Marches a located ray for every task and writes pixel (x, y) of every image.
   // Marches a located ray for the tasks in `tasks` and writes their pixel (x, y); every image's depth.
