@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "core/error.hpp"
 #include "render/render_test_util.hpp"
@@ -373,5 +374,41 @@ TEST(Compositing, FinishImageRoundsLikeLroundAndReusesItsBuffers) {
     EXPECT_EQ(reused.pixels, fresh[round % 2].pixels) << "round " << round;
     finish_image_into(p, cams[round % 2], g, reused, bg, {false});
     EXPECT_EQ(reused.pixels, plain.pixels) << "round " << round;
+  }
+}
+
+// The outline's coverage is kept from one call to the next (K images of one camera in a row): every
+// change of what it depends on (camera, domain, line width) must redraw it. Each call is checked
+// against the same call on a new thread, whose coverage starts empty.
+TEST(Compositing, FinishImageKeepsTheOutlineOnlyForTheSameCameraDomainAndWidth) {
+  const GridGeometry g1{{20, 16, 12}, {-9.5, -7.5, -5.5}, {1, 1, 1}}, g2{{20, 16, 12}, {-9.5, -7.5, -5.5}, {1.2, 1, 1}};
+  const camera::Camera c1({30, -25, 20}, {0, 0, 0}, {0, 0, 1}, 40, 64, 48);
+  const camera::Camera c2({30, -25, 20}, {0, 0, 0}, {0, 0, 1}, 42, 64, 48);  // only the field of view differs
+  PartialImage p;
+  p.reset(64, 48, {5, 3, 60, 41});
+  for (std::size_t i = 0; i < p.rgba.size(); i += 4) p.rgba[i + 1] = p.rgba[i + 3] = float(i % 7) / 7.0f;
+  const Rgb bg{0.1f, 0.2f, 0.3f};
+  OutlineStyle thin, thick;
+  thick.width = 3.0f;
+  struct Call {
+    const camera::Camera* cam;
+    const GridGeometry* grid;
+    OutlineStyle style;
+  };
+  const Call calls[] = {{&c1, &g1, thin}, {&c1, &g1, thin}, {&c1, &g1, thick}, {&c1, &g2, thick},
+                        {&c2, &g2, thick}, {&c2, &g2, thin},  {&c1, &g1, thin}};
+  Image out;
+  for (std::size_t i = 0; i < std::size(calls); ++i) {
+    const Call& c = calls[i];
+    finish_image_into(p, *c.cam, *c.grid, out, bg, c.style);
+    Image fresh;
+    std::thread([&] { fresh = finish_image(p, *c.cam, *c.grid, bg, c.style); }).join();
+    EXPECT_EQ(out.pixels, fresh.pixels) << "call " << i;
+    if (i > 0 && (c.cam != calls[i - 1].cam || c.grid != calls[i - 1].grid || c.style.width != calls[i - 1].style.width)) {
+      Image before;
+      const Call& b = calls[i - 1];
+      std::thread([&] { before = finish_image(p, *b.cam, *b.grid, bg, b.style); }).join();
+      EXPECT_NE(fresh.pixels, before.pixels) << "call " << i << " changes nothing the outline shows";
+    }
   }
 }

@@ -141,9 +141,21 @@ namespace {
 // pixels of an image of a quarter million, so finish_image() composites every pixel without it and
 // then redoes only the touched ones. The dense buffers live per calling thread and are cleared
 // through the touched lists, so a warm call neither allocates nor writes the whole image twice.
+// The coverage depends on the camera, the domain and the width only, so it is kept for the next
+// call: the in-situ session finishes K images of one camera in a row (the demo: 3), and drawing the 12
+// edges was about half of finish_image's time there (perf, BM_Run/demo, 2026-11-25).
 struct OutlineCoverage {
+  struct Key {
+    Vec3 position, forward, right, up, lo, hi;
+    double fov = 0, width = 0;
+    int w = 0, h = 0;
+    camera::Projection projection = camera::Projection::perspective;
+    bool operator==(const Key&) const = default;
+  };
   std::vector<float> front, back;                  // w×h coverage in [0, 1], zero where untouched
   std::vector<std::uint32_t> touched;              // indices whose front or back coverage is > 0
+  Key key;                                         // what front and back were drawn for
+  bool drawn = false;
   void prepare(std::size_t n) {
     if (front.size() < n) {
       front.assign(n, 0.0f);
@@ -153,6 +165,7 @@ struct OutlineCoverage {
   void clear() {
     for (const std::uint32_t i : touched) front[i] = back[i] = 0.0f;
     touched.clear();
+    drawn = false;
   }
 };
 
@@ -199,6 +212,33 @@ bool project_segment(const camera::Camera& cam, Vec3 a, Vec3 b, double& ax, doub
   return cam.project(a, ax, ay) && cam.project(b, bx, by);
 }
 
+// Redraws `cover` for the camera, the domain box lo–hi and the line width that `key` names.
+void draw_outline(const camera::Camera& cam, const Vec3& lo, const Vec3& hi, double width,
+                  const OutlineCoverage::Key& key, OutlineCoverage& cover) {
+  const int w = cam.width(), h = cam.height();
+  const Vec3 c = cam.position();
+  cover.clear();
+  cover.prepare(std::size_t(w) * h);
+  // Face (axis a, side s) is turned towards the camera when the camera is beyond its plane.
+  auto facing = [&](int a, int s) { return s ? c[a] > hi[a] : c[a] < lo[a]; };
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, d = (a + 2) % 3;
+    for (int sb = 0; sb < 2; ++sb)
+      for (int sd = 0; sd < 2; ++sd) {
+        Vec3 p = lo, q = lo;
+        p[b] = q[b] = sb ? hi[b] : lo[b];
+        p[d] = q[d] = sd ? hi[d] : lo[d];
+        q[a] = hi[a];
+        double ax, ay, bx, by;
+        if (!project_segment(cam, p, q, ax, ay, bx, by)) continue;
+        const bool is_front = facing(b, sb) || facing(d, sd);
+        draw_segment(is_front ? cover.front : cover.back, cover.touched, w, h, ax, ay, bx, by, width);
+      }
+  }
+  cover.key = key;
+  cover.drawn = true;
+}
+
 // A colour in [0, 1] (NaN counts as 0) to 8 bits, rounding half away from zero: exactly
 // std::lround(v * 255) for every float v, since v * 255 is computed in float as before and a float
 // plus 0.5 is exact in double. Inline, so the pixel loop vectorizes (lroundf is a libm call).
@@ -241,24 +281,10 @@ void finish_image_into(const PartialImage& comp, const camera::Camera& cam, cons
   if (!outline.enabled) return;
 
   thread_local OutlineCoverage cover;
-  cover.prepare(std::size_t(w) * h);
-  const Vec3 lo = g.domain_lo(), hi = g.domain_hi(), c = cam.position();
-  // Face (axis a, side s) is turned towards the camera when the camera is beyond its plane.
-  auto facing = [&](int a, int s) { return s ? c[a] > hi[a] : c[a] < lo[a]; };
-  for (int a = 0; a < 3; ++a) {
-    const int b = (a + 1) % 3, d = (a + 2) % 3;
-    for (int sb = 0; sb < 2; ++sb)
-      for (int sd = 0; sd < 2; ++sd) {
-        Vec3 p = lo, q = lo;
-        p[b] = q[b] = sb ? hi[b] : lo[b];
-        p[d] = q[d] = sd ? hi[d] : lo[d];
-        q[a] = hi[a];
-        double ax, ay, bx, by;
-        if (!project_segment(cam, p, q, ax, ay, bx, by)) continue;
-        const bool is_front = facing(b, sb) || facing(d, sd);
-        draw_segment(is_front ? cover.front : cover.back, cover.touched, w, h, ax, ay, bx, by, outline.width);
-      }
-  }
+  const Vec3 lo = g.domain_lo(), hi = g.domain_hi();
+  const OutlineCoverage::Key key{cam.position(), cam.forward(), cam.right(), cam.up(), lo, hi,
+                                 cam.fov_y_degrees(), outline.width, w, h, cam.projection()};
+  if (!cover.drawn || !(cover.key == key)) draw_outline(cam, lo, hi, outline.width, key, cover);
   // The touched pixels again, with the outline behind and in front of the volume. A pixel touched
   // by both buffers is listed twice and computed twice to the same value.
   for (const std::uint32_t i : cover.touched) {
@@ -276,7 +302,6 @@ void finish_image_into(const PartialImage& comp, const camera::Camera& cam, cons
     std::uint8_t* o = img.at(x, y);
     for (int k = 0; k < 3; ++k) o[k] = to_byte(col[k]);
   }
-  cover.clear();
 }
 
 Image finish_image(const PartialImage& comp, const camera::Camera& cam, const GridGeometry& g, Rgb bg,
