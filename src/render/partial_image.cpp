@@ -6,6 +6,10 @@
 #include <cstring>
 #include <numeric>
 
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
+
 #include "core/error.hpp"
 
 namespace panoptes::render {
@@ -246,6 +250,36 @@ inline std::uint8_t to_byte(float c) {
   const float v = (c > 0.0f ? std::min(c, 1.0f) : 0.0f) * 255.0f;
   return std::uint8_t(int(double(v) + 0.5));
 }
+
+// One row of premultiplied RGBA over the background `bgc` to RGBA8 (alpha 255): to_byte(v[k] + (1 − v[3])·bgc[k]).
+void finish_row(const float* v, std::uint8_t* q, int n, const float bgc[3]) {
+  int x = 0;
+#if defined(__AVX2__) && defined(__FMA__)
+  // A pixel's four channels at once. The scalar loop compiled with FMA contracts v + (1 − α)·bg into
+  // one fused multiply-add, so this does too; the clamp sends NaN to 0 as to_byte does (the comparison
+  // is false for NaN); the alpha lane's byte is overwritten with 255. The same bytes as the scalar
+  // loop, at about a third of its instructions (no branches, one conversion for four channels).
+  const __m128 bg = _mm_setr_ps(bgc[0], bgc[1], bgc[2], 0.0f), one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+  const __m128 scale = _mm_set1_ps(255.0f);
+  const __m256d half = _mm256_set1_pd(0.5);
+  const __m128i opaque = _mm_set1_epi32(int(0xff000000u));
+  for (; x < n; ++x, v += 4, q += 4) {
+    const __m128 p = _mm_loadu_ps(v);
+    const __m128 c = _mm_fmadd_ps(_mm_sub_ps(one, _mm_shuffle_ps(p, p, 0xff)), bg, p);
+    const __m128 t = _mm_mul_ps(_mm_and_ps(_mm_cmpgt_ps(c, zero), _mm_min_ps(c, one)), scale);
+    const __m128i i = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_cvtps_pd(t), half));
+    const __m128i b = _mm_packus_epi16(_mm_packus_epi32(i, i), _mm_setzero_si128());
+    const int rgba = _mm_cvtsi128_si32(_mm_or_si128(b, opaque));
+    std::memcpy(q, &rgba, 4);
+  }
+#endif
+  for (; x < n; ++x, v += 4, q += 4) {
+    q[0] = to_byte(v[0] + (1 - v[3]) * bgc[0]);
+    q[1] = to_byte(v[1] + (1 - v[3]) * bgc[1]);
+    q[2] = to_byte(v[2] + (1 - v[3]) * bgc[2]);
+    q[3] = 255;
+  }
+}
 }  // namespace
 
 void finish_image_into(const PartialImage& comp, const camera::Camera& cam, const GridGeometry& g, Image& img, Rgb bg,
@@ -266,16 +300,7 @@ void finish_image_into(const PartialImage& comp, const camera::Camera& cam, cons
     const bool in_rows = y >= r.y0 && y < r.y1;
     const int xa = in_rows ? r.x0 : w, xb = in_rows ? r.x1 : w;
     for (int x = 0; x < xa; ++x) std::memcpy(o + 4 * std::size_t(x), bg8, 4);
-    if (xa < xb) {
-      const float* v = comp.rgba_at(xa, y);
-      std::uint8_t* q = o + 4 * std::size_t(xa);
-      for (int x = xa; x < xb; ++x, v += 4, q += 4) {
-        q[0] = to_byte(v[0] + (1 - v[3]) * bgc[0]);
-        q[1] = to_byte(v[1] + (1 - v[3]) * bgc[1]);
-        q[2] = to_byte(v[2] + (1 - v[3]) * bgc[2]);
-        q[3] = 255;
-      }
-    }
+    if (xa < xb) finish_row(comp.rgba_at(xa, y), o + 4 * std::size_t(xa), xb - xa, bgc);
     for (int x = std::max(xb, 0); x < w; ++x) std::memcpy(o + 4 * std::size_t(x), bg8, 4);
   }
   if (!outline.enabled) return;

@@ -1375,6 +1375,8 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   caller_rays.reset(cam, rect.x0, rect.y0, rect.x1, rect.y1);
   double O_index[3];
   for (int a = 0; a < 3; ++a) O_index[a] = (rays.origin()[a] - S.grid.origin[a]) / S.spacing[a];
+  // One brick for the whole domain (one rank): its box is the domain's.
+  const bool whole_domain = std::equal(blo, blo + 3, glo) && std::equal(bhi, bhi + 3, ghi);
   auto locate = [&](int x, int y, PixelRay& r) {
     r.dir = rays.direction(x, y);
     for (int a = 0; a < 3; ++a) {
@@ -1386,7 +1388,11 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     if (!slab(r.O, r.D, glo, ghi, tg0, r.tg1, ag)) return false;
     r.t0 = std::max(tg0, 0.0);
     if (r.tg1 <= r.t0) return false;
-    if (!slab(r.O, r.D, blo, bhi, r.tb0, r.tb1, ab)) return false;
+    if (whole_domain) {  // the brick's slab test would repeat the domain's, bit for bit
+      r.tb0 = tg0, r.tb1 = r.tg1, ab = ag;
+    } else if (!slab(r.O, r.D, blo, bhi, r.tb0, r.tb1, ab)) {
+      return false;
+    }
     r.face = 0;
     if (r.tb0 >= r.t0 && ab >= 0) r.face = std::uint8_t(1 + 4 * ab + (r.D[ab] < 0));
     else if (tg0 > 0 && ag >= 0) r.face = std::uint8_t(3 + 4 * ag + (r.D[ag] < 0));
