@@ -1367,9 +1367,9 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   };
   const bool planar = cam.projection() == camera::Projection::perspective;
   // Camera::ray of the rect's pixels from per-column and per-row terms (the same bits); the origin in
-  // index coordinates is every ray's.
-  // The tables live per calling thread (reused capacity); the OpenMP threads below share this one
-  // through the reference (a thread_local named inside the region would be each thread's own).
+  // index coordinates is every ray's. The tables live per calling thread (reused capacity); the OpenMP
+  // threads below share this one through the reference (a thread_local named inside the region would
+  // be each thread's own, empty).
   thread_local camera::PixelRays caller_rays;
   const camera::PixelRays& rays = caller_rays;
   caller_rays.reset(cam, rect.x0, rect.y0, rect.x1, rect.y1);
