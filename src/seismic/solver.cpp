@@ -1217,6 +1217,61 @@ FieldView Solver::vz() const { return impl_->view(impl_->vz, {0, 0, 0.5}); }
 FieldView Solver::phi_p() const { return impl_->view(impl_->phip, {0, 0, 0}); }
 FieldView Solver::phi_s() const { return impl_->view(impl_->phis, {0, 0, 0}); }
 
+namespace {
+// Forward staggered 4th-order difference (times h) of f at i + ½·st.
+[[gnu::always_inline]] inline float dfwd(const float* f, long i, long st) {
+  return C1 * (f[i + st] - f[i]) + C2 * (f[i + 2 * st] - f[i - st]);
+}
+
+// φp and φs of one row of the two planes under a free surface, computed like the stress update
+// computes its strains there (PANOPTES_STRAIN), so no velocity above the surface is read (the ghost
+// planes above z = 0 hold no model value; the interior stencil read them and made φ on the surface
+// plane 10-30x the interior's). Zm = 1, the surface plane z = 0: ∂z vz = −λ/(λ+2μ)(∂x vx + ∂y vy)
+// (σzz = 0, as in the stress update); the x and y curl components from σxz = σyz = 0, i.e.
+// ∂z vx = −∂x vz and ∂z vy = −∂y vz, so ωx = 2 ∂y vz, ωy = −2 ∂x vz on the two edges at z = 0 around
+// the node (the stress images make σxz, σyz antisymmetric about z = 0: the same condition), with vz
+// at z = 0 extrapolated linearly from its planes at h/2 and 3h/2 (2nd order; vz at h/2 alone would be
+// 1st order, ∂z vz ≠ 0 at the surface). ωz lies in the plane and keeps the interior stencil.
+// Zm = 2, the plane z = h: 2nd-order ∂z vz (as the stress update) and 2nd-order ∂z vx, ∂z vy on the
+// edges at z = h/2 (as the stress update's σxz, σyz there); the edges at 3h/2 keep 4th order.
+template <int Zm, class M>
+[[gnu::always_inline]] inline void derived_surface_row(const M& m, int nx, long Y, long Z, float ih,
+                                                       const float* __restrict ux, const float* __restrict uy,
+                                                       const float* __restrict uz, float* __restrict pp,
+                                                       float* __restrict ps) {
+#pragma omp simd
+  for (int i = 0; i < nx; ++i) {
+    const float exx = C1 * (ux[i] - ux[i - 1]) + C2 * (ux[i + 1] - ux[i - 2]);
+    const float eyy = C1 * (uy[i] - uy[i - Y]) + C2 * (uy[i + Y] - uy[i - 2 * Y]);
+    float ezz, wx = 0, wy = 0, wz = 0;
+    if constexpr (Zm == 1) {
+      const float la = m(LAM, i), tm = m(TWOMU, i);
+      ezz = -la / (la + tm) * (exx + eyy);
+      // ∂ of vz(z = 0) = 1.5 vz(h/2) − 0.5 vz(3h/2) on the edges at ±½ around the node; each edge
+      // counts twice so that 0.25·(sum) is the node value, as for the four edges of the interior.
+      wx = 2.0f * (1.5f * (dfwd(uz, i, Y) + dfwd(uz, i - Y, Y)) - 0.5f * (dfwd(uz, i + Z, Y) + dfwd(uz, i + Z - Y, Y)));
+      wy = -2.0f * (1.5f * (dfwd(uz, i, 1) + dfwd(uz, i - 1, 1)) - 0.5f * (dfwd(uz, i + Z, 1) + dfwd(uz, i + Z - 1, 1)));
+    } else {
+      ezz = uz[i] - uz[i - Z];
+      wx += dfwd(uz, i, Y) - dfwd(uy, i, Z);
+      wx += dfwd(uz, i - Z, Y) - (uy[i] - uy[i - Z]);
+      wx += dfwd(uz, i - Y, Y) - dfwd(uy, i - Y, Z);
+      wx += dfwd(uz, i - Y - Z, Y) - (uy[i - Y] - uy[i - Y - Z]);
+      wy += dfwd(ux, i, Z) - dfwd(uz, i, 1);
+      wy += (ux[i] - ux[i - Z]) - dfwd(uz, i - Z, 1);
+      wy += dfwd(ux, i - 1, Z) - dfwd(uz, i - 1, 1);
+      wy += (ux[i - 1] - ux[i - 1 - Z]) - dfwd(uz, i - 1 - Z, 1);
+    }
+    wz += dfwd(uy, i, 1) - dfwd(ux, i, Y);
+    wz += dfwd(uy, i - Y, 1) - dfwd(ux, i - Y, Y);
+    wz += dfwd(uy, i - 1, 1) - dfwd(ux, i - 1, Y);
+    wz += dfwd(uy, i - 1 - Y, 1) - dfwd(ux, i - 1 - Y, Y);
+    pp[i] = ih * (exx + eyy + ezz);
+    ps[i] = 0.25f * ih * std::sqrt(wx * wx + wy * wy + wz * wz);
+  }
+}
+}  // namespace
+
 void Solver::compute_derived() {
   Impl& s = *impl_;
   if (s.phip.size() != s.N) {
@@ -1235,6 +1290,17 @@ void Solver::compute_derived() {
       const float* __restrict uz = s.vz.data() + b;
       float* __restrict pp = s.phip.data() + b;
       float* __restrict ps = s.phis.data() + b;
+      // Only the rank owning the global planes 0 and 1 (slabs have >= 2 planes) has surface rows.
+      const int g = k + s.kb;
+      if (s.free_surface && g <= 1) {
+        const std::size_t r = std::size_t(k) * ny + j;
+        if (g == 1) derived_surface_row<2>(UniformMat{nullptr}, nx, Y, Z, ih, ux, uy, uz, pp, ps);
+        else if (const int u = s.row_mat[r]; u >= 0)
+          derived_surface_row<1>(UniformMat{s.mat_tuples.data() + std::size_t(u) * s.K}, nx, Y, Z, ih, ux, uy, uz, pp, ps);
+        else if (s.mat_table) derived_surface_row<1>(s.table_mat().row(b), nx, Y, Z, ih, ux, uy, uz, pp, ps);
+        else derived_surface_row<1>(s.dense_mat().row(b), nx, Y, Z, ih, ux, uy, uz, pp, ps);
+        continue;
+      }
       auto d = [](const float* f, long i, long st) {  // forward staggered derivative at i + ½·st
         return C1 * (f[i + st] - f[i]) + C2 * (f[i + 2 * st] - f[i - st]);
       };
