@@ -1247,10 +1247,10 @@ template <int Zm, class M>
     if constexpr (Zm == 1) {
       const float la = m(LAM, i), tm = m(TWOMU, i);
       ezz = -la / (la + tm) * (exx + eyy);
-      // ∂ of vz(z = 0) = 1.5 vz(h/2) − 0.5 vz(3h/2) on the edges at ±½ around the node; each edge
-      // counts twice so that 0.25·(sum) is the node value, as for the four edges of the interior.
-      wx = 2.0f * (1.5f * (dfwd(uz, i, Y) + dfwd(uz, i - Y, Y)) - 0.5f * (dfwd(uz, i + Z, Y) + dfwd(uz, i + Z - Y, Y)));
-      wy = -2.0f * (1.5f * (dfwd(uz, i, 1) + dfwd(uz, i - 1, 1)) - 0.5f * (dfwd(uz, i + Z, 1) + dfwd(uz, i + Z - 1, 1)));
+      // ∂ of vz(z = 0) = 1.5 vz(h/2) − 0.5 vz(3h/2) on the two edges at ±½ around the node, times 2
+      // (ω = ±2 ∂vz) and times 2 again (two edges instead of the interior's four: 0.25·sum is the node value).
+      wx = 4.0f * (1.5f * (dfwd(uz, i, Y) + dfwd(uz, i - Y, Y)) - 0.5f * (dfwd(uz, i + Z, Y) + dfwd(uz, i + Z - Y, Y)));
+      wy = -4.0f * (1.5f * (dfwd(uz, i, 1) + dfwd(uz, i - 1, 1)) - 0.5f * (dfwd(uz, i + Z, 1) + dfwd(uz, i + Z - 1, 1)));
     } else {
       ezz = uz[i] - uz[i - Z];
       wx += dfwd(uz, i, Y) - dfwd(uy, i, Z);
