@@ -88,10 +88,11 @@ preset = "superfast"
 playback_fps = 10      # the player shows the 48 snapshots in ~5 s (the movies themselves are 30 fps)
 
 [render]               # 1.0 voxel: the largest step whose frames look like 0.5 voxel's. Measured on the demo's
-sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) against 0.5: PSNR mean 48-53 dB, min
-percentile = 0.999     # 34 dB (the view down onto the surface, whose thin dark gaps between saturated p rings thin
-                       # out slightly; they look alike). 1.5 voxel: min 26 dB, 2.0: min 22 dB, and the gaps fill in
-                       # visibly (docs/insitu.md). 0.5 voxel would cost more march for no visible gain.
+sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) against 0.5, with the windows below
+percentile = 0.999     # and phi without the surface sheet (2026-11-25): PSNR mean 55-56 dB, min 44.7 (p+s, the view
+                       # down onto the surface); 1.5 voxel: min 39.1 dB. (With the sheet and the former windows the
+                       # saturated p rings at the surface gave min 34 dB at 1.0, 26 at 1.5: docs/insitu.md.)
+                       # 0.5 voxel would cost more march for no visible gain.
 adaptive = true        # 3-4 px per voxel: interpolate smooth cells of every 4th pixel's rays; frames within
                        # 65.6 dB (min) of marching every pixel, the thin gaps kept (docs/rendering.md, Round 4)
 
