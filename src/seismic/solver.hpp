@@ -83,8 +83,9 @@ class Solver {
   FieldView vy() const;
   FieldView vz() const;
   /// Computes φp = ∇·v and φs = |∇×v| at the nodes of this rank's block (4th-order differences;
-  /// curl components averaged from their edges to the node). Uses the velocity halos of the
-  /// last step, so no communication. Units: 1/s.
+  /// curl components averaged from their edges to the node). On the two planes under a free surface
+  /// it uses the stress update's surface strains and σxz = σyz = 0, reading no velocity above the
+  /// surface (docs/seismic.md). Uses the velocity halos of the last step, so no communication. Units: 1/s.
   void compute_derived();
   FieldView phi_p() const;  ///< valid after compute_derived()
   FieldView phi_s() const;  ///< valid after compute_derived()
