@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green, both together) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: about 3.3 min (200 s wall, 383 CPU-seconds), 2026-11-25 19:24 UTC on the idle 2-core machine (AMD EPYC): the whole demo as scripts/demo runs it (OpenMP waiting passively), of which render 161 s, encode 24 s, composite 13 s, simulation 1 s; above the 2-3 min target.
+# Measured: about 2.6 min (158 s wall, 306 CPU-seconds), 2026-11-25 22:00 UTC on the idle 2-core machine (AMD EPYC): the whole demo as scripts/demo runs it (OpenMP waiting passively), of which render 129 s, encode 20 s, composite 8 s, simulation 1 s.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
