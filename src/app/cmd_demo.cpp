@@ -145,11 +145,11 @@ std::string measured_time() {
 }
 
 // Printed under the overhead line, which for the demo alone reads as alarming: its simulation is tiny
-// on purpose. The paper-scale figures are paper_snapshot_bench's (BENCHMARKS.md, 2026-11-23, f514d2c).
+// on purpose. The paper-scale figures are the measured paper run of 2026-11-25 (docs/rendering.md, round 6).
 const char* kOverheadNote =
     "  (the demo's grid, 64x128x40, is small so that the demo runs in minutes: its simulation is cheap and this\n"
-    "  ratio large. At the paper's 256x512x160 grid a snapshot's 40 solver steps take 7.2 s on 2 cores and its\n"
-    "  390 frames of 920x896 about 38 s: about 5x. BENCHMARKS.md, paper_snapshot_bench.)";
+    "  ratio large. At the paper's 256x512x160 grid, panoptes run examples/paper.toml (60 snapshots, 390 movies\n"
+    "  of 920x896) took 27.7 min on 2 cores, visualization 6.1x the simulation: docs/rendering.md, round 6.)";
 
 CommandRegistration reg([](CLI::App& root) {
   auto opt = std::make_shared<SeismicRunOptions>();
