@@ -13,7 +13,7 @@
 //                        the part of the ratio due to the K-task march going further. Also the same K
 //                        images by K separate marches (K_over_separate), samples marched per ray
 //                        (one, K, separate) and, for isosurfaces, hits per ray of the K images.
-//   BM_ManyImagesPaperOptions  mixes 0 and 1 at examples/paper.toml's options (1.0 voxel, adaptive sampling).
+//   BM_ManyImagesPaperOptions  mixes 0, 1 and 2 at examples/paper.toml's options (1.0 voxel, adaptive sampling).
 //   BM_ParaViewAnchor    128x256x80 float32 dense volume, 8 cameras at 1.1x the diagonal, 920x896, one
 //                        volume task: CPU-seconds per image next to ParaView 5.11 "Ray Cast Only"'s 1.46.
 //   BM_DemoAdaptive      examples/demo.toml's snapshot at step 240 through the in-situ session with adaptive
@@ -325,7 +325,7 @@ void BM_ManyImagesPaperOptions(benchmark::State& state) {
   state.counters["step_voxel"] = opt.sample_distance;
   many_images(state, opt);
 }
-BENCHMARK(BM_ManyImagesPaperOptions)->ArgName("mix")->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ManyImagesPaperOptions)->ArgName("mix")->Arg(0)->Arg(1)->Arg(2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 
 // PSNR against the reference path (computed once; the scalar reference takes a while).
