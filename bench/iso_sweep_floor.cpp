@@ -126,7 +126,7 @@ int main(int argc, char** argv) try {
       char* end = nullptr;
       const double v = std::strtod(argv[++i], &end);
       if (!end || *end || !(v > 0) || (a == "--stride" && (v != std::floor(v) || v > 64)) || (a == "--step" && v > 16))
-        throw Error(std::string("iso_sweep_floor: ") + a + " " + argv[i] +
+        throw Error(a + " " + argv[i] +
                     "; expected a whole number 1..64 (--stride) or 0 < D <= 16 (--step)");
       (a == "--stride" ? void(stride = int(v)) : void(step = v));
       continue;

@@ -162,7 +162,7 @@ void BM_ParaViewAnchor(benchmark::State& state) {
   state.counters["marched_pct"] = 100.0 * double(marched) / double(marched + interpolated);
 }
 // Seven repetitions whatever REPS is: a row takes 0.5-2 s, and the target row's median moved by
-// 0.126-0.169 CPU-s between runs of one binary on the shared machine (2026-11-26), around a 0.15 bound.
+// 0.126-0.177 CPU-s between runs of one binary on the shared machine (2026-11-26), around a 0.15 bound.
 BENCHMARK(BM_ParaViewAnchor)->ArgNames({"sparse", "step_x10", "adaptive"})->ArgsProduct({{0, 1}, {5, 10}, {0, 1}})->Iterations(1)->Repetitions(7)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Simulation seconds per snapshot of the paper setting, measured by BM_PaperSimulation (0 until then).
