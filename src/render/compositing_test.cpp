@@ -100,6 +100,41 @@ TEST(Compositing, OneMarchForKTasksEqualsKMarches) {
   EXPECT_LT(st.marched_samples, separate_marched);
 }
 
+// An isosurface sweep (many isovalues of one field, the case `BM_ManyImages/mix:2` measures): every
+// isovalue's image from one march is its one-task image, bit for bit, with more than 8 values on one
+// field, sweeps on two fields, a value repeated, values that are exactly grid values, and a volume
+// task in the same march. Guards any per-block shortcut over the live isovalues (one was tried in
+// Round 8 of docs/rendering.md; this test caught its off-by-one mutant).
+TEST(Compositing, IsosurfaceSweepInOneMarchGivesEveryIsovalueItsOneTaskImage) {
+  const Scene sc;
+  std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  std::vector<TaskSpec> tasks;
+  for (int i = 0; i < 11; ++i)
+    tasks.push_back(TaskSpec::isosurface(0, -0.75f + 0.15f * float(i), {1, 0.1f * float(i), 0.2f}));
+  tasks.push_back(TaskSpec::isosurface(0, 0.3f, {0.2f, 0.2f, 1}));  // the same value as task 7
+  tasks.push_back(TaskSpec::isosurface(0, sc.p[std::size_t(20 + 41 * (18 + 37 * 16))], {0.5f, 1, 0.5f}));
+  tasks.push_back(TaskSpec::isosurface(0, sc.p[std::size_t(23 + 41 * (20 + 37 * 17))], {0.5f, 0.5f, 1}));
+  for (int i = 0; i < 4; ++i)
+    tasks.push_back(TaskSpec::isosurface(1, -0.3f + 0.2f * float(i), {0.3f, 0.9f, 0.1f * float(i)}));
+  tasks.push_back(sc.tasks[0]);
+  for (const auto& cam : kCams) {
+    std::vector<PartialImage> together(tasks.size());
+    const RenderStats st = render_brick(cam, fields, tasks, together);
+    std::uint64_t separate_marched = 0;
+    int with_hits = 0;
+    for (std::size_t t = 0; t < tasks.size(); ++t) {
+      std::vector<PartialImage> one(1);
+      separate_marched += render_brick(cam, fields, std::span(&tasks[t], 1), one).marched_samples;
+      EXPECT_EQ(one[0].rgba, together[t].rgba) << "task " << t;
+      bool hit = false;
+      for (std::size_t i = 3; i < one[0].rgba.size() && !hit; i += 4) hit = one[0].rgba[i] > 0;
+      with_hits += hit;
+    }
+    EXPECT_GE(with_hits, 12);  // the scene gives most isovalues a surface to hit
+    EXPECT_LT(st.marched_samples, separate_marched);
+  }
+}
+
 // The paper's three volume tasks on the test scene: p, s and the two-field p+s.
 std::vector<TaskSpec> p_s_and_ps_tasks() {
   return {
