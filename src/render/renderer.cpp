@@ -485,12 +485,12 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
 }
 
 // Software prefetch of the corner records of samples k0 … k0 + kBlock − 1 of the N fields (one
-// corner layout, as interp_block_corners_n(); the same clamped cell records). For the general
-// (K-task) path only: a block there composites several tasks, which fills the out-of-order window,
-// so the loads of the following blocks are issued only after this one retires and each block waits
-// for memory (the corner copies are far larger than L3). The single-task loop's blocks are short
-// enough for the window to run ahead by itself (prefetching there measured nothing, Round 5a).
-// Prefetches never fault and change no value, so images keep their bits.
+// corner layout, as interp_block_corners_n(); the same clamped cell records). The corner copies are
+// far larger than L3 and a ray's cells are scattered through them, so without it every block waits
+// for memory: in the general (K-task) path, whose blocks composite several tasks and fill the
+// out-of-order window (Round 6k), and — measured on the AMD EPYC machine, not on the earlier Intel
+// one (Round 5a) — in the single-task loop too (Round 8: −17 % CPU for one volume task on the paper
+// grid at 0.5 voxel). Prefetches never fault and change no value, so images keep their bits.
 constexpr int kPrefetchBlocks = 2;  // distance in blocks: see Round 6k in docs/rendering.md for 1, 2 and 3
 template <int N>
 inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
@@ -717,6 +717,10 @@ std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::in
   alignas(32) int bin[kBlock];
   for (std::int64_t k0 = kb; k0 <= kend; k0 += kBlock) {
     const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
+    if (f.corners && k0 + kPrefetchBlocks * kBlock <= kend) {
+      const FieldAcc* const fs[1] = {&f};
+      prefetch_block_corners<1>(fs, P, k0 + kPrefetchBlocks * kBlock);
+    }
     volume_block(f, P, k0, n, safe, v);
     lut_bin_block<kRowShift>(v, T.lo1, T.sc1, T.last1, T.abs1, bin);
     const int stop = composite_volume1(T.row1, bin, n, k0, k_partial, partial, tr_stop, a0, a1, a2, tr);
