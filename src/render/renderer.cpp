@@ -491,7 +491,7 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
 // out-of-order window (Round 6k), and — measured on the AMD EPYC machine, not on the earlier Intel
 // one (Round 5a) — in the single-task loop too (Round 8: −17 % CPU for one volume task on the paper
 // grid at 0.5 voxel). Prefetches never fault and change no value, so images keep their bits.
-constexpr int kPrefetchBlocks = 2;  // distance in blocks: see Round 6k in docs/rendering.md for 1, 2 and 3
+constexpr int kPrefetchBlocks = 2;  // distance in blocks: Rounds 6k (K-task path: 1, 2, 3) and 8 (both: 1, 2, 4), docs/rendering.md
 template <int N>
 inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
 #ifdef PANOPTES_RENDER_AVX2
