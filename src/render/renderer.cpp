@@ -488,9 +488,9 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
 // corner layout, as interp_block_corners_n(); the same clamped cell records). The corner copies are
 // far larger than L3 and a ray's cells are scattered through them, so without it every block waits
 // for memory: in the general (K-task) path, whose blocks composite several tasks and fill the
-// out-of-order window (Round 6k), and — measured on the AMD EPYC machine, not on the earlier Intel
-// one (Round 5a) — in the single-task loop too (Round 8: −17 % CPU for one volume task on the paper
-// grid at 0.5 voxel). Prefetches never fault and change no value, so images keep their bits.
+// out-of-order window (Round 6k), and in the single-task loop too (Round 8: −17 % CPU for one volume
+// task on the paper grid at 0.5 voxel; Round 5a's sparser prefetch, every other lane one block ahead,
+// had not paid). Prefetches never fault and change no value, so images keep their bits.
 constexpr int kPrefetchBlocks = 2;  // distance in blocks: Rounds 6k (K-task path: 1, 2, 3) and 8 (both: 1, 2, 4), docs/rendering.md
 template <int N>
 inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
