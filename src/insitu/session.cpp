@@ -574,8 +574,14 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   prepared.clear();
   if (b.has_brick) {
     render::PointRange pr{req.lo, req.hi};
+    std::vector<render::FieldView> views;
     for (std::size_t f = 0; f < field_names.size(); ++f)
-      prepared.emplace_back(render::FieldView::of_brick(grid, b.brick, pr, buffers[f].data()));
+      views.push_back(render::FieldView::of_brick(grid, b.brick, pr, buffers[f].data()));
+    // Every camera renders every task in one march: the fields the volume tasks read together get
+    // one interleaved corner copy (render::prepare_fields()).
+    std::vector<render::TaskSpec> uses;
+    for (const Task& t : tasks) uses.push_back(t.spec);
+    prepared = render::prepare_fields(views, uses);
   }
 }
 

@@ -170,6 +170,81 @@ TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
   }
 }
 
+// prepare_fields() gives the fields that volume tasks read together one interleaved corner copy
+// (Round 9 of docs/rendering.md), and the march composites single-field volume tasks in groups of
+// four with their chains interleaved. Neither may change a bit: with p, s and p+s, six more volume
+// tasks on p (two groups, one of them partial), isosurfaces and slices in one march, every task's
+// image equals its one-task image on separately prepared fields, on bricks too (the joint copy of a
+// brick view), and a single task read from the joint copy equals its own copy's image.
+TEST(Compositing, JointCornerCopiesAndGroupedTasksGiveTheOneTaskImages) {
+  const Scene sc;
+  std::vector<TaskSpec> tasks = p_s_and_ps_tasks();
+  for (int i = 0; i < 6; ++i)
+    tasks.push_back(TaskSpec::volume(0, TransferFunction::preset(i % 2 ? "hot" : "p-wave", 1 + i % 3),
+                                     ValueWindow::absolute(0, 0.5 + 0.15 * i)));
+  tasks.push_back(TaskSpec::volume(1, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1)));
+  tasks.push_back(sc.tasks[3]);  // isosurfaces and slices of both fields
+  tasks.push_back(sc.tasks[4]);
+  tasks.push_back(sc.tasks[5]);
+  tasks.push_back(sc.tasks[6]);
+  const std::vector<PreparedField> joint = prepare_fields(sc.views, tasks);
+  ASSERT_EQ(joint.size(), 2u);
+  ASSERT_EQ(joint[0].corners.record(), 16);
+  ASSERT_EQ(joint[1].corners.data(), joint[0].corners.data() + 8);
+  const std::vector<PreparedField> separate{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  ASSERT_EQ(separate[0].corners.record(), 8);
+  for (const auto& cam : kCams) {
+    std::vector<PartialImage> together(tasks.size());
+    render_brick(cam, joint, tasks, together);
+    for (std::size_t t = 0; t < tasks.size(); ++t) {
+      std::vector<PartialImage> one(1), one_joint(1);
+      render_brick(cam, separate, std::span(&tasks[t], 1), one);
+      EXPECT_EQ(one[0].rgba, together[t].rgba) << "task " << t;
+      render_brick(cam, joint, std::span(&tasks[t], 1), one_joint);
+      EXPECT_EQ(one[0].rgba, one_joint[0].rgba) << "task " << t;
+    }
+  }
+  // Bricks: each brick's fields prepared jointly still composite to the single-brick image.
+  const auto& cam = kCams[1];
+  std::vector<PartialImage> whole(3);
+  render_brick(cam, separate, std::span(tasks.data(), 3), whole);
+  for (const Brick& b : sc.slabs(2, 3)) {
+    const std::vector<FieldView> v{sc.views[0].subview(b), sc.views[1].subview(b)};
+    const std::vector<PreparedField> jb = prepare_fields(v, std::span(tasks.data(), 3));
+    const std::vector<PreparedField> sb{PreparedField(v[0]), PreparedField(v[1])};
+    std::vector<PartialImage> pj(3), ps(3);
+    render_brick(cam, jb, std::span(tasks.data(), 3), pj);
+    render_brick(cam, sb, std::span(tasks.data(), 3), ps);
+    for (int t = 0; t < 3; ++t) EXPECT_EQ(pj[std::size_t(t)].rgba, ps[std::size_t(t)].rgba) << "task " << t;
+  }
+}
+
+// Which copies prepare_fields() builds: none for a field only isosurfaces or slices read, its own
+// for a volume field without a partner, joint ones for two volume fields; bad field indices throw.
+TEST(Compositing, PrepareFieldsBuildsTheCopiesTheTasksRead) {
+  const Scene sc;
+  const TaskSpec vol_p = TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1));
+  const TaskSpec iso_s = TaskSpec::isosurface(1, 0.2f);
+  const std::vector<TaskSpec> p_and_iso{vol_p, iso_s};
+  std::vector<PreparedField> f = prepare_fields(sc.views, p_and_iso);
+  EXPECT_EQ(f[0].corners.record(), 8);
+  EXPECT_FALSE(f[0].corners.empty());
+  EXPECT_TRUE(f[1].corners.empty());
+  EXPECT_EQ(f[1].view.data, sc.views[1].data);
+  f = prepare_fields(sc.views, p_s_and_ps_tasks());
+  EXPECT_EQ(f[0].corners.record(), 16);
+  EXPECT_EQ(f[1].corners.record(), 16);
+  EXPECT_EQ(f[0].corners.bytes(), f[1].corners.bytes());
+  const TaskSpec wrong = TaskSpec::volume(2, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1));
+  EXPECT_THROW(prepare_fields(sc.views, std::span(&wrong, 1)), Error);
+  // Views of different point ranges cannot share a copy: each gets its own.
+  const std::vector<FieldView> mixed{sc.views[0], sc.views[1].subview(Brick::slab(sc.grid, 2, 2, 0))};
+  f = prepare_fields(mixed, p_s_and_ps_tasks());
+  EXPECT_EQ(f[0].corners.record(), 8);
+  EXPECT_EQ(f[1].corners.record(), 8);
+  EXPECT_THROW(CornerField::joint(mixed[0], mixed[1]), Error);
+}
+
 // Adaptive sampling decides per volume task (a cell is split only for the tasks whose corners
 // disagree), so a volume task's image from a K-task march is its one-task adaptive image, bit for
 // bit, and the K-task march marches fewer samples than the K one-task marches together.

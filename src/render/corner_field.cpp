@@ -1,5 +1,9 @@
 #include "render/corner_field.hpp"
 
+#include <string>
+
+#include "core/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -26,7 +30,7 @@ void* allocate_huge(std::size_t bytes) {
 void deallocate_huge(void* p) noexcept { std::free(p); }
 
 
-CornerField::CornerField(const FieldView& f) {
+bool CornerField::shape(const FieldView& f) {
   f.validate();
   const PointRange& pr = f.points;
   std::int64_t cells = 1;
@@ -37,8 +41,42 @@ CornerField::CornerField(const FieldView& f) {
   }
   if (cells > std::numeric_limits<std::int32_t>::max()) {
     counts_ = {0, 0, 0};
-    return;
+    return false;
   }
+  return true;
+}
+
+CornerField::CornerField(const FieldView& f) {
+  if (!shape(f)) return;
+  auto buf = std::make_shared<Buffer>(std::size_t(counts_[0]) * counts_[1] * counts_[2] * 8);
+  fill(f, buf->data(), 0);
+  data_ = buf->data();
+  q_ = std::move(buf);
+}
+
+std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const FieldView& b) {
+  a.validate();
+  b.validate();
+  if (a.points.lo != b.points.lo || a.points.hi != b.points.hi)
+    throw Error("CornerField::joint: the two views cover different point ranges ([" + std::to_string(a.points.lo[0]) +
+                ", " + std::to_string(a.points.hi[0]) + ") vs [" + std::to_string(b.points.lo[0]) + ", " +
+                std::to_string(b.points.hi[0]) + ") along x, or along y or z); a joint copy needs the same range");
+  std::pair<CornerField, CornerField> r;
+  if (!r.first.shape(a) || !r.second.shape(b)) return {};
+  const Index3& c = r.first.counts_;
+  auto buf = std::make_shared<Buffer>(std::size_t(c[0]) * c[1] * c[2] * 16);
+  r.first.record_ = r.second.record_ = 16;
+  r.first.fill(a, buf->data(), 0);
+  r.second.fill(b, buf->data(), 8);
+  r.first.data_ = buf->data();
+  r.second.data_ = buf->data() + 8;
+  r.first.q_ = buf;
+  r.second.q_ = std::move(buf);
+  return r;
+}
+
+void CornerField::fill(const FieldView& f, std::uint16_t* q, int lane) {
+  const PointRange& pr = f.points;
   const int nx = pr.hi[0] - pr.lo[0], ny = pr.hi[1] - pr.lo[1], nz = pr.hi[2] - pr.lo[2];
   auto at = [&](int i, int j, int k) {
     return f.data[std::int64_t(i) * f.stride[0] + std::int64_t(j) * f.stride[1] + std::int64_t(k) * f.stride[2]];
@@ -67,7 +105,6 @@ CornerField::CornerField(const FieldView& f) {
         pq[std::size_t(i + std::int64_t(nx) * (j + std::int64_t(ny) * k))] =
             u >= 0 ? std::uint16_t(std::min(u, 65535.0f)) : std::uint16_t(0);  // also NaN → 0
       }
-  q_.resize(std::size_t(cells) * 8);
   const int cx = counts_[0], cy = counts_[1], cz = counts_[2];
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < cz; ++k)
@@ -77,8 +114,8 @@ CornerField::CornerField(const FieldView& f) {
       const std::uint16_t* r10 = &pq[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k))];
       const std::uint16_t* r01 = &pq[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k1))];
       const std::uint16_t* r11 = &pq[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k1))];
-      std::uint16_t* out = &q_[std::size_t(8 * (std::int64_t(cx) * (j + std::int64_t(cy) * k)))];
-      for (int i = 0; i < cx; ++i, out += 8) {
+      std::uint16_t* out = q + std::size_t(record_) * std::size_t(std::int64_t(cx) * (j + std::int64_t(cy) * k)) + lane;
+      for (int i = 0; i < cx; ++i, out += record_) {
         const int i1 = std::min(i + 1, nx - 1);
         out[0] = r00[i], out[1] = r00[i1], out[2] = r10[i], out[3] = r10[i1];
         out[4] = r01[i], out[5] = r01[i1], out[6] = r11[i], out[7] = r11[i1];

@@ -3,7 +3,9 @@
 // and stored together, so one trilinear sample is one 16-byte load instead of eight gathered floats.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <new>
+#include <utility>
 #include <vector>
 
 #include "render/field_view.hpp"
@@ -32,26 +34,48 @@ struct HugePageAllocator {
 /// (0,1,1), (1,1,1), as q ∈ [0, 65535] with value = offset + scale·q (rounded to nearest: the error
 /// is at most scale / 2 = (max − min) / 131070 of the view's value range). 16 bytes per cell: four
 /// times the float32 field, paid once per snapshot and shared by every camera and task.
+///
+/// Two fields of one point range that a march reads together (the paper's p and s) may share one
+/// buffer (joint()): cell records of 32 bytes, the first field's 8 values then the second's, so a
+/// sample of both is one cache line instead of two (docs/rendering.md, Round 9). Values and
+/// quantization are those of two separate copies.
 class CornerField {
  public:
   CornerField() = default;
   /// Builds the copy (OpenMP-parallel). Views with more than 2^31 − 1 cells get an empty copy (the
   /// renderer then reads the float field).
   explicit CornerField(const FieldView& view);
+  /// The copies of two views with the same point range in one interleaved buffer: first.data() and
+  /// second.data() point 8 values apart, record() = 16. Throws panoptes::Error when the point
+  /// ranges differ.
+  static std::pair<CornerField, CornerField> joint(const FieldView& a, const FieldView& b);
 
-  bool empty() const { return q_.empty(); }
-  /// 8 values per cell, cells x fastest over counts().
-  const std::uint16_t* data() const { return q_.data(); }
+  bool empty() const { return data_ == nullptr; }
+  /// This field's 8 values of cell c start at data() + record()·c (cells x fastest over counts()).
+  const std::uint16_t* data() const { return data_; }
+  /// Values from one cell's record to the next: 8, or 16 in a joint copy.
+  int record() const { return record_; }
   /// Global index of the first cell's lower corner (= the view's points.lo).
   const Index3& lo() const { return lo_; }
   /// Cells per axis.
   const Index3& counts() const { return counts_; }
   float offset() const { return offset_; }
   float scale() const { return scale_; }
-  std::size_t bytes() const { return q_.size() * sizeof(std::uint16_t); }
+  /// This field's share of the buffer: 16 bytes per cell (a joint buffer is the sum of both).
+  std::size_t bytes() const {
+    return data_ ? std::size_t(16) * std::size_t(counts_[0]) * std::size_t(counts_[1]) * std::size_t(counts_[2]) : 0;
+  }
 
  private:
-  std::vector<std::uint16_t, HugePageAllocator<std::uint16_t>> q_;
+  using Buffer = std::vector<std::uint16_t, HugePageAllocator<std::uint16_t>>;
+  // Checks the view, sets lo_ and counts_; false when the copy would have too many cells.
+  bool shape(const FieldView& view);
+  // Quantizes `view` into the records of `out` at values lane … lane + 7 of every record.
+  void fill(const FieldView& view, std::uint16_t* out, int lane);
+
+  std::shared_ptr<const Buffer> q_;
+  const std::uint16_t* data_ = nullptr;
+  int record_ = 8;
   Index3 lo_{0, 0, 0}, counts_{0, 0, 0};
   float offset_ = 0, scale_ = 0;
 };

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -21,6 +22,32 @@ TEST(CornerField, HugePageAllocatorAlignsLargeBlocksAndKeepsContents) {
   big = small;  // reallocation through the allocator
   EXPECT_EQ(big.size(), 100u);
   EXPECT_EQ(big[0], 7);
+}
+
+// A joint copy holds, record by record, exactly the values of the two separate copies (so the
+// march reads the same numbers from either), with the same quantization.
+TEST(CornerField, JointCopyInterleavesTheTwoSeparateCopies) {
+  const GridGeometry g{{9, 7, 5}, {0, 0, 0}, {1, 1, 1}};
+  std::vector<float> a(std::size_t(9 * 7 * 5)), b(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::sin(0.37f * float(i)), b[i] = 3.0f * std::cos(0.11f * float(i)) - 1;
+  const FieldView va = FieldView::whole(g, a.data()), vb = FieldView::whole(g, b.data());
+  const CornerField sa(va), sb(vb);
+  const auto [ja, jb] = CornerField::joint(va, vb);
+  ASSERT_EQ(ja.record(), 16);
+  ASSERT_EQ(sa.record(), 8);
+  ASSERT_EQ(ja.counts(), sa.counts());
+  EXPECT_EQ(ja.offset(), sa.offset());
+  EXPECT_EQ(ja.scale(), sa.scale());
+  EXPECT_EQ(jb.offset(), sb.offset());
+  EXPECT_EQ(jb.scale(), sb.scale());
+  EXPECT_EQ(jb.data(), ja.data() + 8);
+  EXPECT_EQ(ja.bytes(), sa.bytes());
+  const std::size_t cells = std::size_t(sa.counts()[0]) * sa.counts()[1] * sa.counts()[2];
+  for (std::size_t c = 0; c < cells; ++c)
+    for (int v = 0; v < 8; ++v) {
+      ASSERT_EQ(ja.data()[16 * c + v], sa.data()[8 * c + v]) << "cell " << c;
+      ASSERT_EQ(jb.data()[16 * c + v], sb.data()[8 * c + v]) << "cell " << c;
+    }
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #pragma once
 // Min/max macro-cells of a field on a brick: the data structure behind empty-space skipping.
+#include <utility>
 #include <vector>
 
 #include "render/corner_field.hpp"
@@ -50,6 +51,9 @@ struct PreparedField {
       : view((v.validate(), v)), cells(v, macro_cell_size) {
     if (copy == FieldCopy::corners16) corners = CornerField(v);
   }
+  /// With a corner copy built elsewhere (e.g. one half of CornerField::joint()).
+  PreparedField(const FieldView& v, CornerField copy, int macro_cell_size = MacroCells::kDefaultSize)
+      : view((v.validate(), v)), cells(v, macro_cell_size), corners(std::move(copy)) {}
 };
 
 }  // namespace panoptes::render

@@ -79,6 +79,7 @@ struct FieldAcc {
   // slices and shading read the float field.
   const std::uint16_t* corners = nullptr;
   std::int32_t ccx = 0, ccxy = 0;  // corner records per row / per slice
+  std::int32_t crec = 8;           // uint16 per cell record (16: two fields interleaved)
   float qoff = 0, qscale = 0;      // value = qoff + qscale·q
 };
 
@@ -228,7 +229,7 @@ struct Shared {
   std::array<std::uint32_t, 8> corner_mates{};
   std::vector<TaskRt> rt;
   std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
-  std::uint64_t march_mask = 0, iso_mask = 0;
+  std::uint64_t march_mask = 0, iso_mask = 0, volume1_mask = 0;
   // Dense scenes: (nearly) every macro-cell is visible to every march task. A ray that meets none
   // of the few cells that are not (`exceptions`: their boxes in index space, grown by one voxel) would
   // have its walk merge all its cells into one run, so the march skips the walk and runs [ks, ke].
@@ -449,7 +450,7 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
     const __m256 wy = _mm256_fmadd_ps(_mm256_broadcast_ss(&fy[l]), sy, oy);
     const __m256 wz = _mm256_fmadd_ps(_mm256_broadcast_ss(&fz[l]), sz, oz);
     const __m256 w = _mm256_mul_ps(wx, _mm256_mul_ps(wy, wz));
-    const std::int64_t o = 8 * std::int64_t(id[l]);
+    const std::int64_t o = std::int64_t(f.crec) * id[l];
     for (int s = 0; s < N; ++s) {
       const __m128i q = _mm_loadu_si128(reinterpret_cast<const __m128i*>(fs[s]->corners + o));
       p[s][l] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q)), w);
@@ -473,7 +474,7 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
       const int j = std::min(std::max(int(y), f.ilo[1]), f.ihi[1]);
       const int k = std::min(std::max(int(z), f.ilo[2]), f.ihi[2]);
       const float fx = x - float(i), fy = y - float(j), fz = z - float(k);
-      const std::uint16_t* c = f.corners + 8 * (std::int64_t(i - f.ilo[0]) + std::int64_t(j - f.ilo[1]) * f.ccx +
+      const std::uint16_t* c = f.corners + f.crec * (std::int64_t(i - f.ilo[0]) + std::int64_t(j - f.ilo[1]) * f.ccx +
                                                 std::int64_t(k - f.ilo[2]) * f.ccxy);
       const float c00 = c[0] + fx * (c[1] - c[0]), c10 = c[2] + fx * (c[3] - c[2]);
       const float c01 = c[4] + fx * (c[5] - c[4]), c11 = c[6] + fx * (c[7] - c[6]);
@@ -511,9 +512,10 @@ inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos&
                      _mm256_add_epi32(cell(x, f.ilo[0], f.ihi[0]),
                                       _mm256_add_epi32(_mm256_mullo_epi32(cell(y, f.ilo[1], f.ihi[1]), _mm256_set1_epi32(f.ccx)),
                                                        _mm256_mullo_epi32(cell(z, f.ilo[2], f.ihi[2]), _mm256_set1_epi32(f.ccxy)))));
+  const bool joint = N == 2 && fs[N - 1]->corners == fs[0]->corners + 8;
   for (int l = 0; l < kBlock; ++l)
-    for (int s = 0; s < N; ++s)
-      _mm_prefetch(reinterpret_cast<const char*>(fs[s]->corners + 8 * std::int64_t(id[l])), _MM_HINT_T0);
+    for (int s = 0; s < (joint ? 1 : N); ++s)
+      _mm_prefetch(reinterpret_cast<const char*>(fs[s]->corners + std::int64_t(f.crec) * id[l]), _MM_HINT_T0);
 #else
   (void)fs, (void)P, (void)k0;
 #endif
@@ -528,7 +530,7 @@ inline void interp_block_corners(const FieldAcc& f, const RayPos& P, std::int64_
 // Whether two fields' corner copies have the same layout, so interp_block_corners_n() may share
 // their geometry.
 inline bool same_corner_layout(const FieldAcc& a, const FieldAcc& b) {
-  if (!a.corners || !b.corners || a.ccx != b.ccx || a.ccxy != b.ccxy) return false;
+  if (!a.corners || !b.corners || a.ccx != b.ccx || a.ccxy != b.ccxy || a.crec != b.crec) return false;
   for (int k = 0; k < 3; ++k)
     if (a.ilo[k] != b.ilo[k] || a.ihi[k] != b.ihi[k]) return false;
   return true;
@@ -623,31 +625,6 @@ inline int composite_volume1(const VolRow* lut, const int* bin, int n, std::int6
   return composite_volume1_scalar(lut, bin, n, k0, k_partial, partial, tr_stop, c0, c1, c2, tr);
 }
 
-// composite_volume1() on an accumulator row a = {c0, c1, c2, tr} in memory (the general path: one
-// 16-byte load and store per task and block instead of three scalar inserts and extracts). Lane 3 of
-// the colour vector starts at tr and collects junk; lanes 0–2 see the same operations, so the same bits.
-inline int composite_volume1_row(const VolRow* lut, const int* bin, int n, std::int64_t k0, std::int64_t k_partial,
-                                 float partial, float tr_stop, float* a) {
-#ifdef PANOPTES_RENDER_AVX2
-  if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
-    __m128 c = _mm_load_ps(a);
-    __m128 t = _mm_broadcast_ss(a + 3);
-    for (int l = 0; l < n; ++l) {
-      const __m128 r = _mm_load_ps(&row_at(lut, bin[l]).pr);
-      c = _mm_fmadd_ps(t, r, c);
-      t = _mm_mul_ps(t, _mm_permute_ps(r, 0xFF));
-    }
-    const float tr = _mm_cvtss_f32(t);
-    if (tr > tr_stop) [[likely]] {
-      _mm_store_ps(a, c);
-      a[3] = tr;
-      return -1;
-    }
-  }
-#endif
-  return composite_volume1_scalar(lut, bin, n, k0, k_partial, partial, tr_stop, a[0], a[1], a[2], a[3]);
-}
-
 // The same for a two-field volume task (extinctions add, colours mix by extinction): per sample
 // α = 1 − (1 − α1)(1 − α2) and colour (τ1·c1 + τ2·c2)·α/(τ1 + τ2). Rows of MixEntry hold τ·rgb, τ and
 // 1 − α, so the numerator and τ are one 4-lane add of the two rows, and no per-sample branch is left:
@@ -684,7 +661,7 @@ inline int composite_volume2(const MixEntry* m1, const MixEntry* m2, const int* 
   // As composite_volume1(): the colour accumulated as a 4-lane vector (the same operations as the
   // scalar loop, so the same bits; lane 3 collects s·τ, unused), termination tested once per block.
   if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
-    __m128 c = _mm_load_ps(a);  // lane 3 (tr) collects junk, as in composite_volume1_row()
+    __m128 c = _mm_load_ps(a);  // lane 3 (tr) collects junk, as in composite_group()
     float tr = a[3];
     for (int l = 0; l < n; ++l) {
       const MixEntry& e1 = row_at(m1, bin1[l]);
@@ -703,6 +680,45 @@ inline int composite_volume2(const MixEntry* m1, const MixEntry* m2, const int* 
   }
 #endif
   return composite_volume2_scalar(m1, m2, bin1, bin2, n, k0, k_partial, partial, tr_stop, a);
+}
+
+// One block of G single-field volume tasks (composite_volume1()), sample-outer: each task's
+// transmittance and colour form a latency chain of a multiply and an FMA per sample; interleaved,
+// the G chains run side by side. Per task the operations and their order are those of
+// composite_volume1(), so the same bits. The block is composited in registers; a task whose
+// transmittance reached tr_stop (once per ray), or a block holding the shortened last sample, is
+// redone by the scalar loop from its accumulator a[g] = {c0, c1, c2, tr}, written only on success.
+// Fills stop[g] as composite_volume1() returns it.
+template <int G>
+inline void composite_group(const VolRow* const* luts, const int (*bins)[kBlock], float* const* a, int* stop, int n,
+                            std::int64_t k0, std::int64_t k_partial, float partial, float tr_stop) {
+#ifdef PANOPTES_RENDER_AVX2
+  if (std::uint64_t(k_partial - k0) >= std::uint64_t(n)) {
+    __m128 c[G], t[G];  // lane 3 of c starts at tr and collects junk
+    for (int g = 0; g < G; ++g) c[g] = _mm_load_ps(a[g]), t[g] = _mm_broadcast_ss(a[g] + 3);
+    for (int l = 0; l < n; ++l)
+      for (int g = 0; g < G; ++g) {
+        const __m128 r = _mm_load_ps(&row_at(luts[g], bins[g][l]).pr);
+        c[g] = _mm_fmadd_ps(t[g], r, c[g]);
+        t[g] = _mm_mul_ps(t[g], _mm_permute_ps(r, 0xFF));
+      }
+    for (int g = 0; g < G; ++g) {
+      const float tr = _mm_cvtss_f32(t[g]);
+      if (tr > tr_stop) [[likely]] {
+        _mm_store_ps(a[g], c[g]);
+        a[g][3] = tr;
+        stop[g] = -1;
+      } else {
+        stop[g] = composite_volume1_scalar(luts[g], bins[g], n, k0, k_partial, partial, tr_stop, a[g][0], a[g][1],
+                                           a[g][2], a[g][3]);
+      }
+    }
+    return;
+  }
+#endif
+  for (int g = 0; g < G; ++g)
+    stop[g] = composite_volume1_scalar(luts[g], bins[g], n, k0, k_partial, partial, tr_stop, a[g][0], a[g][1],
+                                       a[g][2], a[g][3]);
 }
 
 // The single-volume-task loop over samples kb … kend with field, LUT and accumulator in registers.
@@ -875,18 +891,44 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       }
       vq_from_vb = 0;
       int used = 0;  // lanes consumed by the task that went furthest
-      for (std::uint64_t m = lm; m; m &= m - 1) {
+      auto task_done = [&](int i, int stop) {
+        if (stop >= 0) {
+          live &= ~(std::uint64_t(1) << i);
+          used = std::max(used, stop + 1);
+        } else {
+          used = n;
+        }
+      };
+      // Single-field volume tasks in groups of up to four, their chains interleaved.
+      for (std::uint64_t m = lm & S.volume1_mask; m;) {
+        constexpr int kGroup = 4;
+        int ids[kGroup], g = 0;
+        const VolRow* luts[kGroup];
+        float* as[kGroup];
+        alignas(32) int bins[kGroup][kBlock];
+        int stops[kGroup];
+        for (; m && g < kGroup; m &= m - 1, ++g) {
+          const int i = std::countr_zero(m);
+          const TaskRt& T = S.rt[std::size_t(i)];
+          ids[g] = i, luts[g] = T.row1, as[g] = acc[i];
+          lut_bin_block<kRowShift>(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bins[g]);
+        }
+        switch (g) {
+          case 1: composite_group<1>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
+          case 2: composite_group<2>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
+          case 3: composite_group<3>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
+          default: composite_group<4>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
+        }
+        for (int q = 0; q < g; ++q) task_done(ids[q], stops[q]);
+      }
+      for (std::uint64_t m = lm & ~S.volume1_mask; m; m &= m - 1) {
         const int i = std::countr_zero(m);
         const TaskRt& T = S.rt[std::size_t(i)];
         float* a = acc[i];
         int stop = -1;
         switch (T.kind) {
-          case RtKind::volume1: {
-            alignas(32) int bin[kBlock];
-            lut_bin_block<kRowShift>(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin);
-            stop = composite_volume1_row(T.row1, bin, n, k0, k_partial, partial, tr_stop, a);
+          case RtKind::volume1:  // composited above, in groups
             break;
-          }
           case RtKind::volume2: {
             alignas(32) int bin1[kBlock], bin2[kBlock];
             lut_bin_block<kMixShift>(vq[T.s1], T.lo1, T.sc1, T.last1, T.abs1, bin1);
@@ -933,12 +975,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
           case RtKind::slice:
             break;
         }
-        if (stop >= 0) {
-          live &= ~(std::uint64_t(1) << i);
-          used = std::max(used, stop + 1);
-        } else {
-          used = n;
-        }
+        task_done(i, stop);
       }
       marched += std::uint64_t(used);
       for (std::uint32_t m = smask; m; m &= m - 1) {
@@ -1159,6 +1196,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
         acc.corners = cf.data();
         acc.ccx = cf.counts()[0];
         acc.ccxy = cf.counts()[0] * cf.counts()[1];
+        acc.crec = cf.record();
         acc.qoff = cf.offset();
         acc.qscale = cf.scale();
       }
@@ -1191,6 +1229,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
         if (t.field2 < 0) {
           rows[i] = vol_rows(l1);
           r.row1 = rows[i].data();
+          S.volume1_mask |= bit;
         }
         if (t.field2 >= 0) {
           r.s2 = slot(t.field2);
@@ -1241,6 +1280,12 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     for (std::size_t u = 0; u < S.acc.size(); ++u)
       if (u != s && same_corner_layout(S.acc[s], S.acc[u])) S.corner_mates[s] |= 1u << u;
   }
+  // A joint copy's partner is the only mate: their records share a cache line.
+  for (std::size_t s = 0; s < S.acc.size(); ++s)
+    for (std::size_t u = 0; u < S.acc.size(); ++u)
+      if ((S.corner_mates[s] >> u & 1) && S.acc[s].crec == 16 &&
+          (S.acc[u].corners == S.acc[s].corners + 8 || S.acc[s].corners == S.acc[u].corners + 8))
+        S.corner_mates[s] = 1u << u;
   // Macro-cells whose samples cannot reach a data face: cell index c0 − 1 … c1 readable with its
   // upper neighbour in every field (samples are placed within a small fraction of a voxel of their
   // macro-cell, so one cell of margin is plenty).
@@ -1521,6 +1566,57 @@ void shade_isosurface_hit(const FieldView& v, const double p[3], const Vec3& dir
     shade_hit(f, v.grid.dims, v.grid.spacing, p, dir, c, rgba);
   else
     shade_hit_scalar(f, v.grid.dims, v.grid.spacing, p, dir, c, rgba);
+}
+
+std::vector<PreparedField> prepare_fields(std::span<const FieldView> views, std::span<const TaskSpec> tasks,
+                                          int macro_cell_size) {
+  const int n = int(views.size());
+  auto check = [&](int f) {
+    if (f < 0 || f >= n)
+      throw Error("prepare_fields: a task refers to field " + std::to_string(f) + " but " + std::to_string(n) +
+                  " fields were given");
+    return f;
+  };
+  std::vector<char> volume(std::size_t(n), 0);
+  std::vector<std::pair<int, int>> wanted;  // two-field volume tasks first, then in order of use
+  std::vector<int> order;
+  for (const TaskSpec& t : tasks) {
+    if (t.kind != TaskKind::volume) {
+      check(t.field);
+      continue;
+    }
+    const int a = check(t.field);
+    if (!volume[std::size_t(a)]) volume[std::size_t(a)] = 1, order.push_back(a);
+    if (t.field2 >= 0) {
+      const int b = check(t.field2);
+      if (!volume[std::size_t(b)]) volume[std::size_t(b)] = 1, order.push_back(b);
+      if (a != b) wanted.emplace_back(a, b);
+    }
+  }
+  for (std::size_t i = 0; i + 1 < order.size(); ++i) wanted.emplace_back(order[i], order[i + 1]);
+  std::vector<int> partner(std::size_t(n), -1);
+  auto same_range = [&](int a, int b) {
+    return views[std::size_t(a)].points.lo == views[std::size_t(b)].points.lo &&
+           views[std::size_t(a)].points.hi == views[std::size_t(b)].points.hi;
+  };
+  for (const auto& [a, b] : wanted)
+    if (partner[std::size_t(a)] < 0 && partner[std::size_t(b)] < 0 && same_range(a, b))
+      partner[std::size_t(a)] = b, partner[std::size_t(b)] = a;
+  std::vector<PreparedField> out(static_cast<std::size_t>(n));
+  for (int f = 0; f < n; ++f) {
+    const FieldView& v = views[std::size_t(f)];
+    const int p = partner[std::size_t(f)];
+    if (p >= 0 && p < f) continue;  // built with its partner
+    if (p >= 0) {
+      auto [cf, cp] = CornerField::joint(v, views[std::size_t(p)]);
+      out[std::size_t(f)] = PreparedField(v, std::move(cf), macro_cell_size);
+      out[std::size_t(p)] = PreparedField(views[std::size_t(p)], std::move(cp), macro_cell_size);
+    } else {
+      out[std::size_t(f)] =
+          PreparedField(v, macro_cell_size, volume[std::size_t(f)] ? FieldCopy::corners16 : FieldCopy::none);
+    }
+  }
+  return out;
 }
 
 }  // namespace panoptes::render

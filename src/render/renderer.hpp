@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "camera/camera.hpp"
 #include "render/macro_cells.hpp"
@@ -90,5 +91,15 @@ inline constexpr int kMaxTasksPerMarch = 64;
 /// out.size() != tasks.size().
 RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedField> fields,
                          std::span<const TaskSpec> tasks, std::span<PartialImage> out, const RenderOptions& options = {});
+
+/// The fields of one brick prepared for marches of `tasks` (what a caller that renders the same
+/// task list from many cameras should build once per snapshot): a corner copy for every field a
+/// volume task reads, none for the others (isosurfaces and slices read the float field), and the
+/// copies of two such fields with the same point range interleaved (CornerField::joint()) — first
+/// the two fields of each two-field volume task, then the rest in order — since every march of
+/// the task list reads them sample by sample together. Images are those of separately prepared
+/// fields, bit for bit. Throws panoptes::Error when a task names a field outside `views`.
+std::vector<PreparedField> prepare_fields(std::span<const FieldView> views, std::span<const TaskSpec> tasks,
+                                          int macro_cell_size = MacroCells::kDefaultSize);
 
 }  // namespace panoptes::render
