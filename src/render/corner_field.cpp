@@ -48,10 +48,10 @@ bool CornerField::shape(const FieldView& f) {
 
 CornerField::CornerField(const FieldView& f) {
   if (!shape(f)) return;
-  auto buf = std::make_shared<Buffer>(std::size_t(counts_[0]) * counts_[1] * counts_[2] * 8);
-  fill(f, buf->data(), 0);
-  data_ = buf->data();
-  q_ = std::move(buf);
+  const std::vector<std::uint16_t> pq = quantize(f);
+  const std::vector<std::uint16_t>* const list[1] = {&pq};
+  q_ = write_records(list, 1, f, counts_);
+  data_ = q_.get();
 }
 
 std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const FieldView& b) {
@@ -63,19 +63,16 @@ std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const
                 std::to_string(b.points.hi[0]) + ") along x, or along y or z); a joint copy needs the same range");
   std::pair<CornerField, CornerField> r;
   if (!r.first.shape(a) || !r.second.shape(b)) return {};
-  const Index3& c = r.first.counts_;
-  auto buf = std::make_shared<Buffer>(std::size_t(c[0]) * c[1] * c[2] * 16);
+  const std::vector<std::uint16_t> pa = r.first.quantize(a), pb = r.second.quantize(b);
+  const std::vector<std::uint16_t>* const list[2] = {&pa, &pb};
+  r.first.q_ = r.second.q_ = write_records(list, 2, a, r.first.counts_);
   r.first.record_ = r.second.record_ = 16;
-  r.first.fill(a, buf->data(), 0);
-  r.second.fill(b, buf->data(), 8);
-  r.first.data_ = buf->data();
-  r.second.data_ = buf->data() + 8;
-  r.first.q_ = buf;
-  r.second.q_ = std::move(buf);
+  r.first.data_ = r.first.q_.get();
+  r.second.data_ = r.first.q_.get() + 8;
   return r;
 }
 
-void CornerField::fill(const FieldView& f, std::uint16_t* q, int lane) {
+std::vector<std::uint16_t> CornerField::quantize(const FieldView& f) {
   const PointRange& pr = f.points;
   const int nx = pr.hi[0] - pr.lo[0], ny = pr.hi[1] - pr.lo[1], nz = pr.hi[2] - pr.lo[2];
   auto at = [&](int i, int j, int k) {
@@ -105,22 +102,39 @@ void CornerField::fill(const FieldView& f, std::uint16_t* q, int lane) {
         pq[std::size_t(i + std::int64_t(nx) * (j + std::int64_t(ny) * k))] =
             u >= 0 ? std::uint16_t(std::min(u, 65535.0f)) : std::uint16_t(0);  // also NaN → 0
       }
-  const int cx = counts_[0], cy = counts_[1], cz = counts_[2];
+  return pq;
+}
+
+std::shared_ptr<std::uint16_t> CornerField::write_records(const std::vector<std::uint16_t>* const* pq, int nf,
+                                                          const FieldView& f, const Index3& counts) {
+  const PointRange& pr = f.points;
+  const int nx = pr.hi[0] - pr.lo[0], ny = pr.hi[1] - pr.lo[1], nz = pr.hi[2] - pr.lo[2];
+  const int cx = counts[0], cy = counts[1], cz = counts[2];
+  const int rec = 8 * nf;
+  const std::size_t values = std::size_t(cx) * std::size_t(cy) * std::size_t(cz) * std::size_t(rec);
+  std::shared_ptr<std::uint16_t> q(static_cast<std::uint16_t*>(allocate_huge(values * sizeof(std::uint16_t))),
+                                   [](std::uint16_t* p) { deallocate_huge(p); });
+  std::uint16_t* const base = q.get();
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < cz; ++k)
     for (int j = 0; j < cy; ++j) {
       const int k1 = std::min(k + 1, nz - 1), j1 = std::min(j + 1, ny - 1);
-      const std::uint16_t* r00 = &pq[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k))];
-      const std::uint16_t* r10 = &pq[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k))];
-      const std::uint16_t* r01 = &pq[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k1))];
-      const std::uint16_t* r11 = &pq[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k1))];
-      std::uint16_t* out = q + std::size_t(record_) * std::size_t(std::int64_t(cx) * (j + std::int64_t(cy) * k)) + lane;
-      for (int i = 0; i < cx; ++i, out += record_) {
-        const int i1 = std::min(i + 1, nx - 1);
-        out[0] = r00[i], out[1] = r00[i1], out[2] = r10[i], out[3] = r10[i1];
-        out[4] = r01[i], out[5] = r01[i1], out[6] = r11[i], out[7] = r11[i1];
+      std::uint16_t* const row = base + std::size_t(rec) * std::size_t(std::int64_t(cx) * (j + std::int64_t(cy) * k));
+      for (int s = 0; s < nf; ++s) {
+        const std::vector<std::uint16_t>& p = *pq[s];
+        const std::uint16_t* r00 = &p[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k))];
+        const std::uint16_t* r10 = &p[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k))];
+        const std::uint16_t* r01 = &p[std::size_t(std::int64_t(nx) * (j + std::int64_t(ny) * k1))];
+        const std::uint16_t* r11 = &p[std::size_t(std::int64_t(nx) * (j1 + std::int64_t(ny) * k1))];
+        std::uint16_t* out = row + 8 * s;
+        for (int i = 0; i < cx; ++i, out += rec) {
+          const int i1 = std::min(i + 1, nx - 1);
+          out[0] = r00[i], out[1] = r00[i1], out[2] = r10[i], out[3] = r10[i1];
+          out[4] = r01[i], out[5] = r01[i1], out[6] = r11[i], out[7] = r11[i1];
+        }
       }
     }
+  return q;
 }
 
 }  // namespace panoptes::render

@@ -67,13 +67,16 @@ class CornerField {
   }
 
  private:
-  using Buffer = std::vector<std::uint16_t, HugePageAllocator<std::uint16_t>>;
   // Checks the view, sets lo_ and counts_; false when the copy would have too many cells.
   bool shape(const FieldView& view);
-  // Quantizes `view` into the records of `out` at values lane … lane + 7 of every record.
-  void fill(const FieldView& view, std::uint16_t* out, int lane);
+  // The view's points quantized (sets offset_ and scale_), x fastest.
+  std::vector<std::uint16_t> quantize(const FieldView& view);
+  // Allocates the buffer (huge pages, not zeroed: every value is written) and writes the records
+  // of nf fields (1 or 2) from their quantized points, one pass over the buffer.
+  static std::shared_ptr<std::uint16_t> write_records(const std::vector<std::uint16_t>* const* pq, int nf,
+                                                      const FieldView& view, const Index3& counts);
 
-  std::shared_ptr<const Buffer> q_;
+  std::shared_ptr<std::uint16_t> q_;
   const std::uint16_t* data_ = nullptr;
   int record_ = 8;
   Index3 lo_{0, 0, 0}, counts_{0, 0, 0};
