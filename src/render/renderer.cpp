@@ -512,7 +512,8 @@ inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos&
                      _mm256_add_epi32(cell(x, f.ilo[0], f.ihi[0]),
                                       _mm256_add_epi32(_mm256_mullo_epi32(cell(y, f.ilo[1], f.ihi[1]), _mm256_set1_epi32(f.ccx)),
                                                        _mm256_mullo_epi32(cell(z, f.ilo[2], f.ihi[2]), _mm256_set1_epi32(f.ccxy)))));
-  const bool joint = N == 2 && fs[N - 1]->corners == fs[0]->corners + 8;
+  // The two halves of one joint copy (CornerField::joint()): a 32-byte record lies in one cache line.
+  const bool joint = N == 2 && (fs[N - 1]->corners == fs[0]->corners + 8 || fs[0]->corners == fs[N - 1]->corners + 8);
   for (int l = 0; l < kBlock; ++l)
     for (int s = 0; s < (joint ? 1 : N); ++s)
       _mm_prefetch(reinterpret_cast<const char*>(fs[s]->corners + std::int64_t(f.crec) * id[l]), _MM_HINT_T0);
@@ -823,9 +824,10 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         prev_valid = 0;  // values were not kept (no isosurface task is live here)
         return;
       }
-      // General path, task-outer: the block's values of every field a live task reads, then each
-      // live task consumes the whole block with its own accumulator in registers. Per task these are
-      // the operations of a one-task march in the same sample order, so one march for K tasks gives
+      // General path: the block's values of every field a live task reads, then the live tasks
+      // consume the whole block — single-field volume tasks four at a time with their chains
+      // interleaved (composite_group()), the others task after task. Per task these are the
+      // operations of a one-task march in the same sample order, so one march for K tasks gives
       // every task's image bit for bit.
       const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
       // Slots read by live volume tasks (values for classification: vq) and by live isosurface
@@ -835,8 +837,8 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         const TaskRt& T = S.rt[std::size_t(std::countr_zero(m))];
         (T.kind == RtKind::iso ? smask : vmask) |= T.slots;
       }
-      // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_pairs: slot s1's
-      // partner s2, found at setup).
+      // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_mates, found at
+      // setup; a joint copy's partner first: their records share a cache line and one prefetch).
       std::uint32_t cm = vmask & S.corner_slots;
       if (k0 + kPrefetchBlocks * kBlock <= kend) {
         for (std::uint32_t pm = cm; pm;) {
