@@ -170,6 +170,33 @@ TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
   }
 }
 
+// The paper's mix (p, s, p+s) runs in its own loop while exactly those three tasks are live
+// (march_trio()): in any task order, on a joint copy, and taking over mid-ray when an isosurface
+// task that was marched with them has found its hit, every image is its one-task image, bit for bit.
+TEST(Compositing, ThePaperMixInItsOwnLoopGivesTheOneTaskImagesInAnyOrder) {
+  const Scene sc;
+  const std::vector<TaskSpec> pss = p_s_and_ps_tasks();
+  const std::vector<PreparedField> separate{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  const std::vector<std::vector<TaskSpec>> mixes{
+      {pss[2], pss[1], pss[0]},
+      {pss[1], pss[2], pss[0]},
+      {pss[0], sc.tasks[3], pss[1], pss[2]},  // an isosurface of p: the trio takes over after its hit
+  };
+  for (const std::vector<TaskSpec>& tasks : mixes) {
+    const std::vector<PreparedField> joint = prepare_fields(sc.views, tasks);
+    ASSERT_EQ(joint[1].corners.data(), joint[0].corners.data() + 8);
+    for (const auto& cam : kCams) {
+      std::vector<PartialImage> together(tasks.size());
+      render_brick(cam, joint, tasks, together);
+      for (std::size_t t = 0; t < tasks.size(); ++t) {
+        std::vector<PartialImage> one(1);
+        render_brick(cam, separate, std::span(&tasks[t], 1), one);
+        EXPECT_EQ(one[0].rgba, together[t].rgba) << "task " << t << " of " << tasks.size();
+      }
+    }
+  }
+}
+
 // prepare_fields() gives the fields that volume tasks read together one interleaved corner copy
 // (Round 9 of docs/rendering.md), and the march composites single-field volume tasks in groups of
 // four with their chains interleaved. Neither may change a bit: with p, s and p+s, six more volume

@@ -230,6 +230,10 @@ struct Shared {
   std::vector<TaskRt> rt;
   std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
   std::uint64_t march_mask = 0, iso_mask = 0, volume1_mask = 0;
+  // The paper's mix on one corner layout: volume1 tasks trio[0] (slot trio_a) and trio[1] (slot
+  // trio_b) and the volume2 task trio[2] reading (trio_a, trio_b); trio_mask = 0 when absent.
+  std::uint64_t trio_mask = 0;
+  int trio[3] = {0, 0, 0}, trio_a = 0, trio_b = 0;
   // Dense scenes: (nearly) every macro-cell is visible to every march task. A ray that meets none
   // of the few cells that are not (`exceptions`: their boxes in index space, grown by one voxel) would
   // have its walk merge all its cells into one run, so the march skips the walk and runs [ks, ke].
@@ -751,6 +755,93 @@ std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::in
   return kend + 1;
 }
 
+// The paper's three tasks (p, s and p+s: two single-field volume tasks on fields a and b and the
+// two-field task on both) while all three are live, in one loop with the three accumulators in
+// registers: the operations per task are those of composite_group() and composite_volume2(), so
+// the same bits. Returns one past the last sample consumed; `done` receives the tasks (bits 0–2 of
+// the trio) that became opaque in the last block; a block holding k_partial is left to the caller.
+std::int64_t march_trio(const FieldAcc& fa, const FieldAcc& fb, const TaskRt& T1, const TaskRt& T2, const TaskRt& T3,
+                        float* a1, float* a2, float* a3, std::int64_t kb, std::int64_t kend, const RayPos& P,
+                        std::int64_t k_partial, float partial, float tr_stop, unsigned& done) {
+  done = 0;
+#ifdef PANOPTES_RENDER_AVX2
+  const FieldAcc* const fs[2] = {&fa, &fb};
+  alignas(32) float vp[kBlock], vs[kBlock];
+  float* const vv[2] = {vp, vs};
+  alignas(32) int b1[kBlock], b2[kBlock], m1[kBlock], m2[kBlock];
+  __m128 c1 = _mm_load_ps(a1), t1 = _mm_broadcast_ss(a1 + 3);
+  __m128 c2 = _mm_load_ps(a2), t2 = _mm_broadcast_ss(a2 + 3);
+  __m128 c3 = _mm_load_ps(a3);
+  float tr3 = a3[3];
+  std::int64_t k0 = kb;
+  for (; k0 <= kend; k0 += kBlock) {
+    const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
+    if (std::uint64_t(k_partial - k0) < std::uint64_t(n)) break;
+    if (k0 + kPrefetchBlocks * kBlock <= kend) prefetch_block_corners<2>(fs, P, k0 + kPrefetchBlocks * kBlock);
+    interp_block_corners_n<2>(fs, P, k0, n, vv);
+    lut_bin_block<kRowShift>(vp, T1.lo1, T1.sc1, T1.last1, T1.abs1, b1);
+    lut_bin_block<kRowShift>(vs, T2.lo1, T2.sc1, T2.last1, T2.abs1, b2);
+    lut_bin_block<kMixShift>(vp, T3.lo1, T3.sc1, T3.last1, T3.abs1, m1);
+    lut_bin_block<kMixShift>(vs, T3.lo2, T3.sc2, T3.last2, T3.abs2, m2);
+    const __m128 c1s = c1, t1s = t1, c2s = c2, t2s = t2, c3s = c3;
+    const float tr3s = tr3;
+    for (int l = 0; l < n; ++l) {
+      const __m128 r1 = _mm_load_ps(&row_at(T1.row1, b1[l]).pr);
+      const __m128 r2 = _mm_load_ps(&row_at(T2.row1, b2[l]).pr);
+      c1 = _mm_fmadd_ps(t1, r1, c1);
+      t1 = _mm_mul_ps(t1, _mm_permute_ps(r1, 0xFF));
+      c2 = _mm_fmadd_ps(t2, r2, c2);
+      t2 = _mm_mul_ps(t2, _mm_permute_ps(r2, 0xFF));
+      const MixEntry& e1 = row_at(T3.mix1, m1[l]);
+      const MixEntry& e2 = row_at(T3.mix2, m2[l]);
+      const float tau = e1.tau + e2.tau;
+      const float om = e1.om * e2.om;
+      const float s = tr3 * ((1.0f - om) / std::max(tau, std::numeric_limits<float>::min()));
+      c3 = _mm_fmadd_ps(_mm_set1_ps(s), _mm_add_ps(_mm_load_ps(&e1.tr), _mm_load_ps(&e2.tr)), c3);
+      tr3 = tr3 * om;
+    }
+    const bool o1 = !(_mm_cvtss_f32(t1) > tr_stop), o2 = !(_mm_cvtss_f32(t2) > tr_stop), o3 = !(tr3 > tr_stop);
+    if (o1 || o2 || o3) [[unlikely]] {
+      // As composite_group() / composite_volume2(): a task that reached tr_stop is redone sample by
+      // sample from the block's start; the others keep the block's result.
+      auto keep = [](float* a, __m128 c, float tr) { _mm_store_ps(a, c), a[3] = tr; };
+      int used = 0;  // as the general path counts marched samples: n unless all three stopped
+      if (o1) {
+        keep(a1, c1s, _mm_cvtss_f32(t1s));
+        used = std::max(used, 1 + composite_volume1_scalar(T1.row1, b1, n, k0, k_partial, partial, tr_stop, a1[0], a1[1], a1[2], a1[3]));
+        done |= 1;
+      } else {
+        keep(a1, c1, _mm_cvtss_f32(t1));
+      }
+      if (o2) {
+        keep(a2, c2s, _mm_cvtss_f32(t2s));
+        used = std::max(used, 1 + composite_volume1_scalar(T2.row1, b2, n, k0, k_partial, partial, tr_stop, a2[0],
+                                                           a2[1], a2[2], a2[3]));
+        done |= 2;
+      } else {
+        keep(a2, c2, _mm_cvtss_f32(t2));
+      }
+      if (o3) {
+        keep(a3, c3s, tr3s);
+        used = std::max(used, 1 + composite_volume2_scalar(T3.mix1, T3.mix2, m1, m2, n, k0, k_partial, partial, tr_stop, a3));
+        done |= 4;
+      } else {
+        keep(a3, c3, tr3);
+      }
+      return k0 + (done == 7 ? used : n);
+    }
+  }
+  _mm_store_ps(a1, c1), a1[3] = _mm_cvtss_f32(t1);
+  _mm_store_ps(a2, c2), a2[3] = _mm_cvtss_f32(t2);
+  _mm_store_ps(a3, c3), a3[3] = tr3;
+  return k0;
+#else
+  (void)fa, (void)fb, (void)T1, (void)T2, (void)T3, (void)a1, (void)a2, (void)a3, (void)kend, (void)P, (void)k_partial,
+      (void)partial, (void)tr_stop;
+  return kb;
+#endif
+}
+
 // Marches one ray through the brick for the march tasks in `tasks`; fills acc[i] (premultiplied) per task.
 // Returns the effective and marched sample counts through the references.
 void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3& dir, double t0, double tg1,
@@ -823,6 +914,20 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         marched += std::uint64_t(kk - k0);
         prev_valid = 0;  // values were not kept (no isosurface task is live here)
         return;
+      }
+      if (lm == S.trio_mask) {
+        unsigned done = 0;
+        const std::int64_t kk = march_trio(fa[S.trio_a], fa[S.trio_b], S.rt[std::size_t(S.trio[0])],
+                                           S.rt[std::size_t(S.trio[1])], S.rt[std::size_t(S.trio[2])], acc[S.trio[0]],
+                                           acc[S.trio[1]], acc[S.trio[2]], k0, kend, P, k_partial, partial, tr_stop, done);
+        for (int q = 0; q < 3; ++q)
+          if (done >> q & 1) live &= ~(std::uint64_t(1) << S.trio[q]);
+        marched += std::uint64_t(kk - k0);
+        prev_valid = 0;
+        if (kk > k0) {
+          k0 = kk - kBlock;  // the loop's increment moves to kk
+          continue;
+        }
       }
       // General path: the block's values of every field a live task reads, then the live tasks
       // consume the whole block — single-field volume tasks four at a time with their chains
@@ -1288,6 +1393,24 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       if ((S.corner_mates[s] >> u & 1) && S.acc[s].crec == 16 &&
           (S.acc[u].corners == S.acc[s].corners + 8 || S.acc[s].corners == S.acc[u].corners + 8))
         S.corner_mates[s] = 1u << u;
+  // The paper's mix (march_trio()): a two-field task on two corner copies of one layout, with a
+  // single-field task on each of its fields.
+  for (std::size_t i3 = 0; i3 < S.rt.size() && !S.trio_mask; ++i3) {
+    const TaskRt& r3 = S.rt[i3];
+    if (!(S.march_mask >> i3 & 1) || r3.kind != RtKind::volume2 || r3.s1 == r3.s2) continue;
+    if (!(S.corner_slots >> r3.s1 & 1) || !(S.corner_slots >> r3.s2 & 1) ||
+        !(S.corner_mates[std::size_t(r3.s1)] >> r3.s2 & 1))
+      continue;
+    int i1 = -1, i2 = -1;
+    for (std::size_t i = 0; i < S.rt.size(); ++i) {
+      if (!(S.march_mask >> i & 1) || S.rt[i].kind != RtKind::volume1) continue;
+      if (i1 < 0 && S.rt[i].s1 == r3.s1) i1 = int(i);
+      else if (i2 < 0 && S.rt[i].s1 == r3.s2) i2 = int(i);
+    }
+    if (i1 < 0 || i2 < 0) continue;
+    S.trio[0] = i1, S.trio[1] = i2, S.trio[2] = int(i3), S.trio_a = r3.s1, S.trio_b = r3.s2;
+    S.trio_mask = std::uint64_t(1) << i1 | std::uint64_t(1) << i2 | std::uint64_t(1) << i3;
+  }
   // Macro-cells whose samples cannot reach a data face: cell index c0 − 1 … c1 readable with its
   // upper neighbour in every field (samples are placed within a small fraction of a voxel of their
   // macro-cell, so one cell of margin is plenty).
