@@ -418,7 +418,7 @@ inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
 // march for K tasks = K marches, bit for bit). Lanes l ≥ n repeat sample k0 + n − 1, as in
 // interp_block().
 template <int N>
-inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0, int n,
+[[gnu::always_inline]] inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0, int n,
                                    float* const (&vs)[N]) {
 #ifdef PANOPTES_RENDER_AVX2
   const FieldAcc& f = *fs[0];
@@ -498,7 +498,7 @@ inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos&
 // had not paid). Prefetches never fault and change no value, so images keep their bits.
 constexpr int kPrefetchBlocks = 2;  // distance in blocks: Rounds 6k (K-task path: 1, 2, 3) and 8 (both: 1, 2, 4), docs/rendering.md
 template <int N>
-inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
+[[gnu::always_inline]] inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
 #ifdef PANOPTES_RENDER_AVX2
   const FieldAcc& f = *fs[0];
   const __m256 fk = _mm256_cvtepi32_ps(
@@ -755,85 +755,107 @@ std::int64_t march_volume1(const FieldAcc& f, const TaskRt& T, float* a, std::in
   return kend + 1;
 }
 
-// The paper's three tasks (p, s and p+s: two single-field volume tasks on fields a and b and the
-// two-field task on both) while all three are live, in one loop with the three accumulators in
-// registers: the operations per task are those of composite_group() and composite_volume2(), so
-// the same bits. Returns one past the last sample consumed; `done` receives the tasks (bits 0–2 of
-// the trio) that became opaque in the last block; a block holding k_partial is left to the caller.
+// The paper's three tasks (p, s and p+s: single-field volume tasks 1 and 2 on fields a and b, and
+// the two-field task 3 on both), or those of them in the bits of M that are still live (at least
+// two, or task 3 alone), in one loop with their accumulators in registers: per task the operations
+// are those of composite_group() and composite_volume2(), so the same bits. Returns one past the
+// last sample consumed; `done` receives the tasks (bits 0–2) that became opaque in the last block;
+// a block holding k_partial is left to the caller.
+template <unsigned M>
 std::int64_t march_trio(const FieldAcc& fa, const FieldAcc& fb, const TaskRt& T1, const TaskRt& T2, const TaskRt& T3,
                         float* a1, float* a2, float* a3, std::int64_t kb, std::int64_t kend, const RayPos& P,
                         std::int64_t k_partial, float partial, float tr_stop, unsigned& done) {
   done = 0;
 #ifdef PANOPTES_RENDER_AVX2
-  const FieldAcc* const fs[2] = {&fa, &fb};
+  constexpr bool t1 = M & 1, t2 = M & 2, t3 = M & 4;
+  static_assert(t3 || (t1 && t2), "a single single-field task takes march_volume1()");
+  const FieldAcc* const fs[2] = {&fa, &fb};  // every such subset reads both fields
   alignas(32) float vp[kBlock], vs[kBlock];
   float* const vv[2] = {vp, vs};
   alignas(32) int b1[kBlock], b2[kBlock], m1[kBlock], m2[kBlock];
-  __m128 c1 = _mm_load_ps(a1), t1 = _mm_broadcast_ss(a1 + 3);
-  __m128 c2 = _mm_load_ps(a2), t2 = _mm_broadcast_ss(a2 + 3);
-  __m128 c3 = _mm_load_ps(a3);
-  float tr3 = a3[3];
+  __m128 c1{}, w1{}, c2{}, w2{}, c3{};
+  float tr3 = 0;
+  if constexpr (t1) c1 = _mm_load_ps(a1), w1 = _mm_broadcast_ss(a1 + 3);
+  if constexpr (t2) c2 = _mm_load_ps(a2), w2 = _mm_broadcast_ss(a2 + 3);
+  if constexpr (t3) c3 = _mm_load_ps(a3), tr3 = a3[3];
   std::int64_t k0 = kb;
   for (; k0 <= kend; k0 += kBlock) {
     const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
     if (std::uint64_t(k_partial - k0) < std::uint64_t(n)) break;
     if (k0 + kPrefetchBlocks * kBlock <= kend) prefetch_block_corners<2>(fs, P, k0 + kPrefetchBlocks * kBlock);
     interp_block_corners_n<2>(fs, P, k0, n, vv);
-    lut_bin_block<kRowShift>(vp, T1.lo1, T1.sc1, T1.last1, T1.abs1, b1);
-    lut_bin_block<kRowShift>(vs, T2.lo1, T2.sc1, T2.last1, T2.abs1, b2);
-    lut_bin_block<kMixShift>(vp, T3.lo1, T3.sc1, T3.last1, T3.abs1, m1);
-    lut_bin_block<kMixShift>(vs, T3.lo2, T3.sc2, T3.last2, T3.abs2, m2);
-    const __m128 c1s = c1, t1s = t1, c2s = c2, t2s = t2, c3s = c3;
+    if constexpr (t1) lut_bin_block<kRowShift>(vp, T1.lo1, T1.sc1, T1.last1, T1.abs1, b1);
+    if constexpr (t2) lut_bin_block<kRowShift>(vs, T2.lo1, T2.sc1, T2.last1, T2.abs1, b2);
+    if constexpr (t3) {
+      lut_bin_block<kMixShift>(vp, T3.lo1, T3.sc1, T3.last1, T3.abs1, m1);
+      lut_bin_block<kMixShift>(vs, T3.lo2, T3.sc2, T3.last2, T3.abs2, m2);
+    }
+    const __m128 c1s = c1, w1s = w1, c2s = c2, w2s = w2, c3s = c3;
     const float tr3s = tr3;
     for (int l = 0; l < n; ++l) {
-      const __m128 r1 = _mm_load_ps(&row_at(T1.row1, b1[l]).pr);
-      const __m128 r2 = _mm_load_ps(&row_at(T2.row1, b2[l]).pr);
-      c1 = _mm_fmadd_ps(t1, r1, c1);
-      t1 = _mm_mul_ps(t1, _mm_permute_ps(r1, 0xFF));
-      c2 = _mm_fmadd_ps(t2, r2, c2);
-      t2 = _mm_mul_ps(t2, _mm_permute_ps(r2, 0xFF));
-      const MixEntry& e1 = row_at(T3.mix1, m1[l]);
-      const MixEntry& e2 = row_at(T3.mix2, m2[l]);
-      const float tau = e1.tau + e2.tau;
-      const float om = e1.om * e2.om;
-      const float s = tr3 * ((1.0f - om) / std::max(tau, std::numeric_limits<float>::min()));
-      c3 = _mm_fmadd_ps(_mm_set1_ps(s), _mm_add_ps(_mm_load_ps(&e1.tr), _mm_load_ps(&e2.tr)), c3);
-      tr3 = tr3 * om;
+      if constexpr (t1) {
+        const __m128 r1 = _mm_load_ps(&row_at(T1.row1, b1[l]).pr);
+        c1 = _mm_fmadd_ps(w1, r1, c1);
+        w1 = _mm_mul_ps(w1, _mm_permute_ps(r1, 0xFF));
+      }
+      if constexpr (t2) {
+        const __m128 r2 = _mm_load_ps(&row_at(T2.row1, b2[l]).pr);
+        c2 = _mm_fmadd_ps(w2, r2, c2);
+        w2 = _mm_mul_ps(w2, _mm_permute_ps(r2, 0xFF));
+      }
+      if constexpr (t3) {
+        const MixEntry& e1 = row_at(T3.mix1, m1[l]);
+        const MixEntry& e2 = row_at(T3.mix2, m2[l]);
+        const float tau = e1.tau + e2.tau;
+        const float om = e1.om * e2.om;
+        const float s = tr3 * ((1.0f - om) / std::max(tau, std::numeric_limits<float>::min()));
+        c3 = _mm_fmadd_ps(_mm_set1_ps(s), _mm_add_ps(_mm_load_ps(&e1.tr), _mm_load_ps(&e2.tr)), c3);
+        tr3 = tr3 * om;
+      }
     }
-    const bool o1 = !(_mm_cvtss_f32(t1) > tr_stop), o2 = !(_mm_cvtss_f32(t2) > tr_stop), o3 = !(tr3 > tr_stop);
+    const bool o1 = t1 && !(_mm_cvtss_f32(w1) > tr_stop), o2 = t2 && !(_mm_cvtss_f32(w2) > tr_stop),
+               o3 = t3 && !(tr3 > tr_stop);
     if (o1 || o2 || o3) [[unlikely]] {
       // As composite_group() / composite_volume2(): a task that reached tr_stop is redone sample by
       // sample from the block's start; the others keep the block's result.
       auto keep = [](float* a, __m128 c, float tr) { _mm_store_ps(a, c), a[3] = tr; };
-      int used = 0;  // as the general path counts marched samples: n unless all three stopped
-      if (o1) {
-        keep(a1, c1s, _mm_cvtss_f32(t1s));
-        used = std::max(used, 1 + composite_volume1_scalar(T1.row1, b1, n, k0, k_partial, partial, tr_stop, a1[0], a1[1], a1[2], a1[3]));
-        done |= 1;
-      } else {
-        keep(a1, c1, _mm_cvtss_f32(t1));
+      int used = 0;  // as the general path counts marched samples: n unless every task stopped
+      if constexpr (t1) {
+        if (o1) {
+          keep(a1, c1s, _mm_cvtss_f32(w1s));
+          used = std::max(used, 1 + composite_volume1_scalar(T1.row1, b1, n, k0, k_partial, partial, tr_stop, a1[0],
+                                                             a1[1], a1[2], a1[3]));
+          done |= 1;
+        } else {
+          keep(a1, c1, _mm_cvtss_f32(w1));
+        }
       }
-      if (o2) {
-        keep(a2, c2s, _mm_cvtss_f32(t2s));
-        used = std::max(used, 1 + composite_volume1_scalar(T2.row1, b2, n, k0, k_partial, partial, tr_stop, a2[0],
-                                                           a2[1], a2[2], a2[3]));
-        done |= 2;
-      } else {
-        keep(a2, c2, _mm_cvtss_f32(t2));
+      if constexpr (t2) {
+        if (o2) {
+          keep(a2, c2s, _mm_cvtss_f32(w2s));
+          used = std::max(used, 1 + composite_volume1_scalar(T2.row1, b2, n, k0, k_partial, partial, tr_stop, a2[0],
+                                                             a2[1], a2[2], a2[3]));
+          done |= 2;
+        } else {
+          keep(a2, c2, _mm_cvtss_f32(w2));
+        }
       }
-      if (o3) {
-        keep(a3, c3s, tr3s);
-        used = std::max(used, 1 + composite_volume2_scalar(T3.mix1, T3.mix2, m1, m2, n, k0, k_partial, partial, tr_stop, a3));
-        done |= 4;
-      } else {
-        keep(a3, c3, tr3);
+      if constexpr (t3) {
+        if (o3) {
+          keep(a3, c3s, tr3s);
+          used = std::max(used, 1 + composite_volume2_scalar(T3.mix1, T3.mix2, m1, m2, n, k0, k_partial, partial,
+                                                             tr_stop, a3));
+          done |= 4;
+        } else {
+          keep(a3, c3, tr3);
+        }
       }
-      return k0 + (done == 7 ? used : n);
+      return k0 + (done == M ? used : n);
     }
   }
-  _mm_store_ps(a1, c1), a1[3] = _mm_cvtss_f32(t1);
-  _mm_store_ps(a2, c2), a2[3] = _mm_cvtss_f32(t2);
-  _mm_store_ps(a3, c3), a3[3] = tr3;
+  if constexpr (t1) _mm_store_ps(a1, c1), a1[3] = _mm_cvtss_f32(w1);
+  if constexpr (t2) _mm_store_ps(a2, c2), a2[3] = _mm_cvtss_f32(w2);
+  if constexpr (t3) _mm_store_ps(a3, c3), a3[3] = tr3;
   return k0;
 #else
   (void)fa, (void)fb, (void)T1, (void)T2, (void)T3, (void)a1, (void)a2, (void)a3, (void)kend, (void)P, (void)k_partial,
@@ -915,11 +937,23 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         prev_valid = 0;  // values were not kept (no isosurface task is live here)
         return;
       }
-      if (lm == S.trio_mask) {
-        unsigned done = 0;
-        const std::int64_t kk = march_trio(fa[S.trio_a], fa[S.trio_b], S.rt[std::size_t(S.trio[0])],
-                                           S.rt[std::size_t(S.trio[1])], S.rt[std::size_t(S.trio[2])], acc[S.trio[0]],
-                                           acc[S.trio[1]], acc[S.trio[2]], k0, kend, P, k_partial, partial, tr_stop, done);
+      if (S.trio_mask && !(lm & ~S.trio_mask)) {
+        // The paper's mix, or what is left of it (a single volume task took the fast path above).
+        unsigned sub = 0, done = 0;
+        for (int q = 0; q < 3; ++q) sub |= unsigned(lm >> S.trio[q] & 1) << q;
+        const TaskRt &T1 = S.rt[std::size_t(S.trio[0])], &T2 = S.rt[std::size_t(S.trio[1])],
+                     &T3 = S.rt[std::size_t(S.trio[2])];
+        float *a1 = acc[S.trio[0]], *a2 = acc[S.trio[1]], *a3 = acc[S.trio[2]];
+        const FieldAcc &fA = fa[S.trio_a], &fB = fa[S.trio_b];
+        std::int64_t kk = k0;
+        switch (sub) {
+          case 7: kk = march_trio<7>(fA, fB, T1, T2, T3, a1, a2, a3, k0, kend, P, k_partial, partial, tr_stop, done); break;
+          case 3: kk = march_trio<3>(fA, fB, T1, T2, T3, a1, a2, a3, k0, kend, P, k_partial, partial, tr_stop, done); break;
+          case 5: kk = march_trio<5>(fA, fB, T1, T2, T3, a1, a2, a3, k0, kend, P, k_partial, partial, tr_stop, done); break;
+          case 6: kk = march_trio<6>(fA, fB, T1, T2, T3, a1, a2, a3, k0, kend, P, k_partial, partial, tr_stop, done); break;
+          case 4: kk = march_trio<4>(fA, fB, T1, T2, T3, a1, a2, a3, k0, kend, P, k_partial, partial, tr_stop, done); break;
+          default: break;
+        }
         for (int q = 0; q < 3; ++q)
           if (done >> q & 1) live &= ~(std::uint64_t(1) << S.trio[q]);
         marched += std::uint64_t(kk - k0);
