@@ -12,7 +12,8 @@
 //                        by side. Targets: paper3 <= 1.5x, tf10 <= 3x, iso8 <= 2x. marched_K / marched_one:
 //                        the part of the ratio due to the K-task march going further. Also the same K
 //                        images by K separate marches (K_over_separate), samples marched per ray
-//                        (one, K, separate) and, for isosurfaces, hits per ray of the K images.
+//                        (one, K, separate) and, for isosurfaces, hits per ray of the K images;
+//                        values_differing_from_separate (must be 0): the K images equal the separate ones.
 //   BM_ManyImagesPaperOptions  mixes 0, 1 and 2 at examples/paper.toml's options (1.0 voxel, adaptive sampling).
 //   BM_ParaViewAnchor    128x256x80 float32 dense volume, 8 cameras at 1.1x the diagonal, 920x896, one
 //                        volume task: CPU-seconds per image next to ParaView 5.11 "Ray Cast Only"'s 1.46.
@@ -291,6 +292,7 @@ void many_images(benchmark::State& state, const RenderOptions& opt) {
   double hits_k = 0;      // pixels (over all K images) whose ray hit its surface
   std::vector<PartialImage> sep(many.size());
   double cpus = 0, sep_marched = 0;
+  double differing = 0;  // image values of the K-task march that differ from the separate marches': must be 0
   const int cams[] = {12, 77};
   for (auto _ : state)
     for (int c : cams) {
@@ -316,11 +318,14 @@ void many_images(benchmark::State& state, const RenderOptions& opt) {
         sep_marched += double(s.marched_samples);
       }
       cpus += cpu_seconds() - c0;
+      for (std::size_t t = 0; t < many.size(); ++t)
+        for (std::size_t q = 0; q < sep[t].rgba.size(); ++q) differing += sep[t].rgba[q] != outk[t].rgba[q];
       for (const PartialImage& o : outk)
         for (std::size_t q = 3; q < o.rgba.size(); q += 4) hits_k += o.rgba[q] > 0;
     }
   const double n = double(state.iterations()) * std::size(cams);
   state.counters["K"] = double(many.size());
+  state.counters["values_differing_from_separate"] = differing;
   state.counters["cpu_s_one"] = cpu1 / n;
   state.counters["cpu_s_K"] = cpuk / n;
   if (cpu1k > 0) state.counters["cpu_s_one_on_K_fields"] = cpu1k / n;

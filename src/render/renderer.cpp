@@ -856,7 +856,7 @@ std::int64_t march_trio(const FieldAcc& fa, const FieldAcc& fb, const TaskRt& T1
   if constexpr (t1) _mm_store_ps(a1, c1), a1[3] = _mm_cvtss_f32(w1);
   if constexpr (t2) _mm_store_ps(a2, c2), a2[3] = _mm_cvtss_f32(w2);
   if constexpr (t3) _mm_store_ps(a3, c3), a3[3] = tr3;
-  return k0;
+  return std::min(k0, kend + 1);  // the last block may have held fewer than kBlock samples
 #else
   (void)fa, (void)fb, (void)T1, (void)T2, (void)T3, (void)a1, (void)a2, (void)a3, (void)kend, (void)P, (void)k_partial,
       (void)partial, (void)tr_stop;
