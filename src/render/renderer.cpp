@@ -820,26 +820,16 @@ std::int64_t march_trio(const FieldAcc& fa, const FieldAcc& fb, const TaskRt& T1
       // sample from the block's start; the others keep the block's result.
       auto keep = [](float* a, __m128 c, float tr) { _mm_store_ps(a, c), a[3] = tr; };
       int used = 0;  // as the general path counts marched samples: n unless every task stopped
-      if constexpr (t1) {
-        if (o1) {
-          keep(a1, c1s, _mm_cvtss_f32(w1s));
-          used = std::max(used, 1 + composite_volume1_scalar(T1.row1, b1, n, k0, k_partial, partial, tr_stop, a1[0],
-                                                             a1[1], a1[2], a1[3]));
-          done |= 1;
-        } else {
-          keep(a1, c1, _mm_cvtss_f32(w1));
-        }
-      }
-      if constexpr (t2) {
-        if (o2) {
-          keep(a2, c2s, _mm_cvtss_f32(w2s));
-          used = std::max(used, 1 + composite_volume1_scalar(T2.row1, b2, n, k0, k_partial, partial, tr_stop, a2[0],
-                                                             a2[1], a2[2], a2[3]));
-          done |= 2;
-        } else {
-          keep(a2, c2, _mm_cvtss_f32(w2));
-        }
-      }
+      auto finish1 = [&](bool opaque, unsigned bit, const TaskRt& T, const int* b, float* a, __m128 c, __m128 w,
+                         __m128 cs, __m128 ws) {
+        if (!opaque) return keep(a, c, _mm_cvtss_f32(w));
+        keep(a, cs, _mm_cvtss_f32(ws));
+        used = std::max(used, 1 + composite_volume1_scalar(T.row1, b, n, k0, k_partial, partial, tr_stop, a[0], a[1],
+                                                           a[2], a[3]));
+        done |= bit;
+      };
+      if constexpr (t1) finish1(o1, 1, T1, b1, a1, c1, w1, c1s, w1s);
+      if constexpr (t2) finish1(o2, 2, T2, b2, a2, c2, w2, c2s, w2s);
       if constexpr (t3) {
         if (o3) {
           keep(a3, c3s, tr3s);
