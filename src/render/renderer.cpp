@@ -418,8 +418,8 @@ inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
 // march for K tasks = K marches, bit for bit). Lanes l ≥ n repeat sample k0 + n − 1, as in
 // interp_block().
 template <int N>
-[[gnu::always_inline]] inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0, int n,
-                                   float* const (&vs)[N]) {
+[[gnu::always_inline]] inline void interp_block_corners_n(const FieldAcc* const (&fs)[N], const RayPos& P,
+                                                          std::int64_t k0, int n, float* const (&vs)[N]) {
 #ifdef PANOPTES_RENDER_AVX2
   const FieldAcc& f = *fs[0];
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -498,7 +498,8 @@ template <int N>
 // had not paid). Prefetches never fault and change no value, so images keep their bits.
 constexpr int kPrefetchBlocks = 2;  // distance in blocks: Rounds 6k (K-task path: 1, 2, 3) and 8 (both: 1, 2, 4), docs/rendering.md
 template <int N>
-[[gnu::always_inline]] inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P, std::int64_t k0) {
+[[gnu::always_inline]] inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P,
+                                                          std::int64_t k0) {
 #ifdef PANOPTES_RENDER_AVX2
   const FieldAcc& f = *fs[0];
   const __m256 fk = _mm256_cvtepi32_ps(
