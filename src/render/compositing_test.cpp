@@ -148,6 +148,37 @@ std::vector<TaskSpec> p_s_and_ps_tasks() {
 // Volume tasks on p and s: in one march both fields' corner copies are read with one shared
 // geometry (interp_block_corners_n<2>), alone with their own; a field without a corner copy (gathered
 // floats) must not be paired. Every task's image must be its one-task image, bit for bit.
+// A transfer-function sweep (windows of one field, the case `BM_ManyImages/mix:1` measures) takes
+// march_volumes() and runs over macro-cells whose visible windows differ: each window sees other
+// cells (low, middle, high values), so the runs go on for the union and every window composites exact
+// no-ops where it sees nothing. Every image must be its one-task image, bit for bit, for 2 … 12
+// windows (the loop) and 14 (the general path), with opaque windows dropping out on the way.
+TEST(Compositing, TransferFunctionSweepInOneMarchGivesEveryWindowItsOneTaskImage) {
+  const Scene sc;
+  std::vector<PreparedField> fields{PreparedField(sc.views[0]), PreparedField(sc.views[1])};
+  std::vector<TaskSpec> all;
+  for (int i = 0; i < 14; ++i) {
+    const float lo = -0.9f + 0.13f * float(i);
+    all.push_back(TaskSpec::volume(0, TransferFunction::preset(i % 2 ? "hot" : "p-wave", 1 + i % 3),
+                                   ValueWindow::absolute(lo, lo + 0.25f + 0.1f * float(i % 4))));
+  }
+  int opaque = 0;
+  for (const std::size_t k : {std::size_t(2), std::size_t(5), std::size_t(12), std::size_t(14)}) {
+    const std::span<const TaskSpec> tasks(all.data(), k);
+    for (const auto& cam : kCams) {
+      std::vector<PartialImage> together(k);
+      render_brick(cam, fields, tasks, together);
+      for (std::size_t t = 0; t < k; ++t) {
+        std::vector<PartialImage> one(1);
+        render_brick(cam, fields, tasks.subspan(t, 1), one);
+        EXPECT_EQ(one[0].rgba, together[t].rgba) << k << " windows, window " << t;
+        for (std::size_t i = 3; i < one[0].rgba.size(); i += 4) opaque += one[0].rgba[i] > 0.98f;
+      }
+    }
+  }
+  EXPECT_GT(opaque, 100);  // rays that terminate: windows leave the loop while others go on
+}
+
 TEST(Compositing, FieldsReadWithOneSharedGeometryGiveTheirOneFieldImages) {
   const Scene sc;
   const std::vector<TaskSpec> tasks = p_s_and_ps_tasks();

@@ -234,6 +234,9 @@ struct Shared {
   // trio_b) and the volume2 task trio[2] reading (trio_a, trio_b); trio_mask = 0 when absent.
   std::uint64_t trio_mask = 0;
   int trio[3] = {0, 0, 0}, trio_a = 0, trio_b = 0;
+  // Per field slot: the single-field volume tasks reading it (march_volumes(): several transfer
+  // functions or windows of one field).
+  std::array<std::uint64_t, 8> volume1_on_slot{};
   // Dense scenes: (nearly) every macro-cell is visible to every march task. A ray that meets none
   // of the few cells that are not (`exceptions`: their boxes in index space, grown by one voxel) would
   // have its walk merge all its cells into one run, so the march skips the walk and runs [ks, ke].
@@ -496,6 +499,7 @@ template <int N>
 // out-of-order window (Round 6k), and in the single-task loop too (Round 8: −17 % CPU for one volume
 // task on the paper grid at 0.5 voxel; Round 5a's sparser prefetch, every other lane one block ahead,
 // had not paid). Prefetches never fault and change no value, so images keep their bits.
+constexpr int kMaxSweep = 12;      // march_volumes(): up to this many tasks on one field
 constexpr int kPrefetchBlocks = 2;  // distance in blocks: Rounds 6k (K-task path: 1, 2, 3) and 8 (both: 1, 2, 4), docs/rendering.md
 template <int N>
 [[gnu::always_inline]] inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P,
@@ -855,6 +859,49 @@ std::int64_t march_trio(const FieldAcc& fa, const FieldAcc& fb, const TaskRt& T1
 #endif
 }
 
+// G ≥ 2 single-field volume tasks on ONE field (a sweep of transfer functions or windows), all of
+// them live: blocks of samples kb … kend run without the general path's per-block bookkeeping (which
+// tasks read which fields, their kinds, their slots), the per-task constants loaded once. Per task
+// the operations are those of composite_group(), so the same bits. Returns one past the last sample
+// marched and, in `done`, the bits (of 0 … G−1) of the tasks that became opaque — at the first block
+// where any did, so the caller can drop them and go on with fewer.
+template <int G>
+std::int64_t march_volumes(const FieldAcc& f, const TaskRt* const* T, float* const* as, std::int64_t kb,
+                           std::int64_t kend, const RayPos& P, bool safe, std::int64_t k_partial, float partial,
+                           float tr_stop, unsigned& done) {
+  done = 0;
+  const VolRow* luts[G];
+  float lo[G], sc[G], last[G];
+  bool absv[G];
+  for (int g = 0; g < G; ++g) luts[g] = T[g]->row1, lo[g] = T[g]->lo1, sc[g] = T[g]->sc1, last[g] = T[g]->last1,
+                              absv[g] = T[g]->abs1;
+  alignas(32) float v[kBlock];
+  alignas(32) int bins[G][kBlock];
+  int stops[G];
+  std::int64_t k0 = kb;
+  for (; k0 <= kend; k0 += kBlock) {
+    const int n = int(std::min<std::int64_t>(kBlock, kend - k0 + 1));
+    if (f.corners && k0 + kPrefetchBlocks * kBlock <= kend) {
+      const FieldAcc* const fs[1] = {&f};
+      prefetch_block_corners<1>(fs, P, k0 + kPrefetchBlocks * kBlock);
+    }
+    volume_block(f, P, k0, n, safe, v);
+    for (int g = 0; g < G; ++g) lut_bin_block<kRowShift>(v, lo[g], sc[g], last[g], absv[g], bins[g]);
+    // In groups of four, as the general path composites them (the chains of a group interleaved).
+    [&]<int... Q>(std::integer_sequence<int, Q...>) {
+      (composite_group<std::min(4, G - 4 * Q)>(luts + 4 * Q, bins + 4 * Q, as + 4 * Q, stops + 4 * Q, n, k0, k_partial,
+                                               partial, tr_stop),
+       ...);
+    }(std::make_integer_sequence<int, (G + 3) / 4>{});
+    int used = 0;
+    for (int g = 0; g < G; ++g)
+      if (stops[g] >= 0) done |= 1u << g, used = std::max(used, stops[g] + 1);
+    if (done) [[unlikely]]
+      return k0 + (done == (1u << G) - 1 ? used : n);
+  }
+  return std::min(k0, kend + 1);  // the last block may have held fewer than kBlock samples
+}
+
 // Marches one ray through the brick for the march tasks in `tasks`; fills acc[i] (premultiplied) per task.
 // Returns the effective and marched sample counts through the references.
 void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3& dir, double t0, double tg1,
@@ -950,6 +997,34 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
         marched += std::uint64_t(kk - k0);
         prev_valid = 0;
         if (kk > k0) {
+          k0 = kk - kBlock;  // the loop's increment moves to kk
+          continue;
+        }
+      }
+      if (!(lm & ~S.volume1_mask) &&
+          !(lm & ~S.volume1_on_slot[std::size_t(S.rt[std::size_t(std::countr_zero(lm))].s1)])) {
+        // Single-field volume tasks on one field only (two or more: one took the fast path above).
+        const int G = std::popcount(lm);
+        if (G <= kMaxSweep) {
+          const TaskRt* T[kMaxSweep];
+          float* as[kMaxSweep];
+          int ids[kMaxSweep], g = 0;
+          for (std::uint64_t m = lm; m; m &= m - 1, ++g) {
+            ids[g] = std::countr_zero(m);
+            T[g] = &S.rt[std::size_t(ids[g])], as[g] = acc[ids[g]];
+          }
+          const FieldAcc& f = fa[T[0]->s1];
+          unsigned done = 0;
+          std::int64_t kk = k0;
+          [&]<int... Q>(std::integer_sequence<int, Q...>) {
+            ((G == Q + 2 ? (kk = march_volumes<Q + 2>(f, T, as, k0, kend, P, safe, k_partial, partial, tr_stop, done), 0)
+                         : 0),
+             ...);
+          }(std::make_integer_sequence<int, kMaxSweep - 1>{});
+          for (int q = 0; q < G; ++q)
+            if (done >> q & 1) live &= ~(std::uint64_t(1) << ids[q]);
+          marched += std::uint64_t(kk - k0);
+          prev_valid = 0;
           k0 = kk - kBlock;  // the loop's increment moves to kk
           continue;
         }
@@ -1188,6 +1263,7 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
   }
   std::int64_t idx = mi[0] + lin[1] * mi[1] + lin[2] * mi[2];
   const std::uint64_t* active = S.active.data();
+  const std::uint64_t iso_mask = S.iso_mask;
   std::int64_t k = ks;      // first sample not yet marched, queued or skipped
   double tenter = t0 - dt;  // the first cell starts before sample ks
   // Consecutive visible macro-cells with the same live tasks are merged into one queued run
@@ -1233,10 +1309,17 @@ void march_ray(const Shared& S, const double O[3], const double D[3], const Vec3
       else a = 2, texit = tz, last_cell = nz == 0;
     }
     std::uint64_t mask = active[idx] & live;
-    if (queued && mask != rmask) {  // the queued run ends here: march it (live may shrink)
-      flush(false);
-      if (!live || k > ke) break;
-      mask = active[idx] & live;
+    if (queued && mask != rmask) {
+      if (mask && !((mask ^ rmask) & iso_mask)) {
+        // Other volume tasks see something here: the run goes on for the union. A volume task marched
+        // through a cell where it sees nothing composites exact no-ops (α = 0: colour += T·0, T ·= 1),
+        // so its image keeps its bits, and the march is not cut into short runs with setup each.
+        rmask |= mask;
+      } else {  // the queued run ends here: march it (live may shrink)
+        flush(false);
+        if (!live || k > ke) break;
+        mask = active[idx] & live;
+      }
     }
     if (mask) {
       const bool safe = mx >= S.safe_lo[0] && mx <= S.safe_hi[0] && my >= S.safe_lo[1] && my <= S.safe_hi[1] &&
@@ -1418,6 +1501,9 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       if ((S.corner_mates[s] >> u & 1) && S.acc[s].crec == 16 &&
           (S.acc[u].corners == S.acc[s].corners + 8 || S.acc[s].corners == S.acc[u].corners + 8))
         S.corner_mates[s] = 1u << u;
+  for (std::size_t i = 0; i < S.rt.size(); ++i)
+    if ((S.march_mask >> i & 1) && S.rt[i].kind == RtKind::volume1)
+      S.volume1_on_slot[std::size_t(S.rt[i].s1)] |= std::uint64_t(1) << i;
   // The paper's mix (march_trio()): a two-field task on two corner copies of one layout, with a
   // single-field task on each of its fields.
   for (std::size_t i3 = 0; i3 < S.rt.size() && !S.trio_mask; ++i3) {
