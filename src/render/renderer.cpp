@@ -499,7 +499,6 @@ template <int N>
 // out-of-order window (Round 6k), and in the single-task loop too (Round 8: −17 % CPU for one volume
 // task on the paper grid at 0.5 voxel; Round 5a's sparser prefetch, every other lane one block ahead,
 // had not paid). Prefetches never fault and change no value, so images keep their bits.
-constexpr int kMaxSweep = 12;      // march_volumes(): up to this many tasks on one field
 constexpr int kPrefetchBlocks = 2;  // distance in blocks: Rounds 6k (K-task path: 1, 2, 3) and 8 (both: 1, 2, 4), docs/rendering.md
 template <int N>
 [[gnu::always_inline]] inline void prefetch_block_corners(const FieldAcc* const (&fs)[N], const RayPos& P,
@@ -858,6 +857,8 @@ std::int64_t march_trio(const FieldAcc& fa, const FieldAcc& fb, const TaskRt& T1
   return kb;
 #endif
 }
+
+constexpr int kMaxSweep = 12;  // march_volumes(): up to this many tasks on one field (more take the general path)
 
 // G ≥ 2 single-field volume tasks on ONE field (a sweep of transfer functions or windows), all of
 // them live: blocks of samples kb … kend run without the general path's per-block bookkeeping (which
