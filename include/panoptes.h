@@ -6,13 +6,19 @@
  *   panoptes_session* s;
  *   panoptes_create("viz.toml", 1, PANOPTES_COMM_WORLD, &s);    // config file (or TOML text, 0)
  *   panoptes_set_grid(s, dims, origin, spacing);                // the global grid of points
- *   panoptes_set_block(s, offset, extent, ghost_lo, ghost_hi);  // this rank's owned points + ghosts
+ *   panoptes_set_block(s, offset, extent, ghost_lo, ghost_hi);  // this rank's owned points + STORED ghosts
+ *   panoptes_set_halo(s, valid_lo, valid_hi, 0);                // optional: ghosts kept up to date, face-only
  *   for (step...) {
- *     panoptes_set_field(s, "T", T, PANOPTES_FLOAT64, NULL);    // data = first STORED element
+ *     panoptes_set_field_n(s, "T", T, PANOPTES_FLOAT64, NULL, n_T); // data = first STORED element, n_T elements
  *     panoptes_process(s, step, time, NULL);                    // renders when the schedule says so
  *   }
  *   panoptes_finalize(s); panoptes_destroy(s);
- * Configuration keys: docs/insitu.md ([output], [image], [rig], [schedule], [video], [render], [[task]]).
+ * Configuration keys: docs/insitu.md ([output] dir/mode, [image], [rig], [schedule], [video], [render],
+ * [[task]]); a restarted run continues its database with [output] mode = "resume".
+ * Step-by-step guide for C, C++, Fortran and Python codes: docs/instrumenting.md.
+ *
+ * Errors: every function returns a code; a failing call also prints "panoptes: error: ..." to stderr
+ * (see panoptes_set_error_output) — the library never exits, aborts or raises a signal on a bad call.
  */
 #ifndef PANOPTES_H
 #define PANOPTES_H
@@ -30,6 +36,12 @@ enum {
 };
 /** Element types of fields. */
 enum { PANOPTES_FLOAT32 = 0, PANOPTES_FLOAT64 = 1 };
+/** Where failing calls print their message (panoptes_set_error_output). */
+enum {
+  PANOPTES_ERRORS_ALL = 0,   /**< every rank, prefixed with its rank when there are several (default) */
+  PANOPTES_ERRORS_RANK0 = 1, /**< rank 0 only: once for the collective errors (configuration, grid) */
+  PANOPTES_ERRORS_NONE = 2   /**< never: the caller reports panoptes_last_error() itself */
+};
 /** Communicator argument of panoptes_create: MPI_COMM_WORLD when MPI is initialized, else one process.
  * Otherwise pass a Fortran handle: MPI_Comm_c2f(comm) in C, the communicator itself in Fortran. */
 #define PANOPTES_COMM_WORLD (-1)
@@ -44,15 +56,37 @@ int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origi
  * below/above them per axis. Owned boxes of all ranks must partition the grid. */
 int panoptes_set_block(panoptes_session* s, const int offset[3], const int extent[3], const int ghost_lo[3],
                        const int ghost_hi[3]);
+/** Of the stored ghost layers, those the caller's halo exchange keeps up to date (valid_lo/valid_hi per
+ * axis, 0 ..= the stored width; NULL or -1 = every stored layer), and whether that exchange fills edge and
+ * corner ghosts too (edges_valid = 1: a full 26-neighbour exchange; 0 = face-only halos, the common
+ * case: Panoptes fetches edge and corner points from their owners). After panoptes_set_block, before the
+ * first snapshot. */
+int panoptes_set_halo(panoptes_session* s, const int valid_lo[3], const int valid_hi[3], int edges_valid);
 /** (Re)binds a field for the next snapshots. data points at the first STORED element (the ghost
- * corner); strides (elements per axis) may be NULL = contiguous x-fastest over the ghosted box
- * (C array [nz][ny][nx], Fortran array (nx, ny, nz)). The data must stay valid until the next call
- * that renders. */
+ * corner); strides (elements per axis x, y, z) may be NULL = contiguous x-fastest over the ghosted box
+ * (C array [nz][ny][nx], Fortran array (nx, ny, nz)). No copy: the data must stay valid, at the same
+ * address, until the next call that renders. Prefer panoptes_set_field_n, which checks the buffer's size. */
 int panoptes_set_field(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3]);
+/** panoptes_set_field for a buffer of `count` elements starting at data: refused (PANOPTES_ERROR_USAGE,
+ * nothing bound) when the ghosted block, at these strides, reaches outside it. */
+int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3],
+                         long long count);
+/** Binds an array in any axis order: `layout` names the grid axis of each of the array's 3 dimensions, in the
+ * order of extents[] and strides[] (e.g. "zxy" for a Fortran array V(k,i,j), whose first index is z;
+ * "xyz" for V(i,j,k)); extents[d] = points along dimension d, which must equal the block's owned + stored
+ * ghost points on that axis; strides[d] = elements between neighbours along dimension d (any sign, not 0);
+ * data = the element at index 0 of every dimension. A shape that does not fit the block is refused with a
+ * message naming both shapes. The Fortran module passes its arrays (sections included) through this call. */
+int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
+                              const long long extents[3], const long long strides[3]);
 /** If the schedule asks for a snapshot at (step, time), renders and stores it; *taken (may be NULL)
  * tells whether it did. */
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken);
-/** Renders and stores a snapshot now, whatever the schedule. */
+/** Whether the schedule asks for a snapshot at (step, time): *due = 1 or 0, the same on every rank. Does not
+ * render; panoptes_process(step, time) would take exactly this snapshot. Collective the first time (it
+ * starts the session, as the first snapshot does). */
+int panoptes_due(panoptes_session* s, long long step, double time, int* due);
+/** Renders and stores a snapshot now, whatever the schedule (a forced snapshot). */
 int panoptes_snapshot(panoptes_session* s, double time);
 /** Closes all movies and marks the database complete (collective). The first call prints, on rank 0 to
  * stderr, the in-situ overhead: visualization time as a multiple of the simulation time (the wall time
@@ -62,6 +96,9 @@ int panoptes_finalize(panoptes_session* s);
 void panoptes_destroy(panoptes_session* s);
 /** The message of the last error of this thread ("" if none). */
 const char* panoptes_last_error(void);
+/** Where failing calls print their message, process-wide: PANOPTES_ERRORS_ALL (default), _RANK0 or _NONE.
+ * The environment variable PANOPTES_ERRORS=all|rank0|none sets the default before the first call. */
+void panoptes_set_error_output(int mode);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,11 @@
 // The C API over insitu::Session: errors become return codes + a thread-local message.
 #include "panoptes.h"
 
+#include <array>
+#include <atomic>
+#include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <optional>
@@ -15,6 +19,7 @@ using namespace panoptes;
 struct panoptes_session {
   insitu::SessionConfig config;
   int fortran_comm = PANOPTES_COMM_WORLD;
+  int rank = 0, ranks = 1;  // of the communicator, known from panoptes_create on (error messages)
   std::optional<render::GridGeometry> grid;
   std::optional<insitu::LocalBlock> block;
   std::map<std::string, insitu::FieldInput> fields;
@@ -33,25 +38,71 @@ struct ConfigError : Error {
   using Error::Error;
 };
 
+int error_mode_from_env() {
+  const char* v = std::getenv("PANOPTES_ERRORS");
+  const std::string m = v ? v : "";
+  if (m == "rank0") return PANOPTES_ERRORS_RANK0;
+  if (m == "none") return PANOPTES_ERRORS_NONE;
+  return PANOPTES_ERRORS_ALL;
+}
+std::atomic<int> g_error_mode{error_mode_from_env()};
+
+// The rank that prints: the session's when there is one, else MPI_COMM_WORLD's (or 0 without MPI).
+void rank_of(const panoptes_session* s, int& rank, int& ranks) {
+  rank = 0;
+  ranks = 1;
+  if (s) {
+    rank = s->rank;
+    ranks = s->ranks;
+    return;
+  }
+#ifdef PANOPTES_HAVE_MPI
+  int init = 0, done = 0;
+  MPI_Initialized(&init);
+  MPI_Finalized(&done);
+  if (init && !done) {
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  }
+#endif
+}
+
+// One line on stderr (the simulation's own output stays on stdout), as the error mode says.
+void report(const panoptes_session* s, const std::string& message) {
+  const int mode = g_error_mode.load();
+  if (mode == PANOPTES_ERRORS_NONE) return;
+  int rank = 0, ranks = 1;
+  rank_of(s, rank, ranks);
+  if (mode == PANOPTES_ERRORS_RANK0 && rank != 0) return;
+  const std::string who = mode == PANOPTES_ERRORS_ALL && ranks > 1 ? "rank " + std::to_string(rank) + ": " : "";
+  const std::string line = "panoptes: " + who + "error: " + message + "\n";
+  std::fputs(line.c_str(), stderr);
+  std::fflush(stderr);
+}
+
+// Runs f, turning exceptions into a return code, the thread's last error and one printed line.
 template <class F>
-int guarded(F&& f) {
+int guarded(const panoptes_session* s, F&& f) {
+  int code = PANOPTES_OK;
   try {
     f();
     g_error.clear();
     return PANOPTES_OK;
   } catch (const ConfigError& e) {
     g_error = e.what();
-    return PANOPTES_ERROR_CONFIG;
+    code = PANOPTES_ERROR_CONFIG;
   } catch (const UsageError& e) {
     g_error = e.what();
-    return PANOPTES_ERROR_USAGE;
+    code = PANOPTES_ERROR_USAGE;
   } catch (const std::exception& e) {
     g_error = e.what();
-    return PANOPTES_ERROR_RUN;
+    code = PANOPTES_ERROR_RUN;
   } catch (...) {
     g_error = "unknown error";
-    return PANOPTES_ERROR_RUN;
+    code = PANOPTES_ERROR_RUN;
   }
+  report(s, g_error);
+  return code;
 }
 
 void need(bool ok, const std::string& what) {
@@ -82,15 +133,74 @@ std::vector<insitu::FieldInput> inputs(const panoptes_session* s) {
   return v;
 }
 
+std::string shape_text(const std::array<long long, 3>& v) {
+  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+}
+
+// Grid axis (0 = x, 1 = y, 2 = z) of each array dimension, from "xyz", "zxy", ... (any case).
+std::array<int, 3> parse_layout(const char* layout, const std::string& call) {
+  const std::string text = layout ? layout : "";
+  std::array<int, 3> axis{-1, -1, -1};
+  bool ok = text.size() == 3;
+  for (std::size_t d = 0; ok && d < 3; ++d) {
+    const char c = char(std::tolower(static_cast<unsigned char>(text[d])));
+    axis[d] = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
+    ok = axis[d] >= 0;
+    for (std::size_t e = 0; ok && e < d; ++e) ok = axis[e] != axis[d];
+  }
+  need(ok, call + ": layout \"" + text + "\"; expected the three axes x, y, z in the order of the array's dimensions, e.g. \"xyz\" or \"zxy\"");
+  return axis;
+}
+
+std::array<long long, 3> ghosted_extent(const insitu::LocalBlock& b) {
+  return {(long long)b.extent[0] + b.ghost_lo[0] + b.ghost_hi[0], (long long)b.extent[1] + b.ghost_lo[1] + b.ghost_hi[1],
+          (long long)b.extent[2] + b.ghost_lo[2] + b.ghost_hi[2]};
+}
+
+// Binds `data` (first STORED element) with strides per grid axis x, y, z.
+void bind_field(panoptes_session* s, const char* name, const void* data, int type, const std::array<std::int64_t, 3>& st) {
+  const insitu::LocalBlock& b = *s->block;
+  const std::int64_t shift = b.ghost_lo[0] * st[0] + b.ghost_lo[1] * st[1] + b.ghost_lo[2] * st[2];
+  const std::size_t elem = type == PANOPTES_FLOAT64 ? sizeof(double) : sizeof(float);
+  insitu::FieldInput in;
+  in.name = name;
+  in.data = static_cast<const char*>(data) + shift * std::int64_t(elem);
+  in.type = type == PANOPTES_FLOAT64 ? insitu::ScalarType::f64 : insitu::ScalarType::f32;
+  in.stride = st;
+  s->fields[in.name] = in;
+}
+
+// The common checks of the set_field calls; returns the strides per axis (default: contiguous x-fastest).
+std::array<std::int64_t, 3> field_strides(panoptes_session* s, const std::string& call, const char* name, const void* data,
+                                          int type, const long long strides[3]) {
+  need(s && name && data, call + ": null session, name or data");
+  need(type == PANOPTES_FLOAT32 || type == PANOPTES_FLOAT64,
+       call + ": type " + std::to_string(type) + "; expected PANOPTES_FLOAT32 or PANOPTES_FLOAT64");
+  need(s->block.has_value(), call + ": call panoptes_set_block first");
+  if (strides) return {strides[0], strides[1], strides[2]};
+  const auto n = ghosted_extent(*s->block);
+  return {1, n[0], n[0] * n[1]};
+}
+
 }  // namespace
 
 extern "C" {
 
 int panoptes_create(const char* config, int config_is_file, int fortran_comm, panoptes_session** out) {
-  return guarded([&] {
+  return guarded(nullptr, [&] {
     need(config && out, "panoptes_create: null config or output pointer");
     *out = nullptr;
     auto s = std::make_unique<panoptes_session>();
+    s->fortran_comm = fortran_comm;
+#ifdef PANOPTES_HAVE_MPI
+    int init = 0;
+    MPI_Initialized(&init);
+    if (init) {
+      MPI_Comm comm = fortran_comm == PANOPTES_COMM_WORLD ? MPI_COMM_WORLD : MPI_Comm_f2c(fortran_comm);
+      MPI_Comm_rank(comm, &s->rank);
+      MPI_Comm_size(comm, &s->ranks);
+    }
+#endif
     try {
       s->config = config_is_file ? insitu::load_session_config(config)
                                  : insitu::parse_session_config_text(config, "configuration text");
@@ -99,13 +209,12 @@ int panoptes_create(const char* config, int config_is_file, int fortran_comm, pa
       throw ConfigError(e.what());
     }
     s->config.program = "panoptes C API";
-    s->fortran_comm = fortran_comm;
     *out = s.release();
   });
 }
 
 int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origin[3], const double spacing[3]) {
-  return guarded([&] {
+  return guarded(s, [&] {
     need(s && dims && origin && spacing, "panoptes_set_grid: null argument");
     need(!s->session, "panoptes_set_grid: the grid cannot change after the first snapshot");
     render::GridGeometry g{{dims[0], dims[1], dims[2]}, {origin[0], origin[1], origin[2]}, {spacing[0], spacing[1], spacing[2]}};
@@ -120,7 +229,7 @@ int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origi
 
 int panoptes_set_block(panoptes_session* s, const int offset[3], const int extent[3], const int ghost_lo[3],
                        const int ghost_hi[3]) {
-  return guarded([&] {
+  return guarded(s, [&] {
     need(s && offset && extent && ghost_lo && ghost_hi, "panoptes_set_block: null argument");
     need(!s->session, "panoptes_set_block: the block cannot change after the first snapshot");
     insitu::LocalBlock b;
@@ -133,49 +242,111 @@ int panoptes_set_block(panoptes_session* s, const int offset[3], const int exten
       b.ghost_hi[a] = ghost_hi[a];
     }
     s->block = b;
+    s->fields.clear();  // bound against the old block's shape
+  });
+}
+
+int panoptes_set_halo(panoptes_session* s, const int valid_lo[3], const int valid_hi[3], int edges_valid) {
+  return guarded(s, [&] {
+    need(s, "panoptes_set_halo: null session");
+    need(s->block.has_value(), "panoptes_set_halo: call panoptes_set_block first");
+    need(!s->session, "panoptes_set_halo: the halo cannot change after the first snapshot");
+    insitu::LocalBlock& b = *s->block;
+    static const char* const axes = "xyz";
+    for (int a = 0; a < 3; ++a) {
+      const int lo = valid_lo ? valid_lo[a] : -1, hi = valid_hi ? valid_hi[a] : -1;
+      need(lo >= -1 && lo <= b.ghost_lo[a] && hi >= -1 && hi <= b.ghost_hi[a],
+           std::string("panoptes_set_halo: valid ghost layers ") + std::to_string(lo) + " below / " + std::to_string(hi) +
+               " above on axis " + axes[a] + "; expected -1 (every stored layer) or 0 .. the stored " +
+               std::to_string(b.ghost_lo[a]) + " / " + std::to_string(b.ghost_hi[a]) + " (panoptes_set_block)");
+      b.valid_lo[a] = lo;
+      b.valid_hi[a] = hi;
+    }
+    b.edges_valid = edges_valid != 0;
   });
 }
 
 int panoptes_set_field(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3]) {
-  return guarded([&] {
-    need(s && name && data, "panoptes_set_field: null session, name or data");
-    need(type == PANOPTES_FLOAT32 || type == PANOPTES_FLOAT64,
-         "panoptes_set_field: type " + std::to_string(type) + "; expected PANOPTES_FLOAT32 or PANOPTES_FLOAT64");
-    need(s->block.has_value(), "panoptes_set_field: call panoptes_set_block first");
-    const insitu::LocalBlock& b = *s->block;
-    std::array<std::int64_t, 3> st{};
-    if (strides) {
-      st = {strides[0], strides[1], strides[2]};
-    } else {
-      const std::int64_t nx = b.extent[0] + b.ghost_lo[0] + b.ghost_hi[0];
-      const std::int64_t ny = b.extent[1] + b.ghost_lo[1] + b.ghost_hi[1];
-      st = {1, nx, nx * ny};
+  return guarded(s, [&] { bind_field(s, name, data, type, field_strides(s, "panoptes_set_field", name, data, type, strides)); });
+}
+
+int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3],
+                         long long count) {
+  return guarded(s, [&] {
+    const std::string call = "panoptes_set_field_n";
+    const auto st = field_strides(s, call, name, data, type, strides);
+    const auto n = ghosted_extent(*s->block);
+    // The elements the block reaches, relative to data (the first stored element).
+    long long lo = 0, hi = 0;
+    for (int a = 0; a < 3; ++a) {
+      need(st[a] != 0 || n[a] <= 1, call + ": field \"" + name + "\" has stride 0 on axis " + std::to_string(a));
+      (st[a] > 0 ? hi : lo) += (n[a] - 1) * st[a];
     }
-    const std::int64_t shift = b.ghost_lo[0] * st[0] + b.ghost_lo[1] * st[1] + b.ghost_lo[2] * st[2];
-    const std::size_t elem = type == PANOPTES_FLOAT64 ? sizeof(double) : sizeof(float);
-    insitu::FieldInput in;
-    in.name = name;
-    in.data = static_cast<const char*>(data) + shift * std::int64_t(elem);
-    in.type = type == PANOPTES_FLOAT64 ? insitu::ScalarType::f64 : insitu::ScalarType::f32;
-    in.stride = st;
-    s->fields[in.name] = in;
+    need(lo >= 0 && hi < count,
+         call + ": field \"" + name + "\": the block with its stored ghosts " + shape_text(n) + " (x, y, z) at strides " +
+             shape_text({st[0], st[1], st[2]}) + " reaches elements " + std::to_string(lo) + " .. " + std::to_string(hi) +
+             " of the buffer, which holds " + std::to_string(count) + (count > 0 ? " (0 .. " + std::to_string(count - 1) + ")" : ""));
+    bind_field(s, name, data, type, st);
+  });
+}
+
+int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
+                              const long long extents[3], const long long strides[3]) {
+  return guarded(s, [&] {
+    const std::string call = "panoptes_set_field_layout";
+    need(s && name && extents && strides, call + ": null session, name, extents or strides");
+    need(s->block.has_value(), call + ": call panoptes_set_block first");
+    const auto axis = parse_layout(layout, call);
+    const std::string lay = std::string("\"") + layout + "\"";
+    const auto n = ghosted_extent(*s->block);
+    const std::array<long long, 3> got{extents[0], extents[1], extents[2]};
+    std::array<long long, 3> want{};
+    for (int d = 0; d < 3; ++d) want[d] = n[axis[d]];
+    if (got != want) {
+      std::string msg = call + ": field \"" + name + "\" has shape " + shape_text(got) + "; the block with its stored ghosts is " +
+                        shape_text(n) + " points (x, y, z), which in layout " + lay + " is the shape " + shape_text(want);
+      // A hint when the array fits the block in another axis order (the usual mistake: z fastest).
+      static const char* const orders[] = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx"};
+      for (const char* o : orders) {
+        const auto ax = parse_layout(o, call);
+        if (std::array<long long, 3>{n[ax[0]], n[ax[1]], n[ax[2]]} == got && ax != axis) {
+          msg += std::string("; the array fits layout \"") + o + "\": is that its axis order?";
+          break;
+        }
+      }
+      throw UsageError(msg);
+    }
+    need(data, call + ": field \"" + std::string(name) + "\": null data");
+    std::array<std::int64_t, 3> st{};
+    for (int d = 0; d < 3; ++d) {
+      need(strides[d] != 0 || got[d] <= 1, call + ": field \"" + std::string(name) + "\" has stride 0 along dimension " + std::to_string(d + 1));
+      st[axis[d]] = strides[d];
+    }
+    bind_field(s, name, data, type, field_strides(s, call, name, data, type, std::array<long long, 3>{st[0], st[1], st[2]}.data()));
   });
 }
 
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken) {
-  return guarded([&] {
+  return guarded(s, [&] {
     insitu::Session& ss = session_of(s);
     const bool t = ss.process(step, time, inputs(s));
     if (taken) *taken = t ? 1 : 0;
   });
 }
 
+int panoptes_due(panoptes_session* s, long long step, double time, int* due) {
+  return guarded(s, [&] {
+    need(due, "panoptes_due: null output pointer");
+    *due = session_of(s).due(step, time) ? 1 : 0;
+  });
+}
+
 int panoptes_snapshot(panoptes_session* s, double time) {
-  return guarded([&] { session_of(s).snapshot(time, inputs(s)); });
+  return guarded(s, [&] { session_of(s).snapshot(time, inputs(s)); });
 }
 
 int panoptes_finalize(panoptes_session* s) {
-  return guarded([&] {
+  return guarded(s, [&] {
     insitu::Session& ss = session_of(s);
     const bool first = !s->finalized;
     ss.finalize();
@@ -196,5 +367,9 @@ void panoptes_destroy(panoptes_session* s) {
 }
 
 const char* panoptes_last_error(void) { return g_error.c_str(); }
+
+void panoptes_set_error_output(int mode) {
+  if (mode == PANOPTES_ERRORS_ALL || mode == PANOPTES_ERRORS_RANK0 || mode == PANOPTES_ERRORS_NONE) g_error_mode = mode;
+}
 
 }  // extern "C"

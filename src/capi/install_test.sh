@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The installed package, used from outside as a user's project would: `cmake --install` into a
-# temporary prefix, then the C and Fortran heat examples built OUT OF TREE against it, once with CMake
-# (find_package(Panoptes)) and once with pkg-config; the CMake builds run with 1 and 2 MPI ranks, the
-# pkg-config builds with 2 (the CI budget: each run costs an MPI start-up), and every database is
-# checked with the installed `panoptes info`. Also: only the C API is exported from
+# temporary prefix, then the C, C++ and Fortran heat examples built OUT OF TREE against it, once with
+# CMake (find_package(Panoptes); the C++ one includes <mpi.h> and links Panoptes::panoptes alone) and
+# once with pkg-config; the Fortran one also from the installed module SOURCE
+# (share/panoptes/fortran/panoptes.f90), as users of other Fortran compilers build it. The CMake builds
+# run with 1 and 2 MPI ranks, the others with 2 (the CI budget: each run costs an MPI start-up), and
+# every database is checked with the installed `panoptes info`. Also: only the C API is exported from
 # libpanoptes.so, the installed executable runs without LD_LIBRARY_PATH, and the installed Python
 # package imports and reads a frame.
 #   install_test.sh BUILD_DIR WORK_DIR
@@ -24,7 +26,8 @@ step "cmake --install $build --prefix $prefix"
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
 libdir=$(dirname "$(find "$prefix" -name 'libpanoptes.so' | head -1)")
 [ -n "$libdir" ] && [ -d "$libdir" ] || fail "no libpanoptes.so installed"
-for f in bin/panoptes include/panoptes.h include/panoptes/fortran/panoptes.mod; do
+for f in bin/panoptes include/panoptes.h include/panoptes.hpp include/panoptes/fortran/panoptes.mod \
+         share/panoptes/fortran/panoptes.f90; do
   [ -e "$prefix/$f" ] || fail "$f not installed"
 done
 for f in libpanoptes_fortran.a cmake/Panoptes/PanoptesConfig.cmake cmake/Panoptes/PanoptesConfigVersion.cmake \
@@ -32,7 +35,8 @@ for f in libpanoptes_fortran.a cmake/Panoptes/PanoptesConfig.cmake cmake/Panopte
   [ -e "$libdir/$f" ] || fail "$libdir/$f not installed"
 done
 doc=$(find "$prefix/share/doc" -maxdepth 1 -mindepth 1 -type d | head -1)
-for f in README.md docs/formats.md examples/heat_c/heat.c examples/heat_c/CMakeLists.txt \
+for f in README.md docs/formats.md docs/instrumenting.md examples/heat_c/heat.c examples/heat_c/CMakeLists.txt \
+         examples/heat_cpp/heat.cpp examples/heat_cpp/CMakeLists.txt \
          examples/heat_fortran/heat.f90 examples/heat_fortran/CMakeLists.txt; do
   [ -e "$doc/$f" ] || fail "$doc/$f not installed"
 done
@@ -65,7 +69,7 @@ run_and_check() {  # name binary example ranks...
 }
 
 step "CMake: find_package(Panoptes) builds of the examples"
-for example in heat_c heat_fortran; do
+for example in heat_c heat_cpp heat_fortran; do
   cmake -S "$ex/$example" -B "$work/cmake_$example" -G Ninja -DCMAKE_BUILD_TYPE=Release \
         -DCMAKE_PREFIX_PATH="$prefix" >"$work/cmake_$example.log" 2>&1 ||
     { cat "$work/cmake_$example.log"; fail "configure $example against the install"; }
@@ -82,6 +86,18 @@ run_and_check pkg_heat_c "$work/pkg_heat_c" heat_c 2
 mpifort -O2 "$ex/heat_fortran/heat.f90" $(pkg-config --cflags --libs panoptes-fortran) -o "$work/pkg_heat_fortran" ||
   fail "mpifort heat.f90 \$(pkg-config --cflags --libs panoptes-fortran)"
 run_and_check pkg_heat_fortran "$work/pkg_heat_fortran" heat_fortran 2
+
+# C++ with plain c++ (no MPI wrapper): <mpi.h> in C++ must not leave MPI C++ symbols undefined.
+c++ -O2 -std=c++17 "$ex/heat_cpp/heat.cpp" $(pkg-config --cflags --libs panoptes) -o "$work/pkg_heat_cpp" ||
+  fail "c++ heat.cpp \$(pkg-config --cflags --libs panoptes)"
+run_and_check pkg_heat_cpp "$work/pkg_heat_cpp" heat_cpp 2
+
+step "Fortran module built from the installed source"
+mkdir -p "$work/f90src"
+(cd "$work/f90src" && mpifort -O2 -c "$prefix/share/panoptes/fortran/panoptes.f90" &&
+   mpifort -O2 "$ex/heat_fortran/heat.f90" panoptes.o -L"$libdir" -Wl,-rpath,"$libdir" -lpanoptes -o heat_fortran) ||
+  fail "mpifort panoptes.f90 heat.f90 -lpanoptes"
+run_and_check src_heat_fortran "$work/f90src/heat_fortran" heat_fortran 2
 
 pydir=$(find "$prefix" -type d -name panoptes -path '*-packages/*' | head -1)
 if [ -n "$pydir" ]; then

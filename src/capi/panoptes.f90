@@ -1,25 +1,44 @@
-! Fortran 2008 interface to the Panoptes C API (include/panoptes.h) through iso_c_binding.
-! Every routine has an optional integer ierr: 0 on success; without ierr an error stops the program
-! with the message of panoptes_last_error.
+! Fortran interface to the Panoptes C API (include/panoptes.h) through iso_c_binding. Standard Fortran
+! 2008 only (no compiler-specific descriptor layout): this source is installed as
+! share/panoptes/fortran/panoptes.f90, so any compiler (gfortran, Intel, NVHPC, Cray, Fujitsu...) can
+! build the module for itself and link it to libpanoptes.
 !
 !   use panoptes
 !   type(panoptes_t) :: viz
 !   call panoptes_open(viz, 'viz.toml', MPI_COMM_WORLD)
-!   call panoptes_grid(viz, [nx, ny, nz], [0d0, 0d0, 0d0], [h, h, h])
-!   call panoptes_block(viz, offset, extent, ghost_lo, ghost_hi)      ! 0-based offsets
+!   call panoptes_grid(viz, [nx, ny, nz], [0d0, 0d0, 0d0], [h, h, h])   ! real(4) or real(8)
+!   call panoptes_block(viz, offset, extent, ghost_lo, ghost_hi)        ! 0-based offsets, STORED ghosts
+!   call panoptes_halo(viz, valid_lo, valid_hi)                         ! optional: ghosts kept up to date
 !   do step = ...
-!     call panoptes_field(viz, 'T', t)     ! t(:,:,:) real(4) or real(8), INCLUDING its ghost layers
-!     call panoptes_step(viz, step, time)
+!     call panoptes_field(viz, 'T', v, layout='zxy')  ! v(k,i,j): z fastest; sections and padding allowed
+!     call panoptes_step(viz, step, time)             ! integer(4|8) step, real(4|8) time
 !   end do
 !   call panoptes_close(viz)
+!
+! Errors: every routine has an optional integer ierr (0 = success, else PANOPTES_ERROR_*); the library
+! prints the message once to stderr (panoptes_errors chooses which ranks print) and never stops the
+! program itself. Without ierr a failed call ends the program with STOP 1 (no ERROR STOP, no backtrace).
+!
+! Arrays are used in place, never copied: panoptes_field keeps the address and strides of the actual
+! argument and reads it at each snapshot. Its dummy argument is INTENT(INOUT) on purpose: the compiler
+! then accepts only a variable (a whole array, a section or a pointer), never an expression or a
+! vector-subscripted section, which it would pass as a temporary that is freed when the call returns.
+! Give the array the TARGET (or POINTER) attribute and keep it allocated while it is bound.
 module panoptes
   use, intrinsic :: iso_c_binding
+  use, intrinsic :: iso_fortran_env, only: int32, int64, real32, real64
   implicit none
   private
-  public :: panoptes_t, panoptes_open, panoptes_grid, panoptes_block, panoptes_field, panoptes_step, &
-            panoptes_close, panoptes_error_message, PANOPTES_COMM_WORLD
+  public :: panoptes_t, panoptes_open, panoptes_grid, panoptes_block, panoptes_halo, panoptes_field, &
+            panoptes_step, panoptes_due, panoptes_snapshot, panoptes_close, panoptes_errors, &
+            panoptes_error_message
+  public :: PANOPTES_COMM_WORLD, PANOPTES_OK, PANOPTES_ERROR_CONFIG, PANOPTES_ERROR_USAGE, PANOPTES_ERROR_RUN, &
+            PANOPTES_ERRORS_ALL, PANOPTES_ERRORS_RANK0, PANOPTES_ERRORS_NONE
 
   integer, parameter :: PANOPTES_COMM_WORLD = -1
+  integer, parameter :: PANOPTES_OK = 0, PANOPTES_ERROR_CONFIG = 1, PANOPTES_ERROR_USAGE = 2, PANOPTES_ERROR_RUN = 3
+  !> Which ranks print error messages (panoptes_errors): all, prefixed with their rank; rank 0 only; none.
+  integer, parameter :: PANOPTES_ERRORS_ALL = 0, PANOPTES_ERRORS_RANK0 = 1, PANOPTES_ERRORS_NONE = 2
   integer(c_int), parameter :: F32 = 0, F64 = 1
 
   !> A session handle.
@@ -45,11 +64,19 @@ module panoptes
       type(c_ptr), value :: s
       integer(c_int), intent(in) :: offset(3), extent(3), glo(3), ghi(3)
     end function
-    integer(c_int) function c_set_field(s, name, data, type, strides) bind(c, name='panoptes_set_field')
-      import :: c_int, c_ptr, c_char
-      type(c_ptr), value :: s, data, strides
-      character(kind=c_char), intent(in) :: name(*)
+    integer(c_int) function c_set_halo(s, vlo, vhi, edges) bind(c, name='panoptes_set_halo')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: s
+      integer(c_int), intent(in) :: vlo(3), vhi(3)
+      integer(c_int), value :: edges
+    end function
+    integer(c_int) function c_set_field_layout(s, name, data, type, layout, extents, strides) &
+        bind(c, name='panoptes_set_field_layout')
+      import :: c_int, c_ptr, c_char, c_long_long
+      type(c_ptr), value :: s, data
+      character(kind=c_char), intent(in) :: name(*), layout(*)
       integer(c_int), value :: type
+      integer(c_long_long), intent(in) :: extents(3), strides(3)
     end function
     integer(c_int) function c_process(s, step, time, taken) bind(c, name='panoptes_process')
       import :: c_int, c_ptr, c_long_long, c_double
@@ -57,6 +84,18 @@ module panoptes
       integer(c_long_long), value :: step
       real(c_double), value :: time
       integer(c_int), intent(out) :: taken
+    end function
+    integer(c_int) function c_due(s, step, time, due) bind(c, name='panoptes_due')
+      import :: c_int, c_ptr, c_long_long, c_double
+      type(c_ptr), value :: s
+      integer(c_long_long), value :: step
+      real(c_double), value :: time
+      integer(c_int), intent(out) :: due
+    end function
+    integer(c_int) function c_snapshot(s, time) bind(c, name='panoptes_snapshot')
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: s
+      real(c_double), value :: time
     end function
     integer(c_int) function c_finalize(s) bind(c, name='panoptes_finalize')
       import :: c_int, c_ptr
@@ -69,15 +108,36 @@ module panoptes
     type(c_ptr) function c_last_error() bind(c, name='panoptes_last_error')
       import :: c_ptr
     end function
+    subroutine c_set_error_output(mode) bind(c, name='panoptes_set_error_output')
+      import :: c_int
+      integer(c_int), value :: mode
+    end subroutine
     integer(c_size_t) function c_strlen(p) bind(c, name='strlen')
       import :: c_ptr, c_size_t
       type(c_ptr), value :: p
     end function
   end interface
 
-  !> Binds a field (real(4) or real(8) 3-D array including its ghost layers, x fastest).
+  !> The global grid: origin and spacing real(4) or real(8).
+  interface panoptes_grid
+    module procedure grid_r4, grid_r8
+  end interface
+  !> Binds a field: a real(4) or real(8) 3-D array (or section) INCLUDING its stored ghost layers, in the
+  !> axis order `layout` (default 'xyz': first index x).
   interface panoptes_field
     module procedure field_r4, field_r8
+  end interface
+  !> Renders a snapshot if the schedule asks for one at (step, time): integer(4|8) step, real(4|8) time.
+  interface panoptes_step
+    module procedure step_i4_r4, step_i4_r8, step_i8_r4, step_i8_r8
+  end interface
+  !> Whether the schedule asks for a snapshot at (step, time), without rendering.
+  interface panoptes_due
+    module procedure due_i4_r4, due_i4_r8, due_i8_r4, due_i8_r8
+  end interface
+  !> Renders and stores a snapshot now, whatever the schedule (time real(4) or real(8)).
+  interface panoptes_snapshot
+    module procedure snapshot_r4, snapshot_r8
   end interface
 
 contains
@@ -90,21 +150,29 @@ contains
     integer :: n, i
     p = c_last_error()
     n = int(c_strlen(p))
-    call c_f_pointer(p, chars, [n])
     allocate(character(len=n) :: msg)
+    if (n == 0) return
+    call c_f_pointer(p, chars, [n])
     do i = 1, n
       msg(i:i) = chars(i)
     end do
   end function
 
+  !> Which ranks print error messages: PANOPTES_ERRORS_ALL (default; prefixed with the rank when there
+  !> are several), PANOPTES_ERRORS_RANK0 or PANOPTES_ERRORS_NONE. Also: environment PANOPTES_ERRORS=all|rank0|none.
+  subroutine panoptes_errors(mode)
+    integer, intent(in) :: mode
+    call c_set_error_output(int(mode, c_int))
+  end subroutine
+
+  ! The library has printed the message already (as panoptes_errors says).
   subroutine check(rc, ierr)
     integer(c_int), intent(in) :: rc
     integer, intent(out), optional :: ierr
     if (present(ierr)) then
       ierr = int(rc)
     else if (rc /= 0) then
-      write (*, '(a)') 'panoptes: error: '//panoptes_error_message()
-      error stop 1
+      stop 1
     end if
   end subroutine
 
@@ -117,16 +185,23 @@ contains
     call check(c_create(trim(config_file)//c_null_char, 1_c_int, int(comm, c_int), s%handle), ierr)
   end subroutine
 
-  !> The global grid: dims points per axis, origin and spacing.
-  subroutine panoptes_grid(s, dims, origin, spacing, ierr)
+  subroutine grid_r4(s, dims, origin, spacing, ierr)
     type(panoptes_t), intent(in) :: s
     integer, intent(in) :: dims(3)
-    double precision, intent(in) :: origin(3), spacing(3)
+    real(real32), intent(in) :: origin(3), spacing(3)
     integer, intent(out), optional :: ierr
     call check(c_set_grid(s%handle, int(dims, c_int), real(origin, c_double), real(spacing, c_double)), ierr)
   end subroutine
 
-  !> This rank's owned points (0-based offset, extent) and stored ghost layers below / above.
+  subroutine grid_r8(s, dims, origin, spacing, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer, intent(in) :: dims(3)
+    real(real64), intent(in) :: origin(3), spacing(3)
+    integer, intent(out), optional :: ierr
+    call check(c_set_grid(s%handle, int(dims, c_int), real(origin, c_double), real(spacing, c_double)), ierr)
+  end subroutine
+
+  !> This rank's owned points (0-based offset, extent) and the ghost layers its arrays STORE below / above.
   subroutine panoptes_block(s, offset, extent, ghost_lo, ghost_hi, ierr)
     type(panoptes_t), intent(in) :: s
     integer, intent(in) :: offset(3), extent(3), ghost_lo(3), ghost_hi(3)
@@ -135,41 +210,190 @@ contains
                            int(ghost_hi, c_int)), ierr)
   end subroutine
 
-  subroutine field_r4(s, name, a, ierr)
+  !> Of the stored ghost layers, those the halo exchange keeps up to date (-1 = all stored), and whether it
+  !> fills edge and corner ghosts too (edges_valid, default .false.: face-only halos).
+  subroutine panoptes_halo(s, valid_lo, valid_hi, edges_valid, ierr)
     type(panoptes_t), intent(in) :: s
-    character(len=*), intent(in) :: name
-    real(c_float), contiguous, target, intent(in) :: a(:, :, :)
+    integer, intent(in) :: valid_lo(3), valid_hi(3)
+    logical, intent(in), optional :: edges_valid
     integer, intent(out), optional :: ierr
-    call check(c_set_field(s%handle, trim(name)//c_null_char, c_loc(a), F32, c_null_ptr), ierr)
+    integer(c_int) :: edges
+    edges = 0
+    if (present(edges_valid)) then
+      if (edges_valid) edges = 1
+    end if
+    call check(c_set_halo(s%handle, int(valid_lo, c_int), int(valid_hi, c_int), edges), ierr)
   end subroutine
 
-  subroutine field_r8(s, name, a, ierr)
+  ! Elements between two addresses (the array's own strides, whatever the compiler's descriptor).
+  integer(c_long_long) function distance(p, q, bytes)
+    type(c_ptr), intent(in) :: p, q
+    integer, intent(in) :: bytes
+    distance = int((transfer(q, 0_c_intptr_t) - transfer(p, 0_c_intptr_t)) / bytes, c_long_long)
+  end function
+
+  subroutine bind_array(s, name, data, type, layout, extents, strides, ierr)
     type(panoptes_t), intent(in) :: s
     character(len=*), intent(in) :: name
-    real(c_double), contiguous, target, intent(in) :: a(:, :, :)
+    type(c_ptr), intent(in) :: data
+    integer(c_int), intent(in) :: type
+    character(len=*), intent(in), optional :: layout
+    integer(c_long_long), intent(in) :: extents(3), strides(3)
     integer, intent(out), optional :: ierr
-    call check(c_set_field(s%handle, trim(name)//c_null_char, c_loc(a), F64, c_null_ptr), ierr)
+    character(len=8) :: order
+    order = 'xyz'
+    if (present(layout)) order = layout
+    call check(c_set_field_layout(s%handle, trim(name)//c_null_char, data, type, trim(order)//c_null_char, &
+                                  extents, strides), ierr)
   end subroutine
 
-  !> Renders a snapshot if the schedule asks for one at (step, time); taken tells whether it did.
-  subroutine panoptes_step(s, step, time, taken, ierr)
+  subroutine field_r4(s, name, a, layout, ierr)
     type(panoptes_t), intent(in) :: s
-    integer, intent(in) :: step
-    double precision, intent(in) :: time
+    character(len=*), intent(in) :: name
+    real(real32), target, intent(inout) :: a(:, :, :)
+    character(len=*), intent(in), optional :: layout
+    integer, intent(out), optional :: ierr
+    integer(c_long_long) :: n(3), st(3)
+    type(c_ptr) :: p
+    n = shape(a, c_long_long)
+    st = 0
+    p = c_null_ptr
+    if (all(n > 0)) then
+      p = c_loc(a(1, 1, 1))
+      if (n(1) > 1) st(1) = distance(p, c_loc(a(2, 1, 1)), 4)
+      if (n(2) > 1) st(2) = distance(p, c_loc(a(1, 2, 1)), 4)
+      if (n(3) > 1) st(3) = distance(p, c_loc(a(1, 1, 2)), 4)
+    end if
+    call bind_array(s, name, p, F32, layout, n, st, ierr)
+  end subroutine
+
+  subroutine field_r8(s, name, a, layout, ierr)
+    type(panoptes_t), intent(in) :: s
+    character(len=*), intent(in) :: name
+    real(real64), target, intent(inout) :: a(:, :, :)
+    character(len=*), intent(in), optional :: layout
+    integer, intent(out), optional :: ierr
+    integer(c_long_long) :: n(3), st(3)
+    type(c_ptr) :: p
+    n = shape(a, c_long_long)
+    st = 0
+    p = c_null_ptr
+    if (all(n > 0)) then
+      p = c_loc(a(1, 1, 1))
+      if (n(1) > 1) st(1) = distance(p, c_loc(a(2, 1, 1)), 8)
+      if (n(2) > 1) st(2) = distance(p, c_loc(a(1, 2, 1)), 8)
+      if (n(3) > 1) st(3) = distance(p, c_loc(a(1, 1, 2)), 8)
+    end if
+    call bind_array(s, name, p, F64, layout, n, st, ierr)
+  end subroutine
+
+  subroutine do_step(s, step, time, taken, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(c_long_long), intent(in) :: step
+    real(c_double), intent(in) :: time
     logical, intent(out), optional :: taken
     integer, intent(out), optional :: ierr
     integer(c_int) :: t
-    call check(c_process(s%handle, int(step, c_long_long), real(time, c_double), t), ierr)
+    t = 0
+    call check(c_process(s%handle, step, time, t), ierr)
     if (present(taken)) taken = t /= 0
+  end subroutine
+
+  subroutine step_i4_r4(s, step, time, taken, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int32), intent(in) :: step
+    real(real32), intent(in) :: time
+    logical, intent(out), optional :: taken
+    integer, intent(out), optional :: ierr
+    call do_step(s, int(step, c_long_long), real(time, c_double), taken, ierr)
+  end subroutine
+  subroutine step_i4_r8(s, step, time, taken, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int32), intent(in) :: step
+    real(real64), intent(in) :: time
+    logical, intent(out), optional :: taken
+    integer, intent(out), optional :: ierr
+    call do_step(s, int(step, c_long_long), real(time, c_double), taken, ierr)
+  end subroutine
+  subroutine step_i8_r4(s, step, time, taken, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int64), intent(in) :: step
+    real(real32), intent(in) :: time
+    logical, intent(out), optional :: taken
+    integer, intent(out), optional :: ierr
+    call do_step(s, int(step, c_long_long), real(time, c_double), taken, ierr)
+  end subroutine
+  subroutine step_i8_r8(s, step, time, taken, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int64), intent(in) :: step
+    real(real64), intent(in) :: time
+    logical, intent(out), optional :: taken
+    integer, intent(out), optional :: ierr
+    call do_step(s, int(step, c_long_long), real(time, c_double), taken, ierr)
+  end subroutine
+
+  logical function do_due(s, step, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(c_long_long), intent(in) :: step
+    real(c_double), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: d
+    d = 0
+    call check(c_due(s%handle, step, time, d), ierr)
+    do_due = d /= 0
+  end function
+
+  logical function due_i4_r4(s, step, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int32), intent(in) :: step
+    real(real32), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    due_i4_r4 = do_due(s, int(step, c_long_long), real(time, c_double), ierr)
+  end function
+  logical function due_i4_r8(s, step, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int32), intent(in) :: step
+    real(real64), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    due_i4_r8 = do_due(s, int(step, c_long_long), real(time, c_double), ierr)
+  end function
+  logical function due_i8_r4(s, step, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int64), intent(in) :: step
+    real(real32), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    due_i8_r4 = do_due(s, int(step, c_long_long), real(time, c_double), ierr)
+  end function
+  logical function due_i8_r8(s, step, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer(int64), intent(in) :: step
+    real(real64), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    due_i8_r8 = do_due(s, int(step, c_long_long), real(time, c_double), ierr)
+  end function
+
+  subroutine snapshot_r4(s, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real32), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    call check(c_snapshot(s%handle, real(time, c_double)), ierr)
+  end subroutine
+  subroutine snapshot_r8(s, time, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real64), intent(in) :: time
+    integer, intent(out), optional :: ierr
+    call check(c_snapshot(s%handle, real(time, c_double)), ierr)
   end subroutine
 
   !> Finalizes (database complete) and frees the session.
   subroutine panoptes_close(s, ierr)
     type(panoptes_t), intent(inout) :: s
     integer, intent(out), optional :: ierr
-    call check(c_finalize(s%handle), ierr)
+    integer(c_int) :: rc
+    rc = c_finalize(s%handle)
     call c_destroy(s%handle)
     s%handle = c_null_ptr
+    call check(rc, ierr)
   end subroutine
 
 end module panoptes

@@ -43,6 +43,12 @@ struct LocalBlock {
   render::Index3 extent{0, 0, 0};    ///< owned points per axis
   render::Index3 ghost_lo{0, 0, 0};  ///< ghost layers stored below the owned box, per axis
   render::Index3 ghost_hi{0, 0, 0};  ///< ghost layers stored above it
+  /// Ghost layers the caller keeps up to date, per axis (≤ the stored layers); -1 = every stored layer.
+  render::Index3 valid_lo{-1, -1, -1};
+  render::Index3 valid_hi{-1, -1, -1};
+  /// True when the caller's halo exchange fills edge and corner ghosts too (a full 26-neighbour
+  /// exchange); false (the default) = face-only halos: edge and corner ghosts are fetched from their owners.
+  bool edges_valid = false;
   /// The whole grid owned by one process, no ghosts.
   static LocalBlock whole(const render::GridGeometry& g) { return {{0, 0, 0}, g.dims, {0, 0, 0}, {0, 0, 0}}; }
   /// Slab `index` of `parts` along `axis` (the usual 1-D decomposition), with `ghosts` layers on
