@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "camera/rig_spec.hpp"
+#include "insitu/resources.hpp"
 #include "insitu/session.hpp"
 #include "python/bindings.hpp"
 
@@ -77,6 +79,25 @@ class PySession {
     block_ = b;
   }
 
+  void set_halo(const std::vector<long long>& valid_lo, const std::vector<long long>& valid_hi, bool edges_valid) {
+    need_no_session("set_halo", "halo");
+    if (!block_) throw Error("set_halo: call set_block first");
+    insitu::LocalBlock& b = *block_;
+    for (const auto* v : {&valid_lo, &valid_hi})
+      if (v->size() != 3)
+        throw Error("set_halo: valid_lo/valid_hi has " + std::to_string(v->size()) + " entries; expected 3 (x, y, z)");
+    static const char* const axes = "xyz";
+    for (int a = 0; a < 3; ++a) {
+      if (valid_lo[a] < -1 || valid_lo[a] > b.ghost_lo[a] || valid_hi[a] < -1 || valid_hi[a] > b.ghost_hi[a])
+        throw Error(std::string("set_halo: valid ghost layers ") + std::to_string(valid_lo[a]) + " below / " +
+                    std::to_string(valid_hi[a]) + " above on axis " + axes[a] + "; expected -1 (every stored layer) or 0 .. the stored " +
+                    std::to_string(b.ghost_lo[a]) + " / " + std::to_string(b.ghost_hi[a]) + " (set_block)");
+      b.valid_lo[a] = int(valid_lo[a]);
+      b.valid_hi[a] = int(valid_hi[a]);
+    }
+    b.edges_valid = edges_valid;
+  }
+
   /// Binds `array` (shape (nz, ny, nx) of the GHOSTED block, float32 or float64, any strides) without
   /// copying it.
   void set_field(const std::string& name, const py::array& array) {
@@ -113,6 +134,8 @@ class PySession {
     in.stride = stride;
     fields_[name] = {in, array};  // the reference keeps the array alive while the session may read it
   }
+
+  bool due(long long step, double time) { return session().due(step, time); }
 
   bool process(long long step, double time) {
     insitu::Session& s = session();
@@ -153,6 +176,48 @@ class PySession {
 
   std::string output_dir() const { return config_.output_dir; }
 
+  // Known as soon as the Session exists: a simulation needs its rank to compute its block.
+  std::pair<int, int> rank_and_size() const {
+    if (session_) return {session_->rank(), session_->ranks()};
+    int rank = 0, size = 1;
+#ifdef PANOPTES_HAVE_MPI
+    int init = 0, done = 0;
+    MPI_Initialized(&init);
+    MPI_Finalized(&done);
+    if (init && !done) {
+      const MPI_Comm c = comm_ ? *comm_ : MPI_COMM_WORLD;
+      MPI_Comm_rank(c, &rank);
+      MPI_Comm_size(c, &size);
+    }
+#endif
+    return {rank, size};
+  }
+
+  int camera_count() const {
+    if (session_) return session_->camera_count();
+    const camera::RigSpec spec = camera::RigSpec::parse(config_.rig);
+    const bool needs_grid = spec.kind == camera::RigSpec::Kind::file || spec.kind == camera::RigSpec::Kind::path;
+    if (needs_grid && !grid_) throw Error("camera_count: the rig \"" + config_.rig + "\" is placed in the grid: call set_grid first");
+    return int(insitu::rig_camera_count(config_, grid_ ? *grid_ : render::GridGeometry{}));
+  }
+
+  // The tasks the session will render: one per window, isovalue or slice position of each [[task]] (as
+  // insitu::Session expands them; test_session.py checks both agree).
+  int task_count() const {
+    if (session_) return session_->task_count();
+    std::size_t n = 0;
+    for (const insitu::TaskConfig& t : config_.tasks) {
+      switch (t.kind) {
+        case insitu::TaskConfig::Kind::volume: n += t.windows.size(); break;
+        case insitu::TaskConfig::Kind::volume2: n += 1; break;
+        case insitu::TaskConfig::Kind::isosurface: n += t.isovalues.size(); break;
+        case insitu::TaskConfig::Kind::slice: n += t.slice_positions.size(); break;
+      }
+    }
+    return int(n);
+  }
+  int snapshots() const { return session_ ? session_->snapshots() : 0; }
+
  private:
   void need_no_session(const char* call, const char* what) const {
     if (session_) throw Error(std::string(call) + ": the " + what + " cannot change after the first snapshot");
@@ -183,16 +248,18 @@ void bind_session(py::module_& m) {
       .def("set_grid", &PySession::set_grid, py::arg("dims"), py::arg("origin"), py::arg("spacing"))
       .def("set_block", &PySession::set_block, py::arg("offset"), py::arg("extent"), py::arg("ghost_lo"),
            py::arg("ghost_hi"))
+      .def("set_halo", &PySession::set_halo, py::arg("valid_lo"), py::arg("valid_hi"), py::arg("edges_valid"))
       .def("set_field", &PySession::set_field, py::arg("name"), py::arg("array"))
+      .def("due", &PySession::due, py::arg("step"), py::arg("time"))
       .def("process", &PySession::process, py::arg("step"), py::arg("time"))
       .def("snapshot", &PySession::snapshot, py::arg("time"))
       .def("finalize", &PySession::finalize)
       .def_property_readonly("output_dir", &PySession::output_dir)
-      .def_property_readonly("rank", [](PySession& s) { return s.session().rank(); })
-      .def_property_readonly("ranks", [](PySession& s) { return s.session().ranks(); })
-      .def_property_readonly("camera_count", [](PySession& s) { return s.session().camera_count(); })
-      .def_property_readonly("task_count", [](PySession& s) { return s.session().task_count(); })
-      .def_property_readonly("snapshots", [](PySession& s) { return s.session().snapshots(); });
+      .def_property_readonly("rank", [](const PySession& s) { return s.rank_and_size().first; })
+      .def_property_readonly("ranks", [](const PySession& s) { return s.rank_and_size().second; })
+      .def_property_readonly("camera_count", &PySession::camera_count)
+      .def_property_readonly("task_count", &PySession::task_count)
+      .def_property_readonly("snapshots", &PySession::snapshots);
 }
 
 }  // namespace panoptes::python

@@ -26,23 +26,35 @@ class Session:
         self._s.set_block([int(v) for v in offset], [int(v) for v in extent], [int(v) for v in ghost_lo],
                           [int(v) for v in ghost_hi])
 
+    def set_halo(self, valid_lo, valid_hi, edges_valid=False):
+        """Of the stored ghost layers (set_block), those the halo exchange keeps up to date per axis
+        (x, y, z; -1 = every stored layer), and whether it fills edge and corner ghosts too
+        (edges_valid=True: a full 26-neighbour exchange; False: face-only halos, whose edge and corner
+        points Panoptes fetches from their owners). After set_block, before the first snapshot."""
+        self._s.set_halo([int(v) for v in valid_lo], [int(v) for v in valid_hi], bool(edges_valid))
+
     def set_field(self, name, array):
         """Binds a float32/float64 array of shape (nz, ny, nx) of the block INCLUDING its ghost layers.
         The array is not copied: the session reads it at the next process()/snapshot()."""
         self._s.set_field(name, array)
+
+    def due(self, step, time):
+        """Whether the schedule asks for a snapshot at (step, time); process(step, time) would take it."""
+        return self._s.due(int(step), float(time))
 
     def process(self, step, time):
         """Renders and stores a snapshot if the schedule asks for one; returns whether it did."""
         return self._s.process(int(step), float(time))
 
     def snapshot(self, time):
-        """Renders and stores a snapshot now."""
+        """Renders and stores a snapshot now, whatever the schedule (a forced snapshot)."""
         self._s.snapshot(float(time))
 
     def finalize(self):
         """Closes the movies and marks the database complete."""
         self._s.finalize()
 
+    # rank, ranks, camera_count and task_count answer as soon as the Session exists (before set_grid).
     output_dir = property(lambda self: self._s.output_dir)
     rank = property(lambda self: self._s.rank)
     ranks = property(lambda self: self._s.ranks)

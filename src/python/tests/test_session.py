@@ -74,3 +74,42 @@ def test_session_errors(tmp_path):
         panoptes.Session("[image]\nwidth = -3\n")
     with pytest.raises(panoptes.FileError):
         panoptes.Session(str(tmp_path / "missing.toml"))
+
+
+def test_rank_and_counts_answer_before_set_grid(tmp_path):
+    # A simulation needs its rank to compute its block: nothing may require set_grid/set_block first.
+    sweep = '[[task]]\nname = "iso"\ntype = "isosurface"\nfield = "T"\nisovalues = [0.2, 0.5]\n'
+    s = panoptes.Session(HEAT_TOML.format(dir=tmp_path / "c") + sweep)
+    assert (s.rank, s.ranks, s.snapshots) == (0, 1, 0)
+    early = (s.camera_count, s.task_count)
+    s.set_grid((NX, NY, NZ))
+    s.set_block((0, 0, 0), (NX, NY, NZ))
+    s.set_field("T", np.zeros((NZ, NY, NX), dtype=np.float32))
+    s.snapshot(0.0)  # the session exists from here: its own counts must be the ones announced
+    assert early == (s.camera_count, s.task_count) == (6, 3)  # the sweep is 2 tasks
+    s.finalize()
+
+
+def test_due_and_forced_snapshot(tmp_path):
+    s = panoptes.Session(HEAT_TOML.format(dir=tmp_path / "d"))  # every_steps = 2
+    s.set_grid((NX, NY, NZ))
+    s.set_block((0, 0, 0), (NX, NY, NZ))
+    T = blob((NZ, NY, NX), (12, 10, 8)).astype(np.float32)
+    s.set_field("T", T)
+    assert [s.due(step, 0.1 * step) for step in range(5)] == [True, False, True, False, True]
+    assert s.snapshots == 0  # due() renders nothing
+    s.snapshot(0.15)  # forced, between scheduled steps
+    assert s.process(2, 0.2) and not s.process(3, 0.3)
+    s.finalize()
+    np.testing.assert_allclose(panoptes.open(tmp_path / "d").times, [0.15, 0.2])
+
+
+def test_set_halo_is_checked_against_the_stored_ghosts(tmp_path):
+    s = panoptes.Session(HEAT_TOML.format(dir=tmp_path / "h"))
+    s.set_grid((NX, NY, NZ))
+    with pytest.raises(panoptes.Error, match="set_halo: call set_block first"):
+        s.set_halo((0, 0, 0), (0, 0, 0))
+    s.set_block((0, 0, 0), (NX, NY, NZ), (0, 0, 2), (0, 0, 2))
+    with pytest.raises(panoptes.Error, match=r"set_halo: valid ghost layers 3 below / 1 above on axis z; expected -1"):
+        s.set_halo((0, 0, 3), (0, 0, 1))
+    s.set_halo((0, 0, 1), (-1, -1, 1), edges_valid=False)
