@@ -1,5 +1,6 @@
 # `cmake --install`: libpanoptes.so (C API) and the Fortran module library,
-# panoptes.h and the Fortran .mod files, PanoptesConfig.cmake (+ version file, imported targets
+# panoptes.h, panoptes.hpp (C++ wrapper), the Fortran .mod files and the module's source
+# (share/panoptes/fortran/panoptes.f90, for other Fortran compilers), PanoptesConfig.cmake (+ version file, imported targets
 # Panoptes::panoptes and Panoptes::fortran), panoptes.pc / panoptes-fortran.pc, the Python package,
 # the docs and the examples, under the GNUInstallDirs locations.
 include(CMakePackageConfigHelpers)
@@ -21,7 +22,11 @@ if(TARGET panoptes_capi)
           LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
           RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-  install(FILES ${PROJECT_SOURCE_DIR}/include/panoptes.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(FILES ${PROJECT_SOURCE_DIR}/include/panoptes.h ${PROJECT_SOURCE_DIR}/include/panoptes.hpp
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  # .mod files only suit the compiler that wrote them: users of Intel, NVHPC, Cray or Fujitsu Fortran
+  # compile the module's source themselves (standard Fortran 2008 + iso_c_binding) and link -lpanoptes.
+  install(FILES ${PROJECT_SOURCE_DIR}/src/capi/panoptes.f90 DESTINATION ${CMAKE_INSTALL_DATADIR}/panoptes/fortran)
   install(EXPORT PanoptesTargets NAMESPACE Panoptes:: DESTINATION ${PANOPTES_CMAKE_DIR})
 
   set(PANOPTES_CONFIG_WITH_MPI ${PANOPTES_WITH_MPI})
@@ -71,7 +76,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
         PATTERN "CMakeLists.txt" EXCLUDE)
 # Each example's own stand-alone CMakeLists.txt (find_package(Panoptes)); the top one is in-tree only.
-foreach(example heat_c heat_fortran)
+foreach(example heat_c heat_cpp heat_fortran)
   install(FILES ${PROJECT_SOURCE_DIR}/examples/${example}/CMakeLists.txt
           DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples/${example})
 endforeach()
