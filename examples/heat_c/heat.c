@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
                  MPI_STATUS_IGNORE);
     MPI_Sendrecv(u + plane, (int)plane, MPI_DOUBLE, down, 1, u + plane * (nzl + 1), (int)plane, MPI_DOUBLE, up, 1,
                  MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    check(panoptes_set_field(viz, "T", u, PANOPTES_FLOAT64, NULL), viz);             /* panoptes */
+    check(panoptes_set_field_n(viz, "T", u, PANOPTES_FLOAT64, NULL, plane * (nzl + 2)), viz); /* panoptes */
     check(panoptes_process(viz, step, step * dt, NULL), viz);                         /* panoptes */
     if (step == steps) break;
     for (int k = 1; k <= nzl; ++k)
