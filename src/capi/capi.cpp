@@ -134,7 +134,9 @@ std::vector<insitu::FieldInput> inputs(const panoptes_session* s) {
 }
 
 std::string shape_text(const std::array<long long, 3>& v) {
-  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+  std::string text = "(";  // appended, not "(" + ...: GCC 12 warns falsely (-Wrestrict) on the latter
+  for (int d = 0; d < 3; ++d) text.append(std::to_string(v[d])).append(d < 2 ? ", " : ")");
+  return text;
 }
 
 // Grid axis (0 = x, 1 = y, 2 = z) of each array dimension, from "xyz", "zxy", ... (any case).
