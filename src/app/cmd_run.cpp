@@ -118,7 +118,9 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
     throw FileError(source, "[time] steps = " + std::to_string(rc.solver.steps) +
                                 ": a run needs at least one step (a database without frames would be written)");
   if (!options.out.empty()) cfg.output_dir = options.out;
-  if (options.overwrite) cfg.overwrite = true;
+  if (options.overwrite && options.resume) throw Error("--overwrite and --resume exclude each other");
+  if (options.overwrite) cfg.mode = insitu::OutputMode::overwrite;
+  if (options.resume) cfg.mode = insitu::OutputMode::resume;
   cfg.validate();
   cfg.program = "panoptes run";
   cfg.command_line = options.command_line;
@@ -261,7 +263,10 @@ CommandRegistration reg([](CLI::App& root) {
       "phi_s (|curl v|).");
   sub->add_option("CONFIG", *config, "TOML configuration file")->required();
   sub->add_option("--out", opt->out, "Database directory (overrides [output] dir)");
-  sub->add_flag("--overwrite", opt->overwrite, "Replace an existing database");
+  sub->add_flag("--overwrite", opt->overwrite, "Replace an existing database ([output] mode = \"overwrite\")");
+  sub->add_flag("--resume", opt->resume,
+                "Continue the database after a restart: its snapshots stay, the run's snapshots at or before its "
+                "last time are skipped, the movies go on ([output] mode = \"resume\")");
   sub->add_flag("-q,--quiet", opt->quiet, "No progress output");
   sub->add_flag("--force", opt->force,
                 "Start even when the estimated memory per rank exceeds what the rank has available");

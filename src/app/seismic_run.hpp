@@ -7,7 +7,8 @@ namespace panoptes::app {
 /// Options of a seismic in-situ run.
 struct SeismicRunOptions {
   std::string out;  ///< overrides [output] dir when not empty
-  bool overwrite = false;
+  bool overwrite = false;  ///< [output] mode = "overwrite"
+  bool resume = false;     ///< [output] mode = "resume"
   bool quiet = false;
   std::string command_line;
   bool force = false;  ///< start even when the memory estimate exceeds what a rank has available

@@ -182,6 +182,21 @@ TaskConfig parse_task(const Ctx& c, const toml::table& t, std::size_t index) {
 
 }  // namespace
 
+const char* to_string(OutputMode mode) {
+  switch (mode) {
+    case OutputMode::create: return "create";
+    case OutputMode::overwrite: return "overwrite";
+    case OutputMode::resume: return "resume";
+  }
+  return "create";
+}
+
+OutputMode parse_output_mode(const std::string& text) {
+  for (OutputMode m : {OutputMode::create, OutputMode::overwrite, OutputMode::resume})
+    if (text == to_string(m)) return m;
+  throw Error("[output] mode = \"" + text + "\": expected \"create\", \"overwrite\" or \"resume\"");
+}
+
 void SessionConfig::validate() const {
   if (output_dir.empty()) throw Error("output.dir: must not be empty");
   if (width < 2 || height < 2 || width > kMaxImageSide || height > kMaxImageSide)
@@ -215,9 +230,22 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   only_keys(c, root, "", allowed);
   SessionConfig s;
   if (const auto* o = table(c, root, "output")) {
-    only_keys(c, *o, "output", {"dir", "overwrite", "title", "units"});
+    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "title", "units"});
     s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
-    s.overwrite = boolean(c, *o, "overwrite", "output.", false);
+    // `overwrite = true/false` is the key's old spelling: it still means mode "overwrite"/"create".
+    if (o->get("mode") && o->get("overwrite"))
+      c.fail("output.overwrite", "give only [output] mode (\"create\", \"overwrite\" or \"resume\"); overwrite is its "
+                                 "old spelling");
+    if (o->get("overwrite"))
+      s.mode = boolean(c, *o, "overwrite", "output.", false) ? OutputMode::overwrite : OutputMode::create;
+    if (o->get("mode")) {
+      const std::string m = str(c, *o, "mode", "output.", "create");
+      try {
+        s.mode = parse_output_mode(m);
+      } catch (const Error&) {
+        c.fail("output.mode", "\"" + m + "\"; expected \"create\", \"overwrite\" or \"resume\"");
+      }
+    }
     s.title = str(c, *o, "title", "output.", s.title);
     s.units = str(c, *o, "units", "output.", "");
   }
@@ -366,8 +394,13 @@ SessionConfig load_session_config(const std::string& path, const std::vector<std
 
 const char* config_keys_help() {
   return R"(IN-SITU CONFIGURATION (TOML). Unknown keys, wrong types and impossible values are errors.
-[output]    dir = "panoptes_out" (database directory); overwrite = false; title = "in-situ visualization";
-            units = "" (length unit of the grid)
+[output]    dir = "panoptes_out" (database directory); title = "in-situ visualization";
+            units = "" (length unit of the grid);
+            mode = "create" (refuse a directory that holds a database) | "overwrite" (replace it) |
+            "resume" (continue it after a checkpoint restart: its snapshots stay, snapshots repeated by
+            the restarted run (time <= the last written time) are skipped, the movies go on; rig, tasks,
+            grid, image and video settings must be the ones it was written with);
+            overwrite = true | false is the old spelling of mode = "overwrite" | "create"
 [image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box)
 [rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,
             optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R);

@@ -57,10 +57,24 @@ struct ScheduleConfig {
   int max_snapshots = 0;
 };
 
+/// What a session does with a database already in its output directory ([output] mode).
+enum class OutputMode {
+  create,     ///< refuse it (a new run never destroys an old one by accident)
+  overwrite,  ///< replace it
+  /// Continue it after a checkpoint restart: the snapshots it holds stay, snapshots the restarted run
+  /// repeats (time ≤ the last one written) are skipped, and the movies go on from there. The rig,
+  /// tasks, grid, image and video settings must be the ones it was written with.
+  resume
+};
+/// "create" / "overwrite" / "resume".
+const char* to_string(OutputMode mode);
+/// Parses the names of to_string(); throws Error naming `[output] mode` and the accepted values.
+OutputMode parse_output_mode(const std::string& text);
+
 /// Everything a session needs besides the grid and the communicator.
 struct SessionConfig {
   std::string output_dir = "panoptes_out";
-  bool overwrite = false;
+  OutputMode mode = OutputMode::create;
   std::string title = "in-situ visualization";
   std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
   std::string command_line;

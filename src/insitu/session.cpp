@@ -21,6 +21,8 @@
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
 #include "core/log.hpp"
+#include "insitu/halo.hpp"
+#include "insitu/output.hpp"
 #include "insitu/resources.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
@@ -53,57 +55,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-struct Box {
-  Index3 lo{0, 0, 0}, hi{0, 0, 0};
-  bool empty() const { return hi[0] <= lo[0] || hi[1] <= lo[1] || hi[2] <= lo[2]; }
-  std::int64_t size() const {
-    return empty() ? 0 : std::int64_t(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-  }
-  bool contains(const Box& o) const {
-    for (int a = 0; a < 3; ++a)
-      if (o.lo[a] < lo[a] || o.hi[a] > hi[a]) return false;
-    return true;
-  }
-};
-Box intersect(const Box& a, const Box& b) {
-  Box r;
-  for (int i = 0; i < 3; ++i) {
-    r.lo[i] = std::max(a.lo[i], b.lo[i]);
-    r.hi[i] = std::min(a.hi[i], b.hi[i]);
-  }
-  return r;
-}
-
-// What every rank knows about every rank's block.
-struct BlockInfo {
-  Box owned;      // owned points
-  Box available;  // owned + stored ghosts, clipped to the grid
-  Box required;   // the ghosted point range its brick needs (empty brick: empty)
-  render::Brick brick;
-  bool has_brick = false;
-};
-
-BlockInfo block_info(const render::GridGeometry& g, const LocalBlock& b) {
-  BlockInfo bi;
-  for (int a = 0; a < 3; ++a) {
-    bi.owned.lo[a] = b.offset[a];
-    bi.owned.hi[a] = b.offset[a] + b.extent[a];
-    bi.available.lo[a] = std::max(0, b.offset[a] - b.ghost_lo[a]);
-    bi.available.hi[a] = std::min(g.dims[a], b.offset[a] + b.extent[a] + b.ghost_hi[a]);
-    // Owned points [o, o+e) own the cells [o, min(o+e, dims−1)): the cell boxes of a point partition
-    // partition the cells.
-    bi.brick.lo[a] = b.offset[a];
-    bi.brick.hi[a] = std::min(b.offset[a] + b.extent[a], g.dims[a] - 1);
-  }
-  bi.has_brick = bi.brick.cells() > 0 && bi.brick.hi[0] > bi.brick.lo[0] && bi.brick.hi[1] > bi.brick.lo[1] &&
-                 bi.brick.hi[2] > bi.brick.lo[2];
-  if (bi.has_brick) {
-    const render::PointRange pr = render::required_points(g, bi.brick);
-    bi.required.lo = pr.lo;
-    bi.required.hi = pr.hi;
-  }
-  return bi;
-}
+using halo::Box;
+using halo::BlockInfo;
+using halo::intersect;
 
 // One rendered task: the renderer's spec plus how its window / isovalue follow the reference.
 struct Task {
@@ -136,7 +90,7 @@ struct Session::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
 #endif
   std::vector<BlockInfo> blocks;  // per rank
-  bool exchange_needed = false;   // some rank's stored ghosts do not cover its required range
+  halo::Exchange exchange;        // reads the trusted points, fetches the others
   std::vector<std::string> field_names;
   std::vector<Task> tasks;
   std::vector<store::ParameterAxis> axes_;
@@ -147,6 +101,10 @@ struct Session::Impl {
   std::vector<int> owned;
   int snapshots = 0;
   double next_time = 0;
+  // Resume: the time of the last snapshot written; the restarted run's snapshots at or before it
+  // (repeated after a checkpoint restart) are skipped, so times stay increasing.
+  bool resumed = false;
+  double last_time = -INFINITY;
   bool finalized = false;
   FrameObserver observer;
 
@@ -185,6 +143,9 @@ struct Session::Impl {
   }
 
   void init();
+  bool repeated(double time) const {
+    return resumed && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
+  }
   void build_tasks();
   void check_resources();
   store::Manifest make_manifest() const;
@@ -199,35 +160,19 @@ void Session::Impl::init() {
   cfg.validate();
   grid.validate();
   // Every rank's block, for ownership, bricks and the ghost exchange.
-  std::array<int, 12> mine{};
-  for (int a = 0; a < 3; ++a) {
-    mine[std::size_t(a)] = block.offset[a];
-    mine[std::size_t(3 + a)] = block.extent[a];
-    mine[std::size_t(6 + a)] = block.ghost_lo[a];
-    mine[std::size_t(9 + a)] = block.ghost_hi[a];
-  }
-  std::vector<int> all(12 * std::size_t(size));
+  const std::array<int, halo::kPackedInts> mine = halo::pack_block(block);
+  std::vector<int> all(halo::kPackedInts * std::size_t(size));
 #ifdef PANOPTES_HAVE_MPI
   if (size > 1)
-    MPI_Allgather(mine.data(), 12, MPI_INT, all.data(), 12, MPI_INT, comm);
+    MPI_Allgather(mine.data(), halo::kPackedInts, MPI_INT, all.data(), halo::kPackedInts, MPI_INT, comm);
   else
 #endif
     std::copy(mine.begin(), mine.end(), all.begin());
   std::int64_t points = 0;
   for (int r = 0; r < size; ++r) {
-    LocalBlock b;
-    for (int a = 0; a < 3; ++a) {
-      b.offset[a] = all[12 * std::size_t(r) + std::size_t(a)];
-      b.extent[a] = all[12 * std::size_t(r) + 3 + std::size_t(a)];
-      b.ghost_lo[a] = all[12 * std::size_t(r) + 6 + std::size_t(a)];
-      b.ghost_hi[a] = all[12 * std::size_t(r) + 9 + std::size_t(a)];
-      if (b.offset[a] < 0 || b.extent[a] < 0 || b.offset[a] + b.extent[a] > grid.dims[a] || b.ghost_lo[a] < 0 ||
-          b.ghost_hi[a] < 0)
-        throw Error("local block of rank " + std::to_string(r) + " (offset " + std::to_string(b.offset[a]) + ", extent " +
-                    std::to_string(b.extent[a]) + " on axis " + std::to_string(a) + ") lies outside the grid of " +
-                    std::to_string(grid.dims[a]) + " points or has negative ghosts");
-    }
-    blocks.push_back(block_info(grid, b));
+    const LocalBlock b = halo::unpack_block(all.data() + halo::kPackedInts * std::size_t(r));
+    halo::validate_block(b, r, grid);
+    blocks.push_back(halo::block_info(grid, b));
     points += blocks.back().owned.size();
   }
   const std::int64_t total = std::int64_t(grid.dims[0]) * grid.dims[1] * grid.dims[2];
@@ -239,8 +184,14 @@ void Session::Impl::init() {
     throw Error("the local blocks of the " + std::to_string(size) + " ranks do not partition the grid's " +
                 std::to_string(total) + " points (they own " + std::to_string(points) + (overlap ? ", overlapping" : "") +
                 "): each point must be owned by exactly one rank");
-  for (const BlockInfo& b : blocks)
-    if (b.has_brick && !b.available.contains(b.required)) exchange_needed = true;
+  exchange.blocks = &blocks;
+  exchange.rank = rank;
+  exchange.size = size;
+#ifdef PANOPTES_HAVE_MPI
+  exchange.comm = comm;
+#endif
+  for (int r = 0; r < size; ++r)
+    for (int s = 0; s < size; ++s) exchange.needed = exchange.needed || halo::fetches(blocks, r, s);
 
   build_tasks();
   check_resources();
@@ -266,21 +217,24 @@ void Session::Impl::init() {
   references.resize(field_names.size());
   stage(std::to_string(rig.size()) + " cameras placed; building the navigation graph and the manifest");
 
-  // Rank 0 creates the directory and manifest first; the others then open their movies' writers.
-  const store::Manifest man = make_manifest();
-  stage("manifest ready; creating the database");
-  if (rank == 0) {
-    store::WriterOptions o;
-    o.overwrite = cfg.overwrite;
-    o.owned_cameras = owned;
-    writer.emplace(store::DatabaseWriter::create(cfg.output_dir, man, o));
-  }
-  barrier();
-  if (rank != 0 && !owned.empty()) {
-    store::WriterOptions o;
-    o.owned_cameras = owned;
-    o.writes_manifest = false;
-    writer.emplace(store::DatabaseWriter::create(cfg.output_dir, man, o));
+  OutputGroup group{rank, size};
+#ifdef PANOPTES_HAVE_MPI
+  group.comm = comm;
+#endif
+  SessionOutput out = open_session_output(cfg, make_manifest(), owned, group);
+  writer = std::move(out.writer);
+  if (cfg.mode == OutputMode::resume) {
+    // Go on where the database ends: its snapshots count (frame numbers, max_snapshots), the next
+    // snapshot of an every_time schedule follows the last one, and running references continue.
+    resumed = true;
+    snapshots = out.frames;
+    if (out.frames > 0) {
+      last_time = out.last_time;
+      if (cfg.schedule.every_time > 0)
+        next_time = (std::floor(last_time / cfg.schedule.every_time + 1e-9) + 1) * cfg.schedule.every_time;
+    }
+    if (cfg.running_max && out.references.size() == references.size())
+      for (std::size_t f = 0; f < references.size(); ++f) references[f].update(out.references[f]);
   }
   stage("database created");
   const int slots = size;
@@ -468,12 +422,11 @@ store::Manifest Session::Impl::make_manifest() const {
   return man;
 }
 
-// Copies (and converts) every field to float32 over this rank's required point range; points the
-// simulation's own ghost layers do not hold come from their owners.
+// Copies (and converts) every field to float32 over this rank's required point range: the points
+// its arrays hold valid values for are read there, the others come from their owners (halo.hpp).
 void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   const BlockInfo& b = me();
   const Box& req = b.has_brick ? b.required : b.owned;
-  const Index3 rd{req.hi[0] - req.lo[0], req.hi[1] - req.lo[1], req.hi[2] - req.lo[2]};
   buffers.resize(field_names.size());
   std::vector<const FieldInput*> inputs(field_names.size());
   for (std::size_t f = 0; f < field_names.size(); ++f) {
@@ -481,96 +434,9 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
       if (in.name == field_names[f]) inputs[f] = &in;
     if (!inputs[f] || !inputs[f]->data)
       throw Error("snapshot: field \"" + field_names[f] + "\" (read by a task) was not given or has no data");
+    buffers[f].resize(std::size_t(req.size()));
   }
-  const Box have = intersect(b.available, req);
-  for (std::size_t f = 0; f < field_names.size(); ++f) {
-    const FieldInput& in = *inputs[f];
-    std::array<std::int64_t, 3> st = in.stride;
-    if (st[0] == 0 && st[1] == 0 && st[2] == 0) {
-      const std::int64_t nx = block.extent[0] + block.ghost_lo[0] + block.ghost_hi[0];
-      const std::int64_t ny = block.extent[1] + block.ghost_lo[1] + block.ghost_hi[1];
-      st = {1, nx, nx * ny};
-    }
-    std::vector<float>& buf = buffers[f];
-    buf.resize(std::size_t(req.size()));
-    const bool dbl = in.type == ScalarType::f64;
-    const auto* pf = static_cast<const float*>(in.data);
-    const auto* pd = static_cast<const double*>(in.data);
-#pragma omp parallel for collapse(2) schedule(static)
-    for (int k = have.lo[2]; k < have.hi[2]; ++k)
-      for (int j = have.lo[1]; j < have.hi[1]; ++j) {
-        float* out = buf.data() + (std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] - req.lo[0];
-        const std::int64_t base = std::int64_t(j - block.offset[1]) * st[1] + std::int64_t(k - block.offset[2]) * st[2];
-        for (int i = have.lo[0]; i < have.hi[0]; ++i) {
-          const std::int64_t idx = base + std::int64_t(i - block.offset[0]) * st[0];
-          out[i] = dbl ? float(pd[idx]) : pf[idx];
-        }
-      }
-  }
-#ifdef PANOPTES_HAVE_MPI
-  if (exchange_needed && size > 1) {
-    // Rank s sends to rank r the points it owns in r's required range, for every rank r whose stored
-    // ghosts do not cover that range. Everyone knows every block, so the pattern needs no handshake.
-    const int nf = int(field_names.size());
-    std::vector<MPI_Request> reqs;
-    std::vector<std::vector<float>> out, in_bufs;
-    std::vector<std::pair<int, Box>> incoming;
-    for (int r = 0; r < size; ++r) {
-      const BlockInfo& br = blocks[std::size_t(r)];
-      if (!br.has_brick || br.available.contains(br.required)) continue;
-      if (r == rank) {
-        for (int s = 0; s < size; ++s) {
-          if (s == rank) continue;
-          const Box x = intersect(blocks[std::size_t(s)].owned, br.required);
-          if (!x.empty()) incoming.emplace_back(s, x);
-        }
-      } else {
-        const Box x = intersect(b.owned, br.required);
-        if (x.empty()) continue;
-        std::vector<float> pack;
-        pack.reserve(std::size_t(x.size()) * std::size_t(nf));
-        for (int f = 0; f < nf; ++f) {
-          const FieldInput& in = *inputs[std::size_t(f)];
-          std::array<std::int64_t, 3> st = in.stride;
-          if (st[0] == 0 && st[1] == 0 && st[2] == 0) {
-            const std::int64_t nx = block.extent[0] + block.ghost_lo[0] + block.ghost_hi[0];
-            const std::int64_t ny = block.extent[1] + block.ghost_lo[1] + block.ghost_hi[1];
-            st = {1, nx, nx * ny};
-          }
-          for (int k = x.lo[2]; k < x.hi[2]; ++k)
-            for (int j = x.lo[1]; j < x.hi[1]; ++j)
-              for (int i = x.lo[0]; i < x.hi[0]; ++i) {
-                const std::int64_t idx = std::int64_t(i - block.offset[0]) * st[0] +
-                                         std::int64_t(j - block.offset[1]) * st[1] +
-                                         std::int64_t(k - block.offset[2]) * st[2];
-                pack.push_back(in.type == ScalarType::f64 ? float(static_cast<const double*>(in.data)[idx])
-                                                          : static_cast<const float*>(in.data)[idx]);
-              }
-        }
-        out.push_back(std::move(pack));
-        reqs.emplace_back();
-        MPI_Isend(out.back().data(), int(out.back().size()), MPI_FLOAT, r, 7, comm, &reqs.back());
-      }
-    }
-    in_bufs.resize(incoming.size());
-    for (std::size_t n = 0; n < incoming.size(); ++n) {
-      in_bufs[n].resize(std::size_t(incoming[n].second.size()) * std::size_t(nf));
-      reqs.emplace_back();
-      MPI_Irecv(in_bufs[n].data(), int(in_bufs[n].size()), MPI_FLOAT, incoming[n].first, 7, comm, &reqs.back());
-    }
-    MPI_Waitall(int(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
-    for (std::size_t n = 0; n < incoming.size(); ++n) {
-      const Box& x = incoming[n].second;
-      const float* p = in_bufs[n].data();
-      for (int f = 0; f < nf; ++f)
-        for (int k = x.lo[2]; k < x.hi[2]; ++k)
-          for (int j = x.lo[1]; j < x.hi[1]; ++j)
-            for (int i = x.lo[0]; i < x.hi[0]; ++i)
-              buffers[std::size_t(f)][std::size_t((std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] +
-                                                  (i - req.lo[0]))] = *p++;
-    }
-  }
-#endif
+  exchange.load(inputs, req, buffers);
   prepared.clear();
   if (b.has_brick) {
     render::PointRange pr{req.lo, req.hi};
@@ -779,6 +645,11 @@ void Session::Impl::checkpoint(double t) {
 #endif
   if (rank == 0) {
     writer->set_time(snapshots - 1, t);
+    if (cfg.running_max) {
+      std::vector<double> refs;
+      for (const render::RunningMax& r : references) refs.push_back(r.value());
+      writer->set_note(kRunningMaxNote, format_references(refs));
+    }
     writer->checkpoint(frames == INT_MAX ? snapshots : frames);
   }
   time.checkpoint += since(t0);
@@ -828,6 +699,7 @@ bool Session::due(std::int64_t step, double time) const {
   const ScheduleConfig& s = impl_->cfg.schedule;
   if (impl_->finalized) return false;
   if (s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots) return false;
+  if (impl_->repeated(time)) return false;
   if (s.every_steps > 0) return step % s.every_steps == 0;
   return time >= impl_->next_time - 1e-9 * s.every_time;
 }
@@ -841,6 +713,14 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
     ~Inside() { m.inside += since(t); }
   } inside{m, entered};
   if (m.finalized) throw Error("snapshot: the session is finalized");
+  // [output] mode = "resume": a restarted run repeats the steps since its checkpoint; what the
+  // database already holds is not written twice (the same time on every rank: the same decision).
+  if (m.repeated(time)) {
+    if (m.rank == 0)
+      log::info(m.cfg.output_dir + ": snapshot at time " + fmt(time) + " skipped: the resumed database already holds "
+                "snapshots up to time " + fmt(m.last_time));
+    return;
+  }
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
   // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
@@ -872,6 +752,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   m.time.copy += since(t0);
   m.render_snapshot(m.snapshots);
   ++m.snapshots;
+  m.last_time = time;
   if (m.cfg.schedule.every_time > 0)
     m.next_time = (std::floor(time / m.cfg.schedule.every_time + 1e-9) + 1) * m.cfg.schedule.every_time;
   m.checkpoint(time);

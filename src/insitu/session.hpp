@@ -35,9 +35,11 @@ enum class ScalarType { f32, f64 };
 
 /// This rank's part of the global grid: the points it OWNS (a box; the boxes of all ranks partition
 /// the grid's points) and the ghost layers its arrays hold around them. The session needs, for its
-/// brick, 2 ghost layers below and 2 above the owned box on every split axis (render::required_points);
-/// when the arrays hold fewer, the missing points are fetched from their owners (one extra exchange
-/// per snapshot), so any ghost width, including 0, works.
+/// brick, 2 ghost layers below and 2 above the owned box on every split axis (render::required_points).
+/// It reads from the arrays only the owned points and the ghosts the caller keeps valid: the valid
+/// layers (valid_lo/hi) beside each face, and edge and corner ghosts only when edges_valid. Every other
+/// point it needs is fetched from its owner (one extra exchange per snapshot), so any ghost width,
+/// including 0, and any halo exchange, including none, gives the same picture.
 struct LocalBlock {
   render::Index3 offset{0, 0, 0};    ///< global index of the first owned point
   render::Index3 extent{0, 0, 0};    ///< owned points per axis
@@ -108,8 +110,9 @@ std::string overhead_report(const std::vector<RankOverhead>& ranks);
 class Session {
  public:
   /// Validates the configuration against the grid (throws panoptes::Error naming the bad key), builds
-  /// the rig, the navigation graph and the task list, and creates the database (rank 0 first, then the
-  /// other ranks for the movies of the cameras they own). Single process.
+  /// the rig, the navigation graph and the task list, and creates, replaces or resumes the database as
+  /// [output] mode says (rank 0 first, then the other ranks for the movies of the cameras they own;
+  /// resume: snapshots() starts at the number the database holds). Single process.
   Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block);
 #ifdef PANOPTES_HAVE_MPI
   /// On communicator `comm` (duplicated internally). Every rank passes the same config and grid.
@@ -125,6 +128,8 @@ class Session {
   bool due(std::int64_t step, double time) const;
   /// Renders and stores one snapshot of `fields` (must include every field a task reads) at
   /// simulation time `time`. Collective. Throws Error on missing fields or exhausted max_snapshots.
+  /// After [output] mode = "resume", a snapshot at or before the last time written (a step the
+  /// restarted run repeats) is skipped (due() is false for it): the database keeps the first one.
   void snapshot(double time, const std::vector<FieldInput>& fields);
   /// due() then snapshot(); returns whether a snapshot was taken.
   bool process(std::int64_t step, double time, const std::vector<FieldInput>& fields);

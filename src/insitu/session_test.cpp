@@ -162,7 +162,7 @@ relative = true
 )",
                                               "small");
   c.output_dir = dir;
-  c.overwrite = true;
+  c.mode = insitu::OutputMode::overwrite;
   return c;
 }
 
@@ -295,6 +295,30 @@ TEST(InsituSession, BadBlocksAreRejected) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("do not partition"), std::string::npos) << e.what();
   }
+  fs::remove_all(dir);
+}
+
+// Valid ghost layers are at most the stored ones (or -1 = all): anything else is refused naming the
+// rank, the member, the axis and what was expected.
+TEST(InsituSession, ValidGhostLayersAreChecked) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_badvalid_" + std::to_string(::getpid()));
+  auto refusal = [&](const insitu::LocalBlock& b) -> std::string {
+    try {
+      insitu::Session s(small_config(dir), grid(), b);
+      return "";
+    } catch (const Error& e) {
+      return e.what();
+    }
+  };
+  insitu::LocalBlock b = insitu::LocalBlock::whole(grid());
+  b.valid_hi[2] = 1;  // one layer valid of none stored
+  const std::string m = refusal(b);
+  EXPECT_NE(m.find("rank 0: valid_hi = 1 on axis z: expected -1 (every stored layer) or 0..0"), std::string::npos) << m;
+  b.valid_hi[2] = -2;
+  EXPECT_NE(refusal(b).find("valid_hi = -2"), std::string::npos) << refusal(b);
+  b.valid_hi[2] = 0;  // 0 valid layers (and edges_valid) are fine
+  b.edges_valid = true;
+  EXPECT_EQ(refusal(b), "");
   fs::remove_all(dir);
 }
 

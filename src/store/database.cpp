@@ -23,7 +23,9 @@
 #include "core/log.hpp"
 #include "store/bounded_json.hpp"
 #include "store/camera_table.hpp"
+#include "store/manifest_diff.hpp"
 #include "store/safe_file.hpp"
+#include "video/movie_reader.hpp"
 #include "video/movie_writer.hpp"
 
 namespace panoptes::store {
@@ -384,6 +386,10 @@ void DatabaseWriter::set_time(int frame, double time) {
   times[std::size_t(frame)] = time;
 }
 
+void DatabaseWriter::set_note(const std::string& key, const std::string& value) {
+  impl_->manifest.provenance.extra[key] = value;
+}
+
 void DatabaseWriter::flush() { impl_->flush_all(); }
 
 int DatabaseWriter::complete_frames() const { return impl_->complete_frames(); }
@@ -415,6 +421,127 @@ void DatabaseWriter::finalize(int frames_written) {
 
 const Manifest& DatabaseWriter::manifest() const { return impl_->manifest; }
 const fs::path& DatabaseWriter::dir() const { return impl_->dir; }
+
+// ---- resume (continuing a database after a restart) --------------------------------------------
+
+DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, const WriterOptions& options, int frames) {
+  std::error_code ec;
+  if (options.writes_manifest && !fs::exists(dir / kManifestFileName, ec) && !fs::is_symlink(dir / kManifestFileName, ec)) {
+    WriterOptions fresh = options;
+    fresh.overwrite = false;
+    return create(dir, std::move(manifest), fresh);  // nothing to resume: a new database
+  }
+  if (manifest.image.padded_width == 0 && manifest.image.padded_height == 0) {
+    manifest.image.padded_width = (manifest.image.width + 1) & ~1;
+    manifest.image.padded_height = (manifest.image.height + 1) & ~1;
+  }
+  manifest.status = Status::running;
+  manifest.frames_written = 0;
+  manifest.schema_version = kSchemaVersion;
+  try {
+    manifest.validate();
+  } catch (const Error& e) {
+    throw Error(dir.string() + ": cannot resume the database: " + e.what());
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->dir = dir;
+  impl->options = options;
+  impl->slot_of_camera.assign(std::size_t(manifest.camera_count()), -1);
+  std::vector<int> wanted = options.owned_cameras, owned;  // owned: camera of each slot
+  if (wanted.empty())
+    for (int c = 0; c < manifest.camera_count(); ++c) wanted.push_back(c);
+  for (int c : wanted) {
+    if (c < 0 || c >= manifest.camera_count())
+      throw Error(dir.string() + ": owned camera " + std::to_string(c) + " out of range (database has " +
+                  std::to_string(manifest.camera_count()) + " cameras)");
+    if (impl->slot_of_camera[std::size_t(c)] < 0) {
+      impl->slot_of_camera[std::size_t(c)] = impl->owned++;
+      owned.push_back(c);
+    }
+  }
+  impl->streams.resize(std::size_t(impl->owned) * std::size_t(manifest.task_count()));
+  impl->manifest = std::move(manifest);
+  if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist; nothing to resume");
+  impl->dir_fd = open_directory(dir);
+  std::string old_table;
+  if (options.writes_manifest) {
+    impl->take_lock();  // a live writer of this database refuses the resume here
+    try {
+      const Manifest old = read_manifest(dir / kManifestFileName);
+      const std::string differs = resume_mismatch(old, impl->manifest);
+      if (!differs.empty())
+        throw FileError(dir.string(), "cannot resume this database: " + differs +
+                                          "; a resumed run must use the configuration it was written with");
+      frames = old.frames_written;
+      Manifest& m = impl->manifest;
+      m.times.assign(old.times.begin(), old.times.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(old.times.size()), frames));
+      m.provenance.created = old.provenance.created.empty() ? utc_now_iso8601() : old.provenance.created;
+      if (m.provenance.host.empty()) m.provenance.host = old.provenance.host.empty() ? host_name() : old.provenance.host;
+      const std::string before = old.provenance.extra.count("resumed") ? old.provenance.extra.at("resumed") + " " : "";
+      m.provenance.extra["resumed"] = before + utc_now_iso8601() + "@" + std::to_string(frames);
+      for (const auto& [key, value] : old.provenance.extra) m.provenance.extra.try_emplace(key, value);
+      old_table = referenced_camera_table(dir / kManifestFileName);
+    } catch (...) {
+      impl->release_lock();
+      throw;
+    }
+  }
+  if (frames < 0) throw Error(dir.string() + ": resume: the frame count of the root writer is required here");
+  // Continues one owned stream: its movie is rewritten with its first `frames` frames copied as they
+  // are, into `<movie>.resume`, renamed over the movie once complete (a crash before leaves the old one).
+  auto resume_stream = [](Impl& impl, int camera, int task, int frames, Impl::Stream& s) {
+    s.frames = frames;
+    if (frames == 0) return;  // the first append creates the movie afresh
+    const Manifest& man = impl.manifest;
+    const std::string relative = man.stream_relative_path(camera, task);
+    const fs::path path = impl.dir / relative;
+    const auto slash = relative.rfind('/');
+    const std::string leaf = relative.substr(slash == std::string::npos ? 0 : slash + 1);
+    FileHandle movie_dir;
+    {
+      std::lock_guard lock(impl.mutex);
+      movie_dir = open_subdirectory(impl.dir_fd.get(), slash == std::string::npos ? "" : relative.substr(0, slash), false,
+                                    impl.dir);
+    }
+    // The reader opens by path: the movie must be a regular file inside the database, not a link.
+    struct stat st{};
+    if (::fstatat(movie_dir.get(), leaf.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0)
+      throw FileError(path.string(), "missing: the database's last checkpoint has " + std::to_string(frames) +
+                                         " frames in every movie; cannot resume it");
+    if (!S_ISREG(st.st_mode)) throw FileError(path.string(), "is not a regular file; cannot resume it");
+    const video::MovieReader old(path.string());
+    if (old.frame_count() < frames)
+      throw FileError(path.string(), "holds " + std::to_string(old.frame_count()) + " readable frames, the database's last "
+                                         "checkpoint " + std::to_string(frames) + "; cannot resume it");
+    const std::string temp = leaf + ".resume";
+    FileHandle file = open_for_writing(movie_dir.get(), temp, true, "movie", path.parent_path());
+    auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), man.image.width, man.image.height,
+                                                       man.video);
+    writer->copy_frames(old, frames);
+    writer->flush();
+    if (::renameat(movie_dir.get(), temp.c_str(), movie_dir.get(), leaf.c_str()) != 0)
+      throw FileError(path.string(), std::string("cannot replace the movie by its continued copy: ") + std::strerror(errno));
+    s.writer = std::move(writer);
+  };
+  Impl& m = *impl;
+  const int tasks = m.manifest.task_count();
+  try {
+    parallel_for(std::int64_t(m.streams.size()), m.streams.size() > 16 ? 0 : 1, [&](std::int64_t i) {
+      const int slot = int(i / tasks);
+      resume_stream(m, owned[std::size_t(slot)], int(i % tasks), frames, m.streams[std::size_t(i)]);
+    });
+    if (options.writes_manifest) {
+      m.table = write_camera_table(dir, m.manifest);
+      m.write_manifest(Status::running, frames);
+    }
+  } catch (...) {
+    m.streams.clear();
+    m.release_lock();
+    throw;
+  }
+  if (!old_table.empty() && old_table != m.table.file) ::unlinkat(m.dir_fd.get(), old_table.c_str(), 0);
+  return DatabaseWriter(std::move(impl));
+}
 
 // ---- reader ----------------------------------------------------------------------------------
 

@@ -58,6 +58,16 @@ class DatabaseWriter {
   /// a database and !options.overwrite, or cannot be created; Error if the manifest is invalid.
   static DatabaseWriter create(const std::filesystem::path& dir, Manifest manifest,
                                const WriterOptions& options = {});
+  /// Continues the database in `dir` after a restart (checkpoint/restart of a simulation): the
+  /// manifest (rig, cameras, tasks, axes, grid, image size, video settings, movie pattern) must be
+  /// the one it was written with, else FileError names what differs. The frames of its last
+  /// checkpoint (`frames` < 0: the manifest's frames_written; non-root writers get the root's count)
+  /// stay: each owned movie is rewritten with exactly those frames copied as they are (through a
+  /// temporary file renamed over it, so a crash leaves the old movie) and the next append() continues
+  /// it; the times of those frames stay. A directory without a database is created as by create().
+  /// options.overwrite is ignored.
+  static DatabaseWriter resume(const std::filesystem::path& dir, Manifest manifest, const WriterOptions& options = {},
+                               int frames = -1);
   /// Shorthand for create(dir, manifest, {.overwrite = overwrite}).
   static DatabaseWriter create(const std::filesystem::path& dir, Manifest manifest, bool overwrite);
 
@@ -79,6 +89,10 @@ class DatabaseWriter {
 
   /// Records the simulation time of a frame (stored in Manifest::times at the next checkpoint).
   void set_time(int frame, double time);
+
+  /// Sets a provenance note (Manifest::provenance.extra[key]), written with the next checkpoint; a
+  /// resumed database keeps the notes it had (the in-situ session keeps its running references there).
+  void set_note(const std::string& key, const std::string& value);
 
   /// Flushes every open movie (after it returns the frames are durable), then rewrites the manifest
   /// atomically with frames_written = complete_frames(). Throws FileError on a write failure; the

@@ -80,6 +80,7 @@ struct MovieReader::Impl {
   bool packet_bad = false;       // the packet just sent failed its checksum or the decoder refused it
   int nal_length_size = 0;       // MP4 (avcC) H.264: bytes of each NAL length field; 0 = not checked
   bool checksummed = false;      // the movie's packets carry checksums (packet_checksum.hpp)
+  std::vector<std::uint8_t> header;  // the stream's extradata
 
   ~Impl() {
     avcodec_free_context(&dec);
@@ -313,6 +314,7 @@ struct MovieReader::Impl {
 
     // Packets written by MovieWriter carry a checksum; if the first keyframe has one, every packet must.
     const AVCodecParameters* par = st->codecpar;
+    if (par->extradata_size > 0) header.assign(par->extradata, par->extradata + par->extradata_size);
     if (par->codec_id == AV_CODEC_ID_H264 && par->extradata_size >= 7 && par->extradata[0] == 1 && !packets.empty()) {
       nal_length_size = (par->extradata[4] & 3) + 1;
       const PacketInfo& first = packets.front();
@@ -492,6 +494,33 @@ bool MovieReader::is_keyframe(int index) const {
 }
 
 std::int64_t MovieReader::packets_decoded() const { return impl_->packets_sent; }
+
+void MovieReader::read_packet(int index, std::vector<std::uint8_t>& out) const {
+  const Impl& m = *impl_;
+  if (index < 0 || index >= frame_count())
+    throw Error("movie " + m.path + ": frame " + std::to_string(index) + " out of range (" +
+                std::to_string(frame_count()) + " frames)");
+  const PacketInfo& pi = m.packets[std::size_t(m.frame_packet[std::size_t(index)])];
+  out.resize(std::size_t(pi.size));
+  std::int64_t done = 0;
+  while (done < pi.size) {
+    const ssize_t n = ::pread(m.fd, out.data() + done, std::size_t(pi.size - done), pi.pos + done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw FileError(m.path, "cannot read frame data at byte " + std::to_string(pi.pos + done) + ": " +
+                                            (n < 0 ? errno_string(errno) : "file shrank"));
+    done += n;
+  }
+}
+
+const std::vector<std::uint8_t>& MovieReader::stream_header() const { return impl_->header; }
+
+bool MovieReader::in_decode_order() const {
+  const Impl& m = *impl_;
+  if (m.frame_packet.size() != m.packets.size()) return false;
+  for (std::size_t f = 0; f < m.frame_packet.size(); ++f)
+    if (m.frame_packet[f] != int(f)) return false;
+  return true;
+}
 
 void MovieReader::read(int index, YuvFrame& out) {
   impl_->decode(index);

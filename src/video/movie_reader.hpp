@@ -55,6 +55,15 @@ class MovieReader {
   /// DamagedFrameError if the decoder had to conceal damage in it or in a frame it predicts from.
   void read(int index, YuvFrame& out);
   Image read_rgba(int index);
+  /// The compressed packet of frame `index` exactly as stored (no decoding), for copying it into
+  /// another movie (MovieWriter::copy_frames). Throws Error if index is out of range, FileError if
+  /// the file cannot be read.
+  void read_packet(int index, std::vector<std::uint8_t>& out) const;
+  /// The stream's global header (for H.264 in MP4: the avcC record with SPS and PPS).
+  const std::vector<std::uint8_t>& stream_header() const;
+  /// True when every frame's packet comes in presentation order (no B-frames), so frames 0..n-1 are
+  /// the first n packets.
+  bool in_decode_order() const;
   /// Packets sent to the decoder since open (a measure of decoding work: reading frames i, i+1, ...
   /// in order costs one packet each; a random read costs the distance from its keyframe plus one).
   std::int64_t packets_decoded() const;

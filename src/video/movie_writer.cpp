@@ -16,9 +16,11 @@ extern "C" {
 #include <vector>
 
 #include "core/error.hpp"
+#include "video/annex_b.hpp"
 #include "video/ffmpeg_util.hpp"
 #include "video/h264_encoder.hpp"
 #include "video/intra_encoder_pool.hpp"
+#include "video/movie_reader.hpp"
 #include "video/packet_checksum.hpp"
 
 namespace panoptes::video {
@@ -302,6 +304,98 @@ void MovieWriter::append(const Image& image) {
                            av_error_string(ret));
   ++m.frames_in;
   m.drain_packets(m.own->context);
+}
+
+namespace {
+
+// The NAL units (SPS, PPS) of an H.264 stream header, whether it is an avcC record (as an MP4 file
+// stores it) or Annex B (as libx264 hands it to the muxer): the same stream has the same units.
+std::vector<std::vector<std::uint8_t>> header_units(const std::uint8_t* d, int n) {
+  std::vector<std::vector<std::uint8_t>> units;
+  if (n >= 7 && d[0] == 1) {
+    int at = 5;
+    for (int kind = 0; kind < 2 && at < n; ++kind) {
+      const int count = kind == 0 ? d[at] & 0x1f : d[at];
+      ++at;
+      for (int i = 0; i < count && at + 2 <= n; ++i) {
+        const int len = (d[at] << 8) | d[at + 1];
+        at += 2;
+        if (at + len > n) return {};
+        units.emplace_back(d + at, d + at + len);
+        at += len;
+      }
+    }
+    return units;
+  }
+  for (int at = next_start_code(d, n, 0); at < n;) {
+    const int start = at + 3, next = next_start_code(d, n, start);
+    int end = next;
+    if (next < n && end > start && d[end - 1] == 0) --end;  // the zero_byte of a 4-byte start code
+    units.emplace_back(d + start, d + end);
+    at = next;
+  }
+  return units;
+}
+
+}  // namespace
+
+void MovieWriter::copy_frames(const MovieReader& source, int count) {
+  Impl& m = *impl_;
+  const std::string& from = source.path();
+  if (!m.open) throw Error("movie " + m.path + ": copy after close");
+  if (m.frames_in != 0) throw Error("movie " + m.path + ": frames can be copied only into an empty movie");
+  if (count < 0 || count > source.frame_count())
+    throw Error("movie " + from + " holds " + std::to_string(source.frame_count()) + " frames; " +
+                std::to_string(count) + " were to be continued");
+  if (count == 0) return;
+  const AVCodecParameters* par = m.stream->codecpar;
+  const std::vector<std::uint8_t>& header = source.stream_header();
+  if (source.coded_width() != m.padded_width || source.coded_height() != m.padded_height ||
+      header_units(header.data(), int(header.size())) != header_units(par->extradata, par->extradata_size))
+    throw Error("movie " + from + " (" + std::to_string(source.coded_width()) + "x" +
+                std::to_string(source.coded_height()) + ") was encoded with another frame size or other video settings "
+                "than this run's (" + std::to_string(m.padded_width) + "x" + std::to_string(m.padded_height) +
+                "): its frames cannot be continued");
+  if (!source.in_decode_order() || !source.is_keyframe(0))
+    throw Error("movie " + from + ": frames are not stored in presentation order from a keyframe; cannot continue it");
+  const int length_size = header.size() >= 7 && header[0] == 1 ? (header[4] & 3) + 1 : 0;
+  // The MP4 muxer converts packets to length-prefixed NAL units itself when the stream header it
+  // got is Annex B (libx264's global header); then it must get Annex B packets.
+  const bool to_annex_b = length_size && par->extradata_size > 0 && par->extradata[0] != 1;
+  std::vector<std::uint8_t> bytes, annex_b;
+  for (int f = 0; f < count; ++f) {
+    source.read_packet(f, bytes);
+    // A damaged picture must not be carried into the continued movie as if it were good.
+    if (length_size && verify_packet_checksum(bytes.data(), int(bytes.size()), length_size) == PacketChecksum::bad)
+      throw Error("movie " + from + ": frame " + std::to_string(f) + " is damaged (checksum mismatch); cannot continue it");
+    // Stored length-prefixed (MP4); handed to the muxer as the encoder's packets are, in Annex B
+    // (start codes), which it converts back: the NAL units stay byte for byte.
+    annex_b.clear();
+    for (std::size_t at = 0; to_annex_b && at + std::size_t(length_size) <= bytes.size();) {
+      std::size_t len = 0;
+      for (int i = 0; i < length_size; ++i) len = (len << 8) | bytes[at + std::size_t(i)];
+      at += std::size_t(length_size);
+      if (len > bytes.size() - at) throw Error("movie " + from + ": frame " + std::to_string(f) + " is damaged (bad NAL length)");
+      annex_b.insert(annex_b.end(), {0, 0, 0, 1});
+      annex_b.insert(annex_b.end(), bytes.begin() + std::ptrdiff_t(at), bytes.begin() + std::ptrdiff_t(at + len));
+      at += len;
+    }
+    const std::vector<std::uint8_t>& data = to_annex_b ? annex_b : bytes;
+    if (av_new_packet(m.pkt, int(data.size())) < 0) throw Error("movie " + m.path + ": out of memory");
+    std::memcpy(m.pkt->data, data.data(), data.size());
+    m.pkt->pts = m.pkt->dts = f;
+    m.pkt->duration = 1;
+    if (source.is_keyframe(f)) m.pkt->flags |= AV_PKT_FLAG_KEY;
+    // Already checksummed (and the first packet already carries the encoder's version SEI).
+    av_packet_rescale_ts(m.pkt, m.enc_time_base, m.stream->time_base);
+    m.pkt->stream_index = m.stream->index;
+    const int ret = av_write_frame(m.fmt, m.pkt);
+    av_packet_unref(m.pkt);
+    if (ret < 0) m.fail_write("cannot write copied frame " + std::to_string(f), ret);
+    m.check_io("cannot write copied frame " + std::to_string(f));
+    ++m.packets_out;
+    ++m.frames_in;
+  }
 }
 
 void MovieWriter::flush() {

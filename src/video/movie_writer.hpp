@@ -9,6 +9,8 @@
 
 namespace panoptes::video {
 
+class MovieReader;
+
 /// One movie being written. Frames must all have the size given at construction. Odd sizes are
 /// padded (edge pixels repeated) to the even size H.264 4:2:0 needs; padded_width()/padded_height()
 /// report it so the manifest can record the padding and readers crop it off.
@@ -28,6 +30,12 @@ class MovieWriter {
   MovieWriter(const MovieWriter&) = delete;
   MovieWriter& operator=(const MovieWriter&) = delete;
 
+  /// Copies the first `count` frames of `source` into this movie as they are (no re-encoding, so they
+  /// decode exactly as in the source): a restarted run continues its movies this way. Only before the
+  /// first append; the source must have been written with the same size and settings (its stream
+  /// header must equal this movie's) and hold `count` intact frames. Throws Error naming the source
+  /// otherwise; FileError if writing fails.
+  void copy_frames(const MovieReader& source, int count);
   /// Encodes one frame (3 or 4 channels). Throws Error if its size differs from the movie's,
   /// FileError if writing fails (e.g. disk full).
   void append(const Image& frame);

@@ -1,0 +1,125 @@
+#include "insitu/output.hpp"
+
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <exception>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+
+namespace panoptes::insitu {
+
+namespace {
+
+// Every rank learns whether any failed, and the failing rank's message: then all throw it.
+void agree(const std::string& failure, const OutputGroup& g) {
+  int failed = failure.empty() ? g.size : g.rank;  // lowest failing rank wins
+#ifdef PANOPTES_HAVE_MPI
+  if (g.size > 1) {
+    MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MIN, g.comm);
+    if (failed == g.size) return;
+    int n = failed == g.rank ? int(failure.size()) : 0;
+    MPI_Bcast(&n, 1, MPI_INT, failed, g.comm);
+    std::string text = failed == g.rank ? failure : std::string(std::size_t(n), ' ');
+    MPI_Bcast(text.data(), n, MPI_CHAR, failed, g.comm);
+    throw Error(failed == 0 ? text : "rank " + std::to_string(failed) + ": " + text);
+  }
+#endif
+  if (failed != g.size) throw Error(failure);
+}
+
+std::string message_of(std::exception_ptr e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    return x.what();
+  } catch (...) {
+    return "unknown error";
+  }
+}
+
+}  // namespace
+
+std::string format_references(const std::vector<double>& refs) {
+  std::string out;
+  char buf[40];
+  for (double r : refs) {
+    std::snprintf(buf, sizeof buf, "%.17g", r);
+    out += (out.empty() ? "" : " ") + std::string(buf);
+  }
+  return out;
+}
+
+std::vector<double> parse_references(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<double> v;
+  for (double x; in >> x;) v.push_back(x);
+  return v;
+}
+
+SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifest& manifest,
+                                  const std::vector<int>& owned, const OutputGroup& g) {
+  SessionOutput out;
+  // Rank 0: the manifest (and its movies).
+  std::string failure;
+  if (g.rank == 0) {
+    try {
+      store::WriterOptions o;
+      o.owned_cameras = owned;
+      if (cfg.mode == OutputMode::resume) {
+        out.writer.emplace(store::DatabaseWriter::resume(cfg.output_dir, manifest, o));
+        const store::Manifest& m = out.writer->manifest();
+        out.frames = m.frames_written;
+        if (out.frames > 0 && std::size_t(out.frames) <= m.times.size()) out.last_time = m.times[std::size_t(out.frames) - 1];
+        const auto note = m.provenance.extra.find(kRunningMaxNote);
+        if (note != m.provenance.extra.end()) out.references = parse_references(note->second);
+      } else {
+        struct stat st{};
+        const std::string man = cfg.output_dir + "/panoptes.json";
+        // The store's own refusal names its C++ option; a C, Fortran or Python user has this key.
+        if (cfg.mode == OutputMode::create && ::lstat(man.c_str(), &st) == 0)
+          throw FileError(cfg.output_dir, "already holds a Panoptes database (panoptes.json); set [output] mode = "
+                                          "\"overwrite\" to replace it, or mode = \"resume\" to continue it after a restart");
+        o.overwrite = cfg.mode == OutputMode::overwrite;
+        out.writer.emplace(store::DatabaseWriter::create(cfg.output_dir, manifest, o));
+      }
+    } catch (...) {
+      failure = message_of(std::current_exception());
+    }
+  }
+  agree(failure, g);
+#ifdef PANOPTES_HAVE_MPI
+  if (g.size > 1) {
+    double v[2] = {double(out.frames), out.last_time};
+    MPI_Bcast(v, 2, MPI_DOUBLE, 0, g.comm);
+    out.frames = int(v[0]);
+    out.last_time = v[1];
+    int n = int(out.references.size());
+    MPI_Bcast(&n, 1, MPI_INT, 0, g.comm);
+    out.references.resize(std::size_t(n));
+    MPI_Bcast(out.references.data(), n, MPI_DOUBLE, 0, g.comm);
+  }
+#endif
+  // The other ranks: the movies of the cameras they own, in the directory rank 0 made.
+  if (g.rank != 0 && !owned.empty()) {
+    try {
+      store::WriterOptions o;
+      o.owned_cameras = owned;
+      o.writes_manifest = false;
+      out.writer.emplace(cfg.mode == OutputMode::resume
+                             ? store::DatabaseWriter::resume(cfg.output_dir, manifest, o, out.frames)
+                             : store::DatabaseWriter::create(cfg.output_dir, manifest, o));
+    } catch (...) {
+      failure = message_of(std::current_exception());
+    }
+  }
+  agree(failure, g);
+  if (cfg.mode == OutputMode::resume && g.rank == 0 && out.frames > 0)
+    log::info(cfg.output_dir + ": resuming after snapshot " + std::to_string(out.frames - 1) + " (time " +
+              std::to_string(out.last_time) + "); snapshots at or before that time are skipped");
+  return out;
+}
+
+}  // namespace panoptes::insitu

@@ -1,0 +1,205 @@
+// [output] mode (issue 28): "create" refuses an existing database naming the key, "overwrite"
+// replaces it, "resume" continues one after a restart: a run SIGKILLed in the middle of a snapshot
+// and restarted from an earlier step equals the uninterrupted run frame for frame.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "core/error.hpp"
+#include "insitu/session.hpp"
+#include "render/synthetic_fields.hpp"
+#include "store/database.hpp"
+
+using namespace panoptes;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string error_of(const std::string& toml) {
+  try {
+    (void)insitu::parse_session_config_text(toml + "[[task]]\nname = \"v\"\nfield = \"f\"\n", "test.toml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(InsituOutputMode, KeyAndItsOldSpelling) {
+  auto mode = [](const std::string& output) {
+    return insitu::parse_session_config_text("[output]\n" + output + "\n[[task]]\nname = \"v\"\nfield = \"f\"\n", "t").mode;
+  };
+  EXPECT_EQ(mode(""), insitu::OutputMode::create);
+  EXPECT_EQ(mode("mode = \"resume\""), insitu::OutputMode::resume);
+  EXPECT_EQ(mode("mode = \"overwrite\""), insitu::OutputMode::overwrite);
+  EXPECT_EQ(mode("overwrite = true"), insitu::OutputMode::overwrite);
+  EXPECT_EQ(mode("overwrite = false"), insitu::OutputMode::create);
+  const std::string bad = error_of("[output]\nmode = \"append\"\n");
+  EXPECT_NE(bad.find("output.mode"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("\"resume\""), std::string::npos) << bad;
+  const std::string both = error_of("[output]\nmode = \"resume\"\noverwrite = true\n");
+  EXPECT_NE(both.find("give only [output] mode"), std::string::npos) << both;
+}
+
+const char* kConfig = R"(
+[image]
+width = 32
+height = 30
+[rig]
+spec = "fibonacci:4"
+[schedule]
+every_steps = 1
+[render]
+reference = "running-max"
+[[task]]
+name = "v"
+field = "f"
+[[task]]
+name = "iso"
+type = "isosurface"
+field = "f"
+isovalues = [0.2, 0.5]
+relative = true
+)";
+
+insitu::SessionConfig config(const fs::path& dir, insitu::OutputMode mode) {
+  insitu::SessionConfig c = insitu::parse_session_config_text(kConfig, "resume config");
+  c.output_dir = dir.string();
+  c.mode = mode;
+  return c;
+}
+
+render::GridGeometry grid() { return {{20, 18, 16}, {0, 0, 0}, {1, 1, 1}}; }
+
+std::vector<float> field(double t) {
+  const render::GridGeometry g = grid();
+  // A wave that grows until the last snapshot before the kill (t = 0.4) and then fades: the frames
+  // after the restart depend on the running reference kept across it.
+  const double amp = t <= 0.4 ? 1.0 + t : 1.4 - 0.8 * (t - 0.4);
+  const std::vector<render::WaveFront> fronts{{g.centre(), 3 + 2 * t, 1.5, float(amp)}};
+  return render::wave_field(g, fronts);
+}
+
+constexpr int kSteps = 6;
+double time_of(int step) { return 0.2 * step; }
+
+// Steps first..kSteps-1 of the simulation; `kill_in` ≥ 0: SIGKILL in the middle of that snapshot.
+void run(const fs::path& dir, insitu::OutputMode mode, int first, int kill_in = -1) {
+  insitu::Session s(config(dir, mode), grid(), insitu::LocalBlock::whole(grid()));
+  if (kill_in >= 0)
+    s.set_frame_observer([kill_in](int camera, int, int frame, const Image&) {
+      if (frame == kill_in && camera == 2) ::raise(SIGKILL);
+    });
+  for (int step = first; step < kSteps; ++step) {
+    const auto f = field(time_of(step));
+    s.process(step, time_of(step), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }
+  s.finalize();
+}
+
+TEST(InsituResume, KilledRunResumedEqualsTheUninterruptedRun) {
+  // The killed run is a re-executed copy of this binary (see KilledRunOpensInterrupted in
+  // session_test.cpp: libgomp is not fork-safe); it finds its directory through the environment.
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  if (!std::getenv("PANOPTES_TEST_RESUME_DIR")) {
+    const fs::path d = fs::temp_directory_path() / ("insitu_resume_" + std::to_string(::getpid()));
+    ::setenv("PANOPTES_TEST_RESUME_DIR", d.c_str(), 1);
+  }
+  const fs::path base = std::getenv("PANOPTES_TEST_RESUME_DIR");
+  const fs::path full = base / "full", killed = base / "killed";
+  fs::remove_all(base);
+  fs::create_directories(base);
+  run(full, insitu::OutputMode::create, 0);
+  EXPECT_EXIT(run(killed, insitu::OutputMode::create, 0, 3), ::testing::KilledBySignal(SIGKILL), "");
+  {
+    const auto db = store::Database::open(killed);
+    ASSERT_EQ(db.status(), store::Status::interrupted);
+    ASSERT_EQ(db.frame_count(), 3);  // snapshots 0, 1, 2 checkpointed; 3 died half-way
+  }
+  // Without resume the directory is refused, naming the key a C, Fortran or Python user has.
+  try {
+    run(killed, insitu::OutputMode::create, 2);
+    ADD_FAILURE() << "an existing database was accepted in mode create";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("[output] mode"), std::string::npos) << m;
+    EXPECT_EQ(m.find("--overwrite"), std::string::npos) << m;
+    EXPECT_EQ(m.find("WriterOptions"), std::string::npos) << m;
+  }
+  // The simulation restarts from its checkpoint at step 2: snapshot 2 is repeated (skipped), 3..5 new.
+  run(killed, insitu::OutputMode::resume, 2);
+  const auto a = store::Database::open(full), b = store::Database::open(killed);
+  ASSERT_EQ(b.status(), store::Status::complete);
+  ASSERT_EQ(b.frame_count(), kSteps);
+  ASSERT_EQ(b.manifest().times.size(), std::size_t(kSteps));
+  for (int f = 0; f < kSteps; ++f) EXPECT_DOUBLE_EQ(b.manifest().times[std::size_t(f)], time_of(f));
+  int frames = 0;
+  for (int c = 0; c < a.camera_count(); ++c)
+    for (int t = 0; t < a.task_count(); ++t) {
+      auto ra = a.stream(c, t), rb = b.stream(c, t);
+      ASSERT_EQ(rb->frame_count(), kSteps) << "camera " << c << " task " << t;  // nothing duplicated
+      for (int f = 0; f < kSteps; ++f, ++frames)
+        ASSERT_EQ(ra->read_rgba(f).pixels, rb->read_rgba(f).pixels) << "camera " << c << " task " << t << " frame " << f;
+    }
+  EXPECT_EQ(frames, 4 * 3 * kSteps);
+  fs::remove_all(base);
+}
+
+TEST(InsituResume, RefusesAnotherConfigurationNamingWhatDiffers) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_cfg_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    const auto f = field(0);
+    s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }  // destroyed without finalize: interrupted
+  auto refusal = [&](insitu::SessionConfig c, const render::GridGeometry& g) -> std::string {
+    try {
+      insitu::Session s(c, g, insitu::LocalBlock::whole(g));
+      return "";
+    } catch (const Error& e) {
+      return e.what();
+    }
+  };
+  insitu::SessionConfig rig = config(dir, insitu::OutputMode::resume);
+  rig.rig = "fibonacci:5";
+  EXPECT_NE(refusal(rig, grid()).find("the rig ([rig]) differs"), std::string::npos) << refusal(rig, grid());
+  insitu::SessionConfig task = config(dir, insitu::OutputMode::resume);
+  task.tasks[1].isovalues = {0.2, 0.6};
+  EXPECT_NE(refusal(task, grid()).find("task 2 (\"iso 0.5\""), std::string::npos) << refusal(task, grid());
+  render::GridGeometry other = grid();
+  other.dims[0] = 22;
+  EXPECT_NE(refusal(config(dir, insitu::OutputMode::resume), other).find("the grid"), std::string::npos);
+  insitu::SessionConfig image = config(dir, insitu::OutputMode::resume);
+  image.width = 34;
+  EXPECT_NE(refusal(image, grid()).find("image size"), std::string::npos) << refusal(image, grid());
+  // The refusals left the database as it was; the same configuration resumes it.
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+    EXPECT_EQ(s.snapshots(), 1);
+    EXPECT_FALSE(s.due(0, 0.0));  // already in the database
+    EXPECT_TRUE(s.due(1, 0.2));
+    s.finalize();
+  }
+  EXPECT_EQ(store::Database::open(dir).frame_count(), 1);
+  fs::remove_all(dir);
+}
+
+TEST(InsituResume, NothingToResumeStartsANewDatabase) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_new_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+    EXPECT_EQ(s.snapshots(), 0);
+    const auto f = field(0);
+    EXPECT_TRUE(s.process(0, 0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
+    s.finalize();
+  }
+  EXPECT_EQ(store::Database::open(dir).frame_count(), 1);
+  fs::remove_all(dir);
+}
+
+}  // namespace
