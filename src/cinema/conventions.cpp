@@ -61,6 +61,7 @@ void recorded_cinema_python(const nlohmann::json& meta, int times, CameraModel& 
   m.center = a0;
   m.distance = norm(e0 - a0);
   if (!(m.distance > 0)) throw Error("info.json metadata: camera_eye equals camera_at; no distance to turn at");
+  if (!(m.distance < 1e100 && norm(a0) < 1e100)) throw Error("info.json metadata: camera_eye/camera_at out of range");
   // pv_introspect.explore: the rotation axis is the world axis closest to the recorded view up.
   int best = 0;
   for (int k = 1; k < 3; ++k)
