@@ -1,4 +1,4 @@
-// See cinema_view_test.sh. Arguments: SITE_DIR CHROMIUM NODE_MODULES DATABASE IMAGES [SCREENSHOT].
+// See cinema_view_test.sh (and Cinema:Explorer, the other viewer of the package, shows the images). Arguments: SITE_DIR CHROMIUM NODE_MODULES DATABASE IMAGES [SCREENSHOT].
 import { createRequire } from "node:module";
 import assert from "node:assert/strict";
 import fs from "node:fs";
@@ -112,6 +112,32 @@ try {
 
   if (screenshot) await page.screenshot({ path: screenshot });
   await check("no page errors", async () => assert.deepEqual(errors, []));
+
+  // Cinema:Explorer (same package) reads the same data.csv: its image spread shows the database's
+  // images. It loads vtk.js from unpkg.com for 3D artefacts, which Panoptes does not write: refused here.
+  await check("Cinema:Explorer shows the images", async () => {
+    const ex = await browser.newPage();
+    const local = { "https://d3js.org/d3.v5.min.js": "cinema/lib/d3.v5.min.js",
+                    "https://cinemascience.github.io/release/CinemaComponents.v2.7.1.min.js": "cinema/lib/CinemaComponents.v2.7.1.min.js",
+                    "https://cinemascience.github.io/release/CinemaComponents.v2.7.1.min.css": "cinema/lib/CinemaComponents.v2.7.1.min.css" };
+    await ex.setRequestInterception(true);
+    ex.on("request", (r) => {
+      const u = r.url();
+      if (u.startsWith(base)) return r.continue();
+      if (local[u]) return r.respond({ status: 200, contentType: u.endsWith(".css") ? "text/css" : "text/javascript",
+                                       body: fs.readFileSync(path.join(siteDir, local[u])) });
+      return r.abort();
+    });
+    await ex.setViewport({ width: 1200, height: 800 });
+    await ex.goto(`${base}cinema_explorer.html?databases=${database}`);
+    await ex.waitForFunction((db) => [...document.querySelectorAll("img")].filter(
+      (i) => i.getAttribute("src") && i.getAttribute("src").includes(db + "/image/") && i.complete && i.naturalWidth > 1).length >= 1,
+      { timeout: 20000 }, database);
+    const n = await ex.evaluate((db) => [...document.querySelectorAll("img")].filter((i) => (i.getAttribute("src") || "").includes(db + "/image/")).length, database);
+    assert.ok(await ex.evaluate(() => /36 out of 36 results selected/.test(document.body.innerText)), "explorer did not select all 36 rows");
+    console.log(`     explorer shows ${n} images on its first page`);
+    if (screenshot) await ex.screenshot({ path: screenshot.replace(/\.png$/, "-explorer.png") });
+  });
 } finally {
   await browser.close();
   server.close();
