@@ -96,9 +96,8 @@ void parse_spec_d(std::string_view text, CinemaTable& t) {
 }
 
 void parse_spec_a(std::string_view text, CinemaTable& t, std::int64_t max_rows) {
-  store::JsonLimits limits;
-  limits.max_depth = 32;
-  limits.max_string = kMaxField * 4;  // name_pattern, metadata strings; parameter values checked below
+  store::JsonLimits limits;  // strings as the manifest's (metadata may hold a long pipeline description)
+  limits.max_depth = 32;      // names, values and the pattern are checked against kMaxField below
   t.info = store::parse_bounded_json(text, t.source, limits, "Cinema info.json");
   const nlohmann::json& j = *t.info;
   if (!j.is_object() || !j.contains("name_pattern") || !j["name_pattern"].is_string())
