@@ -240,6 +240,29 @@ int main(int argc, char** argv) {
 
   write(out / "toml_config" / "run.toml", kRunConfig);
   write(out / "toml_config" / "seismic.toml", kSeismicConfig);
+
+  // Cinema tables as ParaView 5.11 extracts, Ascent and Panoptes' export write them (src/cinema/fixtures).
+  write(out / "cinema_csv" / "paraview_extracts.csv",
+        "phi,producer,theta,time,FILE_png\n000.00,iso150,000.00,0,iso150_000000p=000.00t=000.00.png\n"
+        "000.00,iso150,120.00,0,iso150_000000p=000.00t=120.00.png\n090.00,iso200,240.00,1,iso200_000001p=090.00t=240.00.png\n");
+  write(out / "cinema_csv" / "ascent.csv", "phi,theta,time,FILE\n-180.0,0.0,0.0,0.0/-180.0_0.0_contour.png\n"
+                                           "-90.0,60.0,1.0,1.0/-90.0_60.0_contour.png\n");
+  write(out / "cinema_csv" / "export.csv", "time,phi,theta,shell,task,task_name,FILE\r\n0,-180,30,0,0,iso 0.5,image/c0/t0_f0.png\r\n"
+                                           "0.1,90,-30,1,1,\"a, \"\"b\"\"\",image/c1/t1_f1.png\r\n");
+  // Spec A info.json as cinema_python and Ascent write it, and the older parameter_list form.
+  write(out / "cinema_spec_a" / "cinema_python.json",
+        R"({"arguments": {"Contour1": {"default": 150.0, "role": "control", "type": "hidden", "values": [150.0, 175.0]},)"
+        R"( "phi": {"type": "range", "values": [0, 90]}, "theta": {"type": "range", "values": [-60, 0, 60]},)"
+        R"( "time": {"type": "range", "values": ["0", "1"]}}, "name_pattern": "{time}/{phi}/{theta}/{Contour1}.png",)"
+        R"( "metadata": {"camera_model": "phi-theta", "camera_eye": [[0, -80, 0], [0, -80, 0]], "camera_at": [[0, 0, 0], [0, 0, 0]],)"
+        R"( "camera_up": [[0, 0, 1], [0, 0, 1]], "camera_angle": [30.0, 30.0], "type": "parametric-image-stack", "version": "0.0"}})");
+  write(out / "cinema_spec_a" / "ascent.json",
+        R"({"type": "simple", "version": "1.1", "metadata": {"type": "parametric-image-stack"},)"
+        R"( "name_pattern": "{time}/{phi}_{theta}_contour.png", "arguments": {"time": {"values": ["0.0", "1.0"]},)"
+        R"( "phi": {"values": ["-180.0", "-90.0", "0.0", "90.0"]}, "theta": {"values": ["0.0", "60.0", "120.0"]}}})");
+  write(out / "cinema_spec_a" / "parameter_list.json",
+        R"({"name_pattern": "{time}/{phi}_{theta}_{var}.png", "parameter_list": {"time": {"values": ["0", "100"]},)"
+        R"( "phi": {"values": [0, 90]}, "theta": {"values": [-60, 0]}, "var": {"type": "option", "values": ["p", "v"]}}})");
   std::printf("seeds written to %s\n", out.c_str());
   return 0;
 }

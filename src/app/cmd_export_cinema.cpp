@@ -41,9 +41,12 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto args = std::make_shared<Args>();
   auto* sub = root.add_subcommand(
       "export-cinema",
-      "Export a movie database as a Cinema Spec D image database (data.csv with columns time, camera, phi, "
-      "theta, task, one per parameter axis, FILE; one image per camera, task and frame), for Cinema viewers "
-      "and pycinema. phi = longitude (azimuth), theta = latitude (elevation) of the camera, in degrees");
+      "Export a movie database as a Cinema Spec D image database for Cinema viewers (Cinema:View, Cinema:Explorer) "
+      "and pycinema: data.csv, one image per camera, task and frame, and panoptes-cinema.json (cameras, shells, graph, "
+      "tasks: import-cinema restores them). data.csv's numeric columns identify each image once, so every image is "
+      "reachable from the viewers' sliders: time; phi (longitude) and theta (latitude) in degrees, and shell, when "
+      "the cameras form that grid, else camera; the parameter axes when the tasks form their grid, else task (id). "
+      "A failed export leaves nothing behind");
   sub->add_option("DB", args->db, "Movie database directory")->required();
   sub->add_option("OUT", args->out, "Cinema database directory to write (conventionally NAME.cdb)")->required();
   sub->add_option("--frames", args->frames,

@@ -14,7 +14,7 @@
 namespace {
 
 struct Args {
-  std::string in, out, group_by, title;
+  std::string in, out, group_by, title, angles, azimuth_zero;
   int crf = -1, threads = 0;
   bool overwrite = false;
 };
@@ -26,7 +26,10 @@ void run(const Args& a) {
   for (std::string item; std::getline(list, item, ',');)
     if (!item.empty()) o.group_by.push_back(item);
   o.title = a.title;
-  o.command_line = "panoptes import-cinema " + a.in + " " + a.out + (a.group_by.empty() ? "" : " --group-by " + a.group_by);
+  o.angles = a.angles;
+  o.azimuth_zero = a.azimuth_zero;
+  o.command_line = "panoptes import-cinema " + a.in + " " + a.out + (a.group_by.empty() ? "" : " --group-by " + a.group_by) +
+                   (a.angles.empty() ? "" : " --angles " + a.angles) + (a.azimuth_zero.empty() ? "" : " --azimuth-zero " + a.azimuth_zero);
   o.overwrite = a.overwrite;
   o.threads = a.threads;
   if (a.crf >= 0) o.video.crf = a.crf;
@@ -40,6 +43,7 @@ void run(const Args& a) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("wrote %s from Cinema Spec %s: %d cameras x %d tasks = %d movies, %d frames each, in %.2f s\n",
               a.out.c_str(), r.spec.c_str(), r.cameras, r.tasks, r.cameras * r.tasks, r.frames, s);
+  std::printf("cameras: %s\n", r.producer.c_str());
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
@@ -47,15 +51,26 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto* sub = root.add_subcommand(
       "import-cinema",
       "Turn a Cinema image database (Spec D data.csv, or Spec A info.json + name_pattern as ParaView and Ascent "
-      "write) into a movie database: the time column gives the frames, phi (azimuth) and theta (elevation) in "
-      "degrees the camera directions (navigation graph computed), the other columns the tasks; numeric ones "
-      "become parameter axes. Then `panoptes play OUT` switches between them instantly");
+      "write) into a movie database: the time column gives the frames, phi and theta the cameras (built as the "
+      "producer built them: ParaView extractors, cinema_python and Ascent are recognised; views ParaView wrote upside "
+      "down are turned upright; navigation graph computed), the other columns the tasks; numeric ones become "
+      "parameter axes. A database exported by Panoptes gets its cameras, graph and tasks back exactly. Then "
+      "`panoptes play OUT` switches between them instantly");
   sub->add_option("IN", args->in, "Cinema database directory (NAME.cdb)")->required();
   sub->add_option("OUT", args->out, "Movie database directory to write")->required();
   sub->add_option("--group-by", args->group_by,
                   "Comma-separated columns whose value combinations make the tasks (default: every column but time, "
                   "camera, phi, theta and FILE)");
   sub->add_option("--title", args->title, "Title of the database");
+  sub->add_option("--angles", args->angles,
+                  "How phi/theta were made, when the producer is not recognised: paraview (5.11 image extractor, "
+                  "Phi-Theta), cinema-python, ascent (theta polar from +z) or elevation (theta -90..90 above the x-y "
+                  "plane, phi about +z)")
+      ->check(CLI::IsMember({"paraview", "cinema-python", "ascent", "elevation"}));
+  sub->add_option("--azimuth-zero", args->azimuth_zero,
+                  "With --angles elevation: where phi = 0 lies, +x (phi counter-clockwise seen from +z, default) or -x "
+                  "(clockwise)")
+      ->check(CLI::IsMember({"+x", "-x"}));
   sub->add_option("--crf", args->crf, "x264 quality 0..51 (default: the video default, 20)");
   sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in OUT");

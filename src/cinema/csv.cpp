@@ -2,6 +2,9 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <algorithm>
 #include <set>
 
 #include "core/error.hpp"
@@ -109,6 +112,22 @@ std::string format_float(double value) {
   std::string s(buf, r.ptr);
   if (std::isfinite(value) && s.find_first_of(".eE") == std::string::npos) s += ".0";
   return s;
+}
+
+std::string format_value(double v) {
+  if (!std::isfinite(v)) return format_float(v);
+  if (std::abs(v) < 1e-9) return "0";
+  char buf[64];
+  const float f = float(v);
+  if (std::isfinite(f) && double(f) == v) {
+    const auto r = std::to_chars(buf, buf + sizeof buf, f);
+    return std::string(buf, r.ptr);
+  }
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  const double snapped = std::strtod(buf, nullptr);
+  if (std::abs(snapped - v) <= 1e-13 * std::max(1.0, std::abs(v))) v = snapped;
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 
 bool parse_number(std::string_view t, double& value) {

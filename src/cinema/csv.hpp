@@ -29,6 +29,13 @@ std::string csv_field(std::string_view value);
 /// round-trips, with ".0" appended when it would look like an integer ("2" -> "2.0"; "1e+20" stays).
 std::string format_float(double value);
 
+/// A number as Cinema viewers should show it: the shortest decimal that reads back to the same value,
+/// after removing the noise of single-precision storage and of trigonometry: a value that is a float
+/// prints as that float's shortest decimal ("0.3", not "0.30000001192092896"), one within 1e-13 (relative) of a
+/// 12-significant-digit decimal prints as that decimal, |v| < 1e-9 prints as "0". Integers print
+/// without a decimal point ("2").
+std::string format_value(double value);
+
 /// Parses a whole field as a finite double (surrounding spaces allowed); false if it is not one.
 bool parse_number(std::string_view text, double& value);
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/error.hpp"
 
 using namespace panoptes;
@@ -60,3 +62,18 @@ TEST(Csv, FloatsAlwaysHaveADecimalPointAndRoundTrip) {
   EXPECT_FALSE(parse_number("", x));
   EXPECT_FALSE(parse_number("nan", x));
 }
+
+// Numbers as the export prints them for Cinema viewers: no float or trigonometry noise, exact otherwise.
+TEST(Csv, ValuesPrintAsShortestExactDecimals) {
+  EXPECT_EQ(format_value(double(0.3f)), "0.3");  // 0.30000001192092896 stored from a float
+  EXPECT_EQ(format_value(3.5e-15), "0");         // theta of a camera on the equator, from asin
+  EXPECT_EQ(format_value(std::asin(std::sin(30 * M_PI / 180)) * 180 / M_PI), "30");
+  EXPECT_EQ(format_value(-180), "-180");
+  EXPECT_EQ(format_value(0.1), "0.1");
+  for (double v : {1.0 / 3, -45.000000001, 123456.789, 1e-7, 2.5e30}) {
+    double back = 0;
+    ASSERT_TRUE(parse_number(format_value(v), back)) << v;
+    EXPECT_EQ(back, v) << format_value(v);  // values that are neither stay exact
+  }
+}
+

@@ -24,11 +24,19 @@ struct ExportReport {
   std::int64_t bytes = 0;
 };
 
-/// Writes OUT.cdb: data.csv (columns time, camera, phi, theta, task, one per parameter axis, FILE)
-/// and image/c{camera}/t{task}/f{frame}.{png|jpg}, one image per (camera, task, frame), decoded as the
-/// player shows it. Throws FileError if `db_dir` is not a database, `out` exists and holds something
-/// else than a Cinema database (or one without overwrite), or writing fails; Error for a frame out
-/// of range or an unknown format. progress(done, total) in images, from one thread.
+/// Writes OUT.cdb: data.csv, image/c{camera}/t{task}_f{frame}.{png|jpg} (one image per camera, task
+/// and frame, decoded as the player shows it) and panoptes-cinema.json (the manifest: cameras, shells,
+/// graph, rig, tasks, axes, so import-cinema restores them exactly). data.csv's numeric columns
+/// identify each image exactly once, so Cinema viewers (Cinema:View, Cinema:Explorer: one slider per
+/// numeric column) reach every image: time; phi and theta (and shell with several shells) when the
+/// cameras form that grid, else camera; the parameter axes when the tasks form their grid, else task
+/// (the task id; task_name beside it when no name looks like a number). Numbers are the shortest
+/// exact decimals (format_value). Every movie is checked before anything is created, and the
+/// database is written into a temporary directory beside OUT and moved into place at the end: a
+/// failed export leaves nothing behind. Throws FileError if `db_dir` is not a database, a movie is
+/// missing, `out` exists and holds something else than a Cinema database (or one without
+/// overwrite), or writing fails; Error for a frame out of range or an unknown format.
+/// progress(done, total) in images, from one thread.
 ExportReport export_cinema(const std::filesystem::path& db_dir, const std::filesystem::path& out,
                            const ExportOptions& options = {},
                            const std::function<void(std::int64_t, std::int64_t)>& progress = {});

@@ -7,15 +7,16 @@
 #include <map>
 #include <mutex>
 #include <set>
-#include <thread>
+#include <unordered_map>
 
 #include "camera/navigation.hpp"
 #include "camera/rig.hpp"
 #include "cinema/cinema_database.hpp"
+#include "cinema/conventions.hpp"
 #include "cinema/csv.hpp"
+#include "cinema/image_file.hpp"
 #include "cinema/stream_workers.hpp"
 #include "core/error.hpp"
-#include "core/png.hpp"
 #include "store/database.hpp"
 
 namespace panoptes::cinema {
@@ -42,15 +43,52 @@ double number_at(const CinemaTable& t, std::size_t row, int col, const char* wha
   return v;
 }
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kRad = 180.0 / 3.14159265358979323846;
+
+// Latitude and longitude of a direction in the producer's sky frame (its pole as "north"), a proper
+// rotation of the world axes, so the mini-map keeps the handedness of a native database.
+void sky_angles(const Vec3& d, const Vec3& pole, double& lat, double& lon) {
+  Vec3 e{1, 0, 0}, n{0, 1, 0};
+  if (pole.y != 0) e = {0, 0, 1}, n = {1, 0, 0};
+  if (pole.x != 0) e = {0, 1, 0}, n = {0, 0, 1};
+  lat = std::asin(std::clamp(dot(d, pole), -1.0, 1.0)) * kRad;
+  lon = std::atan2(dot(d, n), dot(d, e)) * kRad;
+  if (std::abs(lat) > 90 - 1e-9) lon = 0;
+}
+
+// The cameras, tasks and graph Panoptes' own export wrote beside data.csv; rows are matched to them
+// by the camera column or by phi/theta/shell, and by the task column or the axis columns.
+struct Sidecar {
+  store::Manifest m;
+  bool present = false;
+};
+
+Sidecar read_sidecar(const CinemaTable& t) {
+  Sidecar s;
+  if (!t.panoptes) return s;
+  const std::string source = (t.dir / "panoptes-cinema.json").string();
+  const nlohmann::json& j = *t.panoptes;
+  if (!j.is_object() || !j.contains("manifest")) throw FileError(source, "no \"manifest\" object; not written by panoptes export-cinema");
+  try {
+    s.m = store::manifest_from_json(j["manifest"], source);
+  } catch (const FileError&) {
+    throw;
+  } catch (const Error& e) {
+    throw FileError(source, e.what());
+  }
+  s.present = true;
+  return s;
+}
 
 }  // namespace
 
 ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   const CinemaTable t = read_cinema_database(cdb);
+  const Sidecar side = read_sidecar(t);
   const std::size_t rows = t.files.size();
   const int c_time = find_column(t, "time"), c_phi = find_column(t, "phi"), c_theta = find_column(t, "theta"),
-            c_camera = find_column(t, "camera");
+            c_camera = find_column(t, "camera"), c_shell = side.present ? find_column(t, "shell") : -1;
+  auto is_camera_col = [&](int c) { return c == c_time || c == c_phi || c == c_theta || c == c_camera || c == c_shell; };
 
   // ---- frames: the distinct times, ascending --------------------------------------------------
   std::vector<double> row_time(rows, 0.0);
@@ -63,78 +101,113 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   for (std::size_t r = 0; r < rows; ++r)
     row_frame[r] = int(std::lower_bound(times.begin(), times.end(), row_time[r]) - times.begin());
 
-  // ---- cameras: by the camera column, else by distinct (phi, theta) --------------------------------
+  // ---- the phi/theta convention ---------------------------------------------------------------------
+  std::vector<std::pair<double, double>> angles(rows, {0.0, 0.0});
+  std::vector<double> thetas;
+  for (std::size_t r = 0; r < rows; ++r) {
+    angles[r].first = c_phi >= 0 ? number_at(t, r, c_phi, "phi") : 0.0;
+    angles[r].second = c_theta >= 0 ? number_at(t, r, c_theta, "theta") : 0.0;
+    if (c_theta >= 0) thetas.push_back(angles[r].second);
+  }
+  std::sort(thetas.begin(), thetas.end());
+  thetas.erase(std::unique(thetas.begin(), thetas.end()), thetas.end());
+  CameraModel model;
+  if (!side.present) {
+    ProducerEvidence ev;
+    ev.spec = t.spec;
+    ev.columns = t.columns;
+    ev.file_column = t.file_column;
+    ev.info = t.info;
+    ev.has_info_js = t.has_info_js;
+    ev.thetas = thetas;
+    ev.time_count = int(times.size());
+    try {
+      model = detect_producer(ev, o.angles, o.azimuth_zero);
+    } catch (const FileError&) {
+      throw;
+    } catch (const Error& e) {
+      throw FileError(t.source, e.what());
+    }
+  }
+
+  // ---- cameras: by the camera column, else by distinct (phi, theta[, shell]) ---------------------
   struct Cam {
     double phi = 0, theta = 0;
     std::size_t first_row = 0;
   };
   std::vector<Cam> cams;
   std::vector<int> row_camera(rows);
-  {
-    std::map<std::pair<double, double>, int> by_angles;  // (phi, theta) -> provisional id
-    std::map<long long, int> by_id;
-    std::vector<std::pair<double, double>> angles(rows);
+  if (side.present) {
+    const int n = side.m.camera_count();
+    // The export prints each label as format_value: match on that text.
+    std::map<std::tuple<std::string, std::string, int>, int> by_angles;
+    for (const auto& c : side.m.cameras)
+      by_angles.emplace(std::tuple{format_value(c.labels.lon_deg), format_value(c.labels.lat_deg), c.labels.shell}, c.id);
     for (std::size_t r = 0; r < rows; ++r) {
-      const double phi = c_phi >= 0 ? number_at(t, r, c_phi, "phi") : 0.0;
-      const double theta = c_theta >= 0 ? number_at(t, r, c_theta, "theta") : 0.0;
-      if (theta < -90 || theta > 90)
-        throw FileError(t.where[r], "theta " + format_float(theta) + " is not an elevation in -90..90 degrees");
-      angles[r] = {phi, theta};
-    }
-    if (c_camera >= 0) {
-      std::set<long long> ids;
-      for (std::size_t r = 0; r < rows; ++r) {
+      int id = -1;
+      if (c_camera >= 0) {
         const double v = number_at(t, r, c_camera, "camera");
-        if (v != std::floor(v) || v < 0) throw FileError(t.where[r], "camera \"" + t.values[r][std::size_t(c_camera)] + "\" is not a camera id (integer >= 0)");
-        ids.insert((long long)v);
+        if (v == std::floor(v) && v >= 0 && v < n) id = int(v);
+      } else {
+        const int shell = c_shell >= 0 ? int(number_at(t, r, c_shell, "shell")) : 0;
+        const auto it = by_angles.find({format_value(angles[r].first), format_value(angles[r].second), shell});
+        if (it != by_angles.end()) id = it->second;
       }
-      for (long long id : ids) {
-        by_id[id] = int(cams.size());
-        cams.push_back({});
-      }
-      std::vector<bool> seen(cams.size(), false);
-      for (std::size_t r = 0; r < rows; ++r) {
-        const int c = by_id[(long long)number_at(t, r, c_camera, "camera")];
-        row_camera[r] = c;
-        if (!seen[std::size_t(c)]) {
-          cams[std::size_t(c)] = {angles[r].first, angles[r].second, r};
-          seen[std::size_t(c)] = true;
-        } else if (std::abs(cams[std::size_t(c)].phi - angles[r].first) > 1e-9 ||
-                   std::abs(cams[std::size_t(c)].theta - angles[r].second) > 1e-9) {
-          throw FileError(t.where[r], "camera " + t.values[r][std::size_t(c_camera)] + " has phi/theta " +
-                                          format_float(angles[r].first) + "/" + format_float(angles[r].second) + " but " +
-                                          t.where[cams[std::size_t(c)].first_row] + " gave it " +
-                                          format_float(cams[std::size_t(c)].phi) + "/" +
-                                          format_float(cams[std::size_t(c)].theta));
-        }
-      }
-    } else {
-      // Numbered like Panoptes' lat-lon rigs: from the north (theta = +90) southwards, each ring by phi.
-      for (std::size_t r = 0; r < rows; ++r) by_angles.emplace(std::pair{-angles[r].second, angles[r].first}, 0);
-      for (auto& [key, id] : by_angles) {
-        id = int(cams.size());
-        cams.push_back({key.second, -key.first, 0});
-      }
-      for (std::size_t r = 0; r < rows; ++r) row_camera[r] = by_angles[{-angles[r].second, angles[r].first}];
+      if (id < 0) throw FileError(t.where[r], "no camera of panoptes-cinema.json matches this row's camera columns");
+      row_camera[r] = id;
     }
+    for (const auto& c : side.m.cameras) cams.push_back({c.labels.lon_deg, c.labels.lat_deg, 0});
+  } else if (c_camera >= 0) {
+    std::map<long long, int> by_id;
+    for (std::size_t r = 0; r < rows; ++r) {
+      const double v = number_at(t, r, c_camera, "camera");
+      if (v != std::floor(v) || v < 0 || v > 1e15)
+        throw FileError(t.where[r], "camera \"" + t.values[r][std::size_t(c_camera)] + "\" is not a camera id (integer >= 0)");
+      by_id.emplace((long long)v, 0);
+    }
+    for (auto& [id, index] : by_id) index = int(cams.size()), cams.push_back({});
+    std::vector<bool> seen(cams.size(), false);
+    for (std::size_t r = 0; r < rows; ++r) {
+      const int c = by_id[(long long)number_at(t, r, c_camera, "camera")];
+      row_camera[r] = c;
+      if (!seen[std::size_t(c)]) {
+        cams[std::size_t(c)] = {angles[r].first, angles[r].second, r};
+        seen[std::size_t(c)] = true;
+      } else if (std::abs(cams[std::size_t(c)].phi - angles[r].first) > 1e-9 ||
+                 std::abs(cams[std::size_t(c)].theta - angles[r].second) > 1e-9) {
+        throw FileError(t.where[r], "camera " + t.values[r][std::size_t(c_camera)] + " has phi/theta " +
+                                        format_float(angles[r].first) + "/" + format_float(angles[r].second) + " but " +
+                                        t.where[cams[std::size_t(c)].first_row] + " gave it " +
+                                        format_float(cams[std::size_t(c)].phi) + "/" + format_float(cams[std::size_t(c)].theta));
+      }
+    }
+  } else {
+    // Numbered like Panoptes' lat-lon rigs: by descending theta, each ring by phi.
+    std::map<std::pair<double, double>, int> by_angles;
+    for (std::size_t r = 0; r < rows; ++r) by_angles.emplace(std::pair{-angles[r].second, angles[r].first}, 0);
+    for (auto& [key, id] : by_angles) {
+      id = int(cams.size());
+      cams.push_back({key.second, -key.first, 0});
+    }
+    for (std::size_t r = 0; r < rows; ++r) row_camera[r] = by_angles[{-angles[r].second, angles[r].first}];
   }
 
   // ---- tasks: distinct combinations of the group-by columns ----------------------------------------
   std::vector<int> group;
   if (o.group_by.empty()) {
     for (std::size_t c = 0; c < t.columns.size(); ++c)
-      if (int(c) != c_time && int(c) != c_phi && int(c) != c_theta && int(c) != c_camera) group.push_back(int(c));
+      if (!is_camera_col(int(c))) group.push_back(int(c));
   } else {
     for (const auto& name : o.group_by) {
       const auto it = std::find(t.columns.begin(), t.columns.end(), name);
       if (it == t.columns.end()) {
         std::string list;
         for (const auto& c : t.columns) list += (list.empty() ? "" : ", ") + c;
+        if (list.size() > 1000) list = list.substr(0, 1000) + "...";
         throw FileError(t.source, "--group-by column \"" + name + "\" does not exist; columns: " + list);
       }
       const int c = int(it - t.columns.begin());
-      if (c == c_time || c == c_phi || c == c_theta || c == c_camera)
-        throw Error("--group-by: column \"" + name + "\" already maps to time or cameras; it cannot group tasks");
+      if (is_camera_col(c)) throw Error("--group-by: column \"" + name + "\" already maps to time or cameras; it cannot group tasks");
       group.push_back(c);
     }
   }
@@ -155,14 +228,15 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   std::vector<int> row_task(rows);
   for (std::size_t r = 0; r < rows; ++r) {
     std::vector<std::string> key;
+    key.reserve(group.size());
     for (std::size_t g = 0; g < group.size(); ++g) {
       std::string v = t.values[r][std::size_t(group[g])];
       double x;
       if (numeric[g] && parse_number(v, x)) v = format_float(x);  // "0.5" and "0.50" are one value
-      key.push_back(v);
+      key.push_back(std::move(v));
     }
-    const auto [it, inserted] = task_of.emplace(key, int(task_keys.size()));
-    if (inserted) task_keys.push_back(key);
+    const auto [it, inserted] = task_of.emplace(std::move(key), int(task_keys.size()));
+    if (inserted) task_keys.push_back(it->first);
     row_task[r] = it->second;
   }
 
@@ -180,6 +254,7 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   m.video = o.video;
 
   // Axes: every numeric group column, its distinct values ascending.
+  std::vector<int> axis_of_group(group.size(), -1);
   for (std::size_t g = 0; g < group.size(); ++g) {
     if (!numeric[g]) continue;
     store::ParameterAxis a;
@@ -190,7 +265,8 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     }
     std::sort(a.values.begin(), a.values.end());
     a.values.erase(std::unique(a.values.begin(), a.values.end()), a.values.end());
-    m.axes.push_back(a);
+    axis_of_group[g] = int(m.axes.size());
+    m.axes.push_back(std::move(a));
   }
   const int name_col = [&] {
     for (std::size_t g = 0; g < group.size(); ++g)
@@ -207,16 +283,17 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     for (std::size_t g = 0; g < group.size(); ++g) {
       const std::string& col = t.columns[std::size_t(group[g])];
       if (key[g].empty()) continue;
-      if (int(g) != name_col) generic += (generic.empty() ? "" : " ") + col + "=" + key[g];
+      if (int(g) != name_col && generic.size() <= kMaxField) generic += (generic.empty() ? "" : " ") + col + "=" + key[g];
       double x;
       if (numeric[g] && parse_number(key[g], x)) {
         e.parameters[col] = x;
-        const auto& axis = *std::find_if(m.axes.begin(), m.axes.end(), [&](const auto& a) { return a.name == col; });
+        const auto& axis = m.axes[std::size_t(axis_of_group[g])];
         e.axes.push_back({col, int(std::lower_bound(axis.values.begin(), axis.values.end(), x) - axis.values.begin())});
       } else {
         e.parameters[col] = key[g];
       }
     }
+    if (generic.size() > kMaxField) generic = "task " + std::to_string(k);  // too many columns to name it by
     e.name = name_col >= 0 && !key[std::size_t(name_col)].empty() ? key[std::size_t(name_col)] : generic;
     if (e.name.empty()) e.name = "image";
     if (!names.insert(e.name).second) {  // a "task" column that does not tell all tasks apart
@@ -226,79 +303,170 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     }
     m.tasks.push_back(std::move(e));
   }
+  if (side.present) {
+    // The export's task column holds the task id, or its axis columns the task's axis values; a
+    // table whose tasks are exactly the sidecar's keeps the sidecar's names, methods and parameters.
+    if (task_keys.size() != side.m.tasks.size())
+      throw FileError(t.source, std::to_string(task_keys.size()) + " tasks in the table, " + std::to_string(side.m.tasks.size()) +
+                                    " in panoptes-cinema.json; the files do not belong together");
+    const int c_task = [&] {
+      for (std::size_t g = 0; g < group.size(); ++g)
+        if (t.columns[std::size_t(group[g])] == "task" && numeric[g]) return int(g);
+      return -1;
+    }();
+    std::vector<int> remap(task_keys.size(), -1);
+    for (std::size_t k = 0; k < task_keys.size(); ++k) {
+      int id = -1;
+      double x;
+      if (c_task >= 0 && parse_number(task_keys[k][std::size_t(c_task)], x) && x == std::floor(x) && x >= 0 &&
+          x < double(side.m.tasks.size())) {
+        id = int(x);
+      } else if (c_task < 0) {
+        for (const auto& st : side.m.tasks) {
+          bool all = true;
+          for (std::size_t g = 0; g < group.size() && all; ++g) {
+            const std::string& col = t.columns[std::size_t(group[g])];
+            if (col == "task_name") continue;  // the names are the sidecar's
+            const auto pos = std::find_if(st.axes.begin(), st.axes.end(), [&](const auto& p) { return p.axis == col; });
+            double v;
+            const auto ax = std::find_if(side.m.axes.begin(), side.m.axes.end(), [&](const auto& a) { return a.name == col; });
+            all = pos != st.axes.end() && ax != side.m.axes.end() && parse_number(task_keys[k][g], v) &&
+                  v == ax->values[std::size_t(pos->index)];
+          }
+          if (all) id = st.id;
+        }
+      }
+      if (id < 0) throw FileError(t.source, "task " + std::to_string(k) + " of the table matches no task of panoptes-cinema.json");
+      remap[k] = id;
+    }
+    for (std::size_t r = 0; r < rows; ++r) row_task[r] = remap[std::size_t(row_task[r])];
+    m.tasks = side.m.tasks;
+    m.axes = side.m.axes;
+    task_keys.assign(m.tasks.size(), {});
+  }
 
-  // ---- every (camera, task, frame) exactly once --------------------------------------------------
+  // ---- every (camera, task, frame) exactly once; memory linear in the rows -------------------------
   const std::size_t nc = cams.size(), nt = task_keys.size(), nf = times.size();
-  std::vector<std::int64_t> row_of(nc * nt * nf, -1);
+  std::unordered_map<std::uint64_t, std::int64_t> row_of;
+  row_of.reserve(rows);
+  auto view_key = [&](std::size_t c, std::size_t k, std::size_t f) { return (std::uint64_t(c) * nt + k) * nf + f; };
   for (std::size_t r = 0; r < rows; ++r) {
-    const std::size_t i = (std::size_t(row_camera[r]) * nt + std::size_t(row_task[r])) * nf + std::size_t(row_frame[r]);
-    if (row_of[i] >= 0) {
+    const auto [it, inserted] = row_of.emplace(view_key(std::size_t(row_camera[r]), std::size_t(row_task[r]), std::size_t(row_frame[r])), std::int64_t(r));
+    if (!inserted) {
+      const std::size_t prev = std::size_t(it->second);
       std::string differ;
-      for (std::size_t c = 0; c < t.columns.size(); ++c)
-        if (t.values[r][c] != t.values[std::size_t(row_of[i])][c]) differ += (differ.empty() ? "" : ", ") + t.columns[c];
-      throw FileError(t.where[r], "same camera, task and time as " + t.where[std::size_t(row_of[i])] +
+      for (std::size_t c = 0; c < t.columns.size() && differ.size() < 1000; ++c)
+        if (t.values[r][c] != t.values[prev][c]) differ += (differ.empty() ? "" : ", ") + t.columns[c];
+      throw FileError(t.where[r], "same camera, task and time as " + t.where[prev] +
                                       (differ.empty() ? std::string(": two images for one view")
                                                       : "; they differ in " + differ + ": add it to --group-by"));
     }
-    row_of[i] = std::int64_t(r);
   }
   auto describe = [&](std::size_t c, std::size_t k, std::size_t f) {
     return "camera phi=" + format_float(cams[c].phi) + " theta=" + format_float(cams[c].theta) + ", task \"" +
            m.tasks[k].name + "\", time " + format_float(times[f]);
   };
-  plan.files.resize(row_of.size());
+  // rows distinct views exist; fewer than cameras x tasks x times means one is missing: find it within
+  // rows + 1 lookups (never walking the whole, possibly huge, product).
+  if (double(nc) * double(nt) * double(nf) != double(rows)) {
+    for (std::size_t c = 0; c < nc; ++c)
+      for (std::size_t k = 0; k < nt; ++k)
+        for (std::size_t f = 0; f < nf; ++f)
+          if (!row_of.count(view_key(c, k, f)))
+            throw FileError(t.source, "no image for " + describe(c, k, f) + "; every camera needs every task at every time");
+  }
+  plan.files.resize(rows);
   int width = 0, height = 0;
   std::size_t size_row = 0;
   for (std::size_t c = 0; c < nc; ++c)
     for (std::size_t k = 0; k < nt; ++k)
       for (std::size_t f = 0; f < nf; ++f) {
-        const std::int64_t r = row_of[(c * nt + k) * nf + f];
-        if (r < 0) throw FileError(t.source, "no image for " + describe(c, k, f) + "; every camera needs every task at every time");
-        const fs::path path = resolve_inside(t.dir, t.files[std::size_t(r)], t.where[std::size_t(r)]);
-        if (!fs::is_regular_file(path))
-          throw FileError(t.where[std::size_t(r)], "image \"" + t.files[std::size_t(r)] + "\" does not exist (" + path.string() + ")");
+        const std::size_t r = std::size_t(row_of.at(view_key(c, k, f)));
+        const fs::path path = resolve_inside(t.dir, t.files[r], t.where[r]);
+        if (!fs::exists(fs::symlink_status(path)))
+          throw FileError(t.where[r], "image \"" + t.files[r] + "\" does not exist (" + path.string() + ")");
         int w = 0, h = 0;
-        image_file_size(path.string(), w, h);
+        image_size(path, w, h);
         if (width == 0) {
-          width = w, height = h, size_row = std::size_t(r);
+          width = w, height = h, size_row = r;
         } else if (w != width || h != height) {
-          throw FileError(path.string(), "image is " + std::to_string(w) + "x" + std::to_string(h) + ", but " +
-                                             t.files[size_row] + " is " + std::to_string(width) + "x" +
-                                             std::to_string(height) + "; a Panoptes database has one image size");
+          throw FileError(path.string(), "image is " + std::to_string(w) + "x" + std::to_string(h) + ", but " + t.files[size_row] +
+                                             " is " + std::to_string(width) + "x" + std::to_string(height) +
+                                             "; a Panoptes database has one image size");
         }
         plan.files[(c * nt + k) * nf + f] = path;
       }
   m.image.width = width;
   m.image.height = height;
 
-  // ---- camera geometry: directions on a sphere around a unit box, graph computed -------------------
-  std::vector<camera::PatternPoint> pattern;
-  for (const Cam& c : cams) {
-    const double lat = c.theta * kDeg, lon = c.phi * kDeg;
-    pattern.push_back({{std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat)}, "cinema"});
+  // ---- camera geometry -----------------------------------------------------------------------------
+  plan.rotated.assign(nc, false);
+  if (side.present) {
+    m.cameras = side.m.cameras;
+    m.graph = side.m.graph;
+    m.rig = side.m.rig;
+    m.domain = side.m.domain;
+    plan.producer = "Panoptes export-cinema (cameras, graph and tasks from panoptes-cinema.json)";
+  } else {
+    camera::Rig rig;
+    rig.center = model.center;
+    rig.spec = "cinema";
+    std::size_t turned = 0;
+    for (std::size_t i = 0; i < nc; ++i) {
+      const ProducerCamera pc = producer_camera(model, cams[i].phi, cams[i].theta);
+      camera::RigCamera rc;
+      rc.position = pc.position;
+      rc.look_at = pc.look_at;
+      rc.up = pc.stored_up;
+      rc.fov_y_degrees = model.fov_y_deg;
+      rc.patch = "cinema";
+      sky_angles(normalize(pc.position - pc.look_at), model.pole, rc.latitude_deg, rc.longitude_deg);
+      rc.radius = model.distance;
+      rig.cameras.push_back(rc);
+      plan.rotated[i] = pc.rotated;
+      turned += pc.rotated;
+    }
+    const camera::NavigationGraph graph = camera::build_navigation_graph(rig);
+    for (std::size_t i = 0; i < nc; ++i) {
+      const camera::RigCamera& rc = rig.cameras[i];
+      store::CameraEntry e;
+      e.id = int(i);
+      e.position = rc.position;
+      e.look_at = rc.look_at;
+      e.up = rc.up;
+      e.fov_y_deg = rc.fov_y_degrees;
+      e.labels.patch = "cinema";
+      e.labels.lat_deg = rc.latitude_deg;
+      e.labels.lon_deg = rc.longitude_deg;
+      if (model.angles == Angles::elevation && !model.mirrored) {  // exactly the database's angles
+        e.labels.lat_deg = cams[i].theta;
+        e.labels.lon_deg = cams[i].phi;
+      }
+      e.labels.shell = 0;
+      e.labels.extra["cinema_phi"] = format_float(cams[i].phi);
+      e.labels.extra["cinema_theta"] = format_float(cams[i].theta);
+      if (plan.rotated[i]) e.labels.extra["cinema_turned"] = "180";  // the producer's picture was upside down
+      m.cameras.push_back(e);
+      const camera::Neighbours& n = graph.neighbours[i];
+      m.graph.neighbours.push_back({n.left, n.right, n.up, n.down, n.in, n.out});
+    }
+    m.rig.kind = "cinema";
+    m.rig.parameters = {{"spec", t.spec},
+                        {"cameras", nc},
+                        {"producer", model.producer},
+                        {"angles", to_string(model.angles)},
+                        {"evidence", model.evidence},
+                        {"center", {model.center.x, model.center.y, model.center.z}},
+                        {"distance", model.distance},
+                        {"pole", {model.pole.x, model.pole.y, model.pole.z}},
+                        {"recorded_camera", model.recorded},
+                        {"turned_180", turned}};
+    if (model.angles == Angles::elevation) m.rig.parameters["azimuth_zero"] = model.mirrored ? "-x" : "+x";
+    if (!model.recorded)
+      m.rig.parameters["note"] = "the database records no scene: cameras frame a unit box at the origin as the producer frames its scene";
+    plan.producer = model.producer + " (" + model.evidence + ")";
   }
-  camera::Rig rig = camera::place_on_shells(pattern, camera::Domain{{-0.5, -0.5, -0.5}, {1, 1, 1}}, {camera::kDefaultRadius});
-  rig.spec = "cinema";
-  const camera::NavigationGraph graph = camera::build_navigation_graph(rig);
-  for (std::size_t i = 0; i < nc; ++i) {
-    const camera::RigCamera& rc = rig.cameras[i];
-    store::CameraEntry e;
-    e.id = int(i);
-    e.position = rc.position;
-    e.look_at = rc.look_at;
-    e.up = rc.up;
-    e.fov_y_deg = rc.fov_y_degrees;
-    e.labels.patch = "cinema";
-    e.labels.lat_deg = cams[i].theta;  // exactly the database's angles, not recomputed
-    e.labels.lon_deg = cams[i].phi;
-    e.labels.shell = 0;
-    m.cameras.push_back(e);
-    const camera::Neighbours& n = graph.neighbours[i];
-    m.graph.neighbours.push_back({n.left, n.right, n.up, n.down, n.in, n.out});
-  }
-  m.rig.kind = "cinema";
-  m.rig.parameters = {{"spec", t.spec}, {"cameras", nc}, {"radius", camera::kDefaultRadius},
-                      {"note", "directions from phi (azimuth) and theta (elevation); distance not in the Cinema database"}};
+  m.provenance.extra["cinema_producer"] = plan.producer;
   m.validate();
   return plan;
 }
@@ -315,13 +483,13 @@ ImportReport import_cinema(const fs::path& cdb, const fs::path& out, const Impor
   std::atomic<std::int64_t> done{0};
   std::mutex progress_mutex;
   for_each_stream(streams, o.threads, [&](std::int64_t s) {
+    const bool turn = plan.rotated[std::size_t(s / nt)];
     for (int f = 0; f < nf; ++f) {
       const fs::path& path = plan.files[std::size_t(s) * std::size_t(nf) + std::size_t(f)];
-      const Image img = read_image(path.string());
+      const Image img = decode_image(path, turn);
       if (img.width != m.image.width || img.height != m.image.height)
         throw FileError(path.string(), "image is " + std::to_string(img.width) + "x" + std::to_string(img.height) +
-                                           "; expected " + std::to_string(m.image.width) + "x" +
-                                           std::to_string(m.image.height));
+                                           "; expected " + std::to_string(m.image.width) + "x" + std::to_string(m.image.height));
       writer.append(int(s / nt), int(s % nt), img);
       const std::int64_t d = ++done;
       if (progress && (d % 64 == 0 || d == total)) {
@@ -332,7 +500,7 @@ ImportReport import_cinema(const fs::path& cdb, const fs::path& out, const Impor
     writer.close_stream(int(s / nt), int(s % nt));
   });
   writer.finalize();
-  return {nc, nt, nf, plan.spec};
+  return {nc, nt, nf, plan.spec, plan.producer};
 }
 
 }  // namespace panoptes::cinema

@@ -24,6 +24,10 @@ struct ImportOptions {
   video::VideoSettings video;     ///< encoder settings of every movie
   bool overwrite = false;
   int threads = 0;                ///< streams encoded in parallel (0 = hardware concurrency)
+  /// The phi/theta convention ("paraview", "cinema-python", "ascent", "elevation"); empty = recognise
+  /// the producer (cinema/conventions.hpp) and refuse when it cannot be told.
+  std::string angles;
+  std::string azimuth_zero;       ///< "+x" or "-x" for angles "elevation" (empty = +x)
 };
 
 /// How a Cinema table maps onto a Panoptes database (plan_import's result; no image read yet).
@@ -31,19 +35,26 @@ struct ImportPlan {
   store::Manifest manifest;       ///< cameras, graph, tasks, axes, times; image size filled in
   /// files[(camera * tasks + task) * frames + frame] = the image's absolute path.
   std::vector<std::filesystem::path> files;
+  /// Per camera: the producer's pictures are upside down, imported turned by 180 degrees.
+  std::vector<bool> rotated;
   std::string spec;               ///< "D" or "A"
+  std::string producer;           ///< the recognised producer and why, for the report
 };
 
-/// Reads IN.cdb and plans the database. Throws FileError/Error (naming the file, the row and the
-/// value) for: a non-numeric time, phi or theta; two rows for the same (camera, task, frame); a
-/// (camera, task, frame) without an image; a FILE outside the database; a missing or unreadable
-/// image; images of different sizes; a --group-by column that does not exist.
+/// Reads IN.cdb and plans the database: the producer's convention gives each image's camera (position,
+/// view direction, up; conventions.hpp), Panoptes' own export restores its cameras, graph and tasks
+/// from panoptes-cinema.json. Time and memory are linear in the table. Throws FileError/Error (naming
+/// the file, the row and the value) for: an unknown phi/theta convention (asks for --angles); a
+/// non-numeric time, phi or theta; two rows for the same (camera, task, frame); a (camera, task,
+/// frame) without an image; a FILE outside the database; a missing or unreadable image; images of
+/// different sizes; a --group-by column that does not exist.
 ImportPlan plan_import(const std::filesystem::path& cdb, const ImportOptions& options = {});
 
 /// What import_cinema wrote.
 struct ImportReport {
   int cameras = 0, tasks = 0, frames = 0;
   std::string spec;
+  std::string producer;  ///< see ImportPlan::producer
 };
 
 /// plan_import, then writes the movie database to `out` (DatabaseWriter; refuses an existing database

@@ -10,11 +10,12 @@ fail() { echo "cinema.sh: $*"; exit 1; }
 "$panoptes" synth-db "$tmp/db" --cameras 3 --tasks 2 --frames 4 --size 64x48 >/dev/null
 out=$("$panoptes" export-cinema "$tmp/db" "$tmp/x.cdb" --frames 0:4:2 --format jpg)
 grep "Cinema Spec D, 12 jpg images" <<<"$out" >/dev/null || fail "unexpected export output: $out"
-head -1 "$tmp/x.cdb/data.csv" | grep '^time,camera,phi,theta,task,isovalue,FILE' >/dev/null || fail "bad header: $(head -1 "$tmp/x.cdb/data.csv")"
+head -1 "$tmp/x.cdb/data.csv" | grep '^time,camera,task_name,isovalue,FILE' >/dev/null || fail "bad header: $(head -1 "$tmp/x.cdb/data.csv")"
 [ "$(find "$tmp/x.cdb/image" -name '*.jpg' | wc -l)" -eq 12 ] || fail "expected 12 images"
 
 out=$("$panoptes" import-cinema "$tmp/x.cdb" "$tmp/back")
 grep "from Cinema Spec D: 3 cameras x 2 tasks = 6 movies, 2 frames each" <<<"$out" >/dev/null || fail "unexpected import output: $out"
+grep "cameras: Panoptes export-cinema" <<<"$out" >/dev/null || fail "sidecar not used: $out"
 info=$("$panoptes" info --json "$tmp/back")
 grep -Eq '"status": *"complete"' <<<"$info" >/dev/null || fail "imported database not complete: $info"
 
@@ -26,6 +27,14 @@ if "$panoptes" import-cinema "$tmp/x.cdb" "$tmp/bad" 2>"$tmp/err"; then fail "ac
 [ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "error is not one line: $(cat "$tmp/err")"
 grep -q '^panoptes: error: .*x.cdb/data.csv line 2: theta "north" (column theta) is not a number$' "$tmp/err" ||
   fail "bad message: $(cat "$tmp/err")"
+# Angles whose producer cannot be told are refused with the option to pass; with it they import.
+rm "$tmp/x.cdb/panoptes-cinema.json"
+printf 'time,phi,theta,FILE\n0,0,0,image/c0/t0_f0.jpg\n0,90,30,image/c1/t0_f0.jpg\n' >"$tmp/x.cdb/data.csv"
+if "$panoptes" import-cinema "$tmp/x.cdb" "$tmp/amb" 2>"$tmp/err"; then fail "guessed a phi/theta convention"; fi
+grep -q '^panoptes: error: .*cannot tell which producer.*--angles paraview|cinema-python|ascent|elevation' "$tmp/err" ||
+  fail "bad message: $(cat "$tmp/err")"
+out=$("$panoptes" import-cinema "$tmp/x.cdb" "$tmp/amb" --angles elevation --azimuth-zero -x)
+grep "cameras: generic Cinema (theta = elevation) (--angles elevation)" <<<"$out" >/dev/null || fail "unexpected import output: $out"
 "$panoptes" export-cinema --help | grep -- "--format" >/dev/null || fail "export-cinema --help"
 "$panoptes" import-cinema --help | grep -- "--group-by" >/dev/null || fail "import-cinema --help"
 echo "cinema.sh: ok"
