@@ -11,7 +11,8 @@ namespace panoptes::app {
 /// The index of the task `value` names in the database `db` (an index "2" or a name "p+s"); throws
 /// panoptes::Error naming the option, the value and the database's tasks if there is none.
 inline int resolve_task_option(const std::string& db, const std::string& value) {
-  const store::Manifest& m = store::Database::open(db).manifest();
+  const store::Database database = store::Database::open(db);
+  const store::Manifest& m = database.manifest();
   char* end = nullptr;
   const long index = std::strtol(value.c_str(), &end, 10);
   if (!value.empty() && *end == '\0' && index >= 0 && index < long(m.tasks.size())) return int(index);
