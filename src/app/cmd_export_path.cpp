@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/command.hpp"
+#include "app/task_option.hpp"
 #include "core/error.hpp"
 #include "player/headless.hpp"
 #include "player/look.hpp"
@@ -17,7 +18,8 @@ namespace {
 struct ExportArgs {
   std::string db, script, out;
   double duration = 0;
-  int camera = 0, task = 0, frame = 0;
+  int camera = 0, frame = 0;
+  std::string task = "0";  // an index or a name
   int crf = -1;
   bool paused = false;
   std::string view_size = "1280x720";
@@ -31,17 +33,19 @@ void run_export(const ExportArgs& a) {
                                         : "no such database directory");
   player::HeadlessOptions o;
   o.engine.camera = a.camera;
-  o.engine.task = a.task;
+  o.engine.task = panoptes::app::resolve_task_option(a.db, a.task);
   o.engine.frame = a.frame;
   o.engine.start_playing = !a.paused;
   o.script = player::read_script(a.script);
   if (a.duration > 0) o.duration = a.duration;
   // The writer is created at the first frame, when the frame size is known; the output settings follow
-  // the database's (frame rate, CRF) unless --crf is given. All-frames-seekable is not needed here, so
-  // the GOP is the usual one for ordinary players.
+  // the database's (CRF) unless --crf is given. The movie's rate is the player's (the manifest's
+  // playback_fps if set): the headless run shows one frame per 1/rate s of its clock, so a 5 s path is
+  // a 5 s movie. All-frames-seekable is not needed here, so the GOP is the usual one for ordinary players.
   std::unique_ptr<panoptes::video::MovieWriter> writer;
   const auto manifest = panoptes::store::Database::open(a.db).manifest();
   panoptes::video::VideoSettings settings = manifest.video;
+  if (manifest.playback_fps > 0) settings.fps = manifest.playback_fps;  // as player::Engine::fps()
   settings.gop = std::max(settings.gop, int(settings.fps));
   if (a.crf >= 0) settings.crf = a.crf;
   const auto parent = std::filesystem::path(a.out).parent_path();
@@ -67,8 +71,8 @@ void run_export(const ExportArgs& a) {
   };
   const auto r = player::run_headless(a.db, o);
   if (writer) writer->close();
-  std::printf("wrote %s: %d frames at %g fps (%d placeholders)\n", a.out.c_str(), r.frames_displayed, settings.fps,
-              r.placeholders);
+  std::printf("wrote %s: %d frames at %g fps = %.1f s, the player's rate (%d placeholders)\n", a.out.c_str(),
+              r.frames_displayed, settings.fps, r.frames_displayed / settings.fps, r.placeholders);
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
@@ -85,7 +89,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--duration", args->duration, "Seconds to export (default: until the last command is shown)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--camera", args->camera, "Start camera id")->check(CLI::NonNegativeNumber);
-  sub->add_option("--task", args->task, "Start task id")->check(CLI::NonNegativeNumber);
+  sub->add_option("--task", args->task, "Start task: its id or its name (e.g. p+s)");
   sub->add_option("--frame", args->frame, "Start frame")->check(CLI::NonNegativeNumber);
   sub->add_flag("--paused", args->paused, "Start paused (the script's Space starts playback)");
   sub->add_option("--view-size", args->view_size,

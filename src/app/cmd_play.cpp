@@ -6,6 +6,7 @@
 #include <string>
 
 #include "app/command.hpp"
+#include "app/task_option.hpp"
 #include "core/error.hpp"
 #include "player/headless.hpp"
 #ifdef PANOPTES_HAVE_UI
@@ -19,7 +20,8 @@ struct PlayArgs {
   bool headless = false;
   std::string script, frames_out, stats;
   double duration = 0;
-  int camera = 0, task = 0, frame = 0;
+  int camera = 0, frame = 0;
+  std::string task = "0";  // an index or a name
   double speed = 0;  // 0 = automatic (window) / x1 (headless)
   bool paused = false, no_loop = false;
   double cache_mb = 0;
@@ -51,7 +53,7 @@ void run_play(const PlayArgs& a) {
   if (a.headless) {
     player::HeadlessOptions o;
     o.engine.camera = a.camera;
-    o.engine.task = a.task;
+    o.engine.task = panoptes::app::resolve_task_option(a.db, a.task);
     o.engine.frame = a.frame;
     o.engine.start_playing = !a.paused;
     o.engine.loop = !a.no_loop;
@@ -90,7 +92,7 @@ void run_play(const PlayArgs& a) {
   w.software_renderer = a.software;
   w.vsync = !a.no_vsync;
   w.camera = a.camera;
-  w.task = a.task;
+  w.task = panoptes::app::resolve_task_option(a.db, a.task);
   w.frame = a.frame;
   w.speed = a.speed;
   w.paused = a.paused;
@@ -130,7 +132,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                   "shown, or the whole database once without a script)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--camera", args->camera, "Start camera id")->check(CLI::NonNegativeNumber);
-  sub->add_option("--task", args->task, "Start task id")->check(CLI::NonNegativeNumber);
+  sub->add_option("--task", args->task, "Start task: its id or its name (e.g. p+s)");
   sub->add_option("--frame", args->frame, "Start frame")->check(CLI::NonNegativeNumber);
   sub->add_option("--speed", args->speed,
                   "Playback speed factor (0.25 .. 8) of the database's playback rate (default: x1, in the window "

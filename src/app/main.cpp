@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -26,6 +27,65 @@ int& exit_code() {
   return code;
 }
 
+namespace {
+
+// Edit distance (insertions, deletions, substitutions) between two short words.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string unknown_command_message(const CLI::App& root, const std::string& word) {
+  std::string best, names;
+  std::size_t best_distance = std::string::npos;
+  for (const CLI::App* sub : root.get_subcommands([](const CLI::App*) { return true; })) {
+    const std::string& name = sub->get_name();
+    names += (names.empty() ? "" : ", ") + name;
+    const std::size_t d = edit_distance(word, name);
+    if (d < best_distance) best_distance = d, best = name;
+  }
+  std::string text = "unknown command \"" + word + "\"";
+  // Two edits catch the usual typos (pley, paly, rnu) without suggesting unrelated short words.
+  if (best_distance <= std::min<std::size_t>(2, std::max<std::size_t>(1, word.size() / 2)))
+    return text + "; did you mean \"" + best + "\"? (see `panoptes --help`)";
+  return text + "; the commands are " + names + " (see `panoptes --help`)";
+}
+
+void explain_number_options(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    // The type name, without the descriptions of the option's checks ("FLOAT:FLOAT in [0 - 1]").
+    const std::string full = option->get_type_name();
+    const std::string type = full.substr(0, full.find(':'));
+    const bool integer = type == "INT" || type == "UINT";
+    if (!integer && type != "FLOAT") continue;
+    // Runs before the option's own checks (transform() goes first), so a word given for a number is
+    // reported as such rather than as "Value abc not in range".
+    option->transform(CLI::Validator(
+        [integer, type](std::string& value) {
+          double d = 0;
+          long long i = 0;
+          const bool ok = integer ? CLI::detail::lexical_cast(value, i) : CLI::detail::lexical_cast(value, d);
+          if (ok) return std::string();
+          return "\"" + value + "\" is not " +
+                 (integer ? std::string(type == "UINT" ? "a non-negative integer (e.g. 3)" : "an integer (e.g. 3)")
+                          : std::string("a number (e.g. 0.5)"));
+        },
+        "", "number"));
+  }
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) explain_number_options(*sub);
+}
+
+}  // namespace
 }  // namespace panoptes::app
 
 int main(int argc, char** argv) {
@@ -36,6 +96,13 @@ int main(int argc, char** argv) {
   root.set_version_flag("--version", "panoptes 0.1.0");
   root.require_subcommand(1);
   panoptes::app::add_registered_commands(root);
+  panoptes::app::explain_number_options(root);
+  // A mistyped command: CLI11 would only say "A subcommand is required".
+  if (argc > 1 && argv[1][0] != '-' &&
+      root.get_subcommands([&](const CLI::App* sub) { return sub->check_name(argv[1]); }).empty()) {
+    std::fprintf(stderr, "panoptes: error: %s\n", panoptes::app::unknown_command_message(root, argv[1]).c_str());
+    return 1;
+  }
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "player/engine.hpp"
+#include "store/database.hpp"
 #include "python/bindings.hpp"
 #include "python/frame_array.hpp"
 
@@ -26,13 +27,30 @@ player::Direction parse_direction(const std::string& s) {
   throw Error("navigate: direction \"" + s + "\"; expected left, right, up, down, in or out");
 }
 
+// A task given by index or by name ("p+s"), as db.frame() takes it; `what` names the call in errors.
+int resolve_task(const store::Manifest& manifest, const py::object& task, const std::string& what) {
+  if (py::isinstance<py::str>(task)) {
+    const std::string name = task.cast<std::string>();
+    const int i = manifest.find_task(name);
+    if (i >= 0) return i;
+    std::string names;
+    for (const auto& t : manifest.tasks) names += (names.empty() ? "\"" : ", \"") + t.name + "\"";
+    throw Error(what + ": the database has no task \"" + name + "\"; its tasks are " + names);
+  }
+  if (py::isinstance<py::int_>(task) && !py::isinstance<py::bool_>(task)) return task.cast<int>();
+  throw Error(what + ": task " + std::string(py::str(task)) + " (" + std::string(py::str(task.get_type().attr("__name__"))) +
+              "); expected a task index (int) or name (str)");
+}
+
 class PyPlayer {
  public:
-  PyPlayer(const std::filesystem::path& dir, int camera, int task, int frame, bool prefetch, std::size_t cache_mb)
+  PyPlayer(const std::filesystem::path& dir, int camera, const py::object& task, int frame, bool prefetch,
+           std::size_t cache_mb)
       : clock_(std::make_unique<player::VirtualClock>()) {
     player::EngineOptions o;
     o.camera = camera;
-    o.task = task;
+    o.task = py::isinstance<py::str>(task) ? resolve_task(store::Database::open(dir).manifest(), task, "Player")
+                                           : resolve_task(store::Manifest{}, task, "Player");
     o.frame = frame;
     o.prefetch = prefetch;
     o.start_playing = false;
@@ -78,6 +96,10 @@ class PyPlayer {
     return d;
   }
 
+  int task_index(const py::object& task, const std::string& what) const {
+    return resolve_task(engine_->manifest(), task, what);
+  }
+
   int axis_index(const py::object& axis) const {
     if (py::isinstance<py::str>(axis)) {
       const std::string name = axis.cast<std::string>();
@@ -97,8 +119,8 @@ class PyPlayer {
 
 void bind_player(py::module_& m) {
   py::class_<PyPlayer>(m, "Player")
-      .def(py::init<std::filesystem::path, int, int, int, bool, std::size_t>(), py::arg("path"), py::arg("camera") = 0,
-           py::arg("task") = 0, py::arg("frame") = 0, py::arg("prefetch") = true, py::arg("cache_mb") = 256)
+      .def(py::init<std::filesystem::path, int, py::object, int, bool, std::size_t>(), py::arg("path"),
+           py::arg("camera") = 0, py::arg("task") = 0, py::arg("frame") = 0, py::arg("prefetch") = true, py::arg("cache_mb") = 256)
       .def_property_readonly("selection", &PyPlayer::selection)
       .def_property_readonly("frame_count", [](PyPlayer& p) { return p.engine().frame_count(); })
       .def_property_readonly("playing", [](PyPlayer& p) { return p.engine().playing(); })
@@ -113,7 +135,8 @@ void bind_player(py::module_& m) {
       .def("navigate", [](PyPlayer& p, const std::string& d) { return p.engine().navigate(parse_direction(d)); },
            py::arg("direction"))
       .def("jump_to_camera", [](PyPlayer& p, int c) { return p.engine().jump_to_camera(c); }, py::arg("camera"))
-      .def("set_task", [](PyPlayer& p, int t) { return p.engine().set_task(t); }, py::arg("task"))
+      .def("set_task", [](PyPlayer& p, const py::object& t) { return p.engine().set_task(p.task_index(t, "set_task")); },
+           py::arg("task"))
       .def("next_task", [](PyPlayer& p) { return p.engine().next_task(); })
       .def("previous_task", [](PyPlayer& p) { return p.engine().previous_task(); })
       .def("step_axis", [](PyPlayer& p, const py::object& axis, int delta) {

@@ -154,7 +154,7 @@ void Manifest::validate() const {
   try {
     video.validate();
   } catch (const Error& e) {
-    fail(std::string("video settings: ") + e.what());
+    fail(e.what());  // VideoSettings::validate() already names "video settings"
   }
   try {
     validate_movie_pattern(movie_pattern);

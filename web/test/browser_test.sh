@@ -25,6 +25,9 @@ head -c 3000 /dev/urandom > "$tmp/db/movies/c4/t0.mp4"          # corrupt
 start_serve() {
   local log=$1
   shift
+  # The log exists before the server starts: the background job's redirection may run after the first
+  # sed below, which (under set -e) would end the test on a missing file.
+  : > "$log"
   "$panoptes" serve "$@" > "$log" 2>&1 &
   pids+=($!)
   served_url=""

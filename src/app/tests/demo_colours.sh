@@ -20,8 +20,8 @@ done
 # Frame 1 (step 240) of every camera, p+s task and p-wave task.
 printf 't=0 seek=1\n' > s.txt
 for c in 1 2 3 4 5; do printf 't=%s camera=%d\n' "0.$c" "$c" >> s.txt; done
-"$bin" play db --headless --script s.txt --task 2 --paused --frames-out ps > /dev/null
-"$bin" play db --headless --script s.txt --task 0 --paused --frames-out p > /dev/null
+"$bin" play db --headless --script s.txt --task p+s --paused --frames-out ps > /dev/null
+"$bin" play db --headless --script s.txt --task p-wave --paused --frames-out p > /dev/null
 read -r _ coloured _ orange _ green _ share_ps < <("$share" ps/*.png)
 read -r _ p_coloured _ _ _ _ _ _ < <("$share" p/*.png)
 echo "p+s at mid-run: $coloured coloured pixels, $orange orange, $green green (orange share $share_ps); p-wave task: $p_coloured coloured"

@@ -12,6 +12,12 @@ printf 't=0.1 key=Right\nt=0.3 key=Tab\nt=0.5 key=Right\n' > s.txt
 frames=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,width,height \
          -of csv=p=0 path.mp4)
 [ "$frames" = "64,64,16" ] || { echo "ffprobe says: $frames"; exit 1; }
+# The movie plays at the player's rate: with playback_fps 10 (as the demo has; the movies are 30 fps) the
+# 0.5 s script plus one frame period is 6 frames lasting 0.6 s, not 6 frames at 30 fps (0.2 s).
+jq '.playback_fps = 10' db/panoptes.json > m.json && mv m.json db/panoptes.json
+"$panoptes" export-path db --script s.txt --out slow.mp4 | grep "wrote slow.mp4: 6 frames at 10 fps = 0.6 s" >/dev/null
+duration=$(ffprobe -v error -select_streams v:0 -show_entries stream=duration -of csv=p=0 slow.mp4)
+awk -v d="$duration" 'BEGIN { exit !(d > 0.55 && d < 0.65) }' || { echo "slow.mp4 lasts $duration s, expected 0.6"; exit 1; }
 if "$panoptes" export-path db --script s.txt --out /nonexistent/dir/x.mp4 2>err.txt; then
   echo "unwritable output accepted"; exit 1
 fi

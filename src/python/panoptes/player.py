@@ -6,7 +6,8 @@ from . import _panoptes
 
 
 class Player:
-    """The player's engine on a database (a panoptes.Database or a path), without a window.
+    """The player's engine on a database (a panoptes.Database or a path), without a window; the start
+    task is an index or a name.
 
     Time only moves when advance(seconds) is called (a virtual clock at the database's frame rate),
     so a script shows the same frames on every machine. Commands return False when they cannot apply
@@ -37,6 +38,7 @@ class Player:
         return self._p.jump_to_camera(camera)
 
     def set_task(self, task):
+        """Switches to task `task`: its index or its name (e.g. "p+s"), as db.frame() takes it."""
         return self._p.set_task(task)
 
     def next_task(self):

@@ -43,3 +43,19 @@ def test_bad_commands(synth_db):
         p.navigate("sideways")
     with pytest.raises(panoptes.Error, match='no parameter axis "speed"'):
         p.step_axis("speed")
+
+
+def test_tasks_by_name(synth_db):
+    db = panoptes.open(synth_db)
+    names = [t["name"] for t in db.tasks]
+    p = panoptes.Player(db, task=names[2])
+    assert p.task == 2
+    assert p.set_task(names[1]) and p.task == 1
+    assert np.array_equal(p.image(), db.frame(0, names[1], 0))
+    assert p.set_task(0) and p.task == 0
+    with pytest.raises(panoptes.Error, match=r'set_task: the database has no task "phi_s"; its tasks are "'):
+        p.set_task("phi_s")
+    with pytest.raises(panoptes.Error, match=r"expected a task index \(int\) or name \(str\)"):
+        p.set_task(1.5)
+    with pytest.raises(panoptes.Error, match=r'Player: the database has no task "nope"'):
+        panoptes.Player(db, task="nope")
