@@ -113,15 +113,17 @@ TEST(Mp4Fragments, WrappingBoxSizesEndTheWalk) {
   ASSERT_EQ(whole.fragments.size(), 4u);
   const std::uint64_t wrap = ~std::uint64_t(15);  // 2^64 - 16
 
-  // Top level, between the second and the third fragment.
+  // Top level, between the second and the third fragment, after a 16-byte box: the wrapped offset
+  // landed on that box again, and again.
   const std::size_t third = whole.fragments[2].offset;
-  write_bytes(movie, good.substr(0, third) + large_box("free", wrap) + good.substr(third));
+  const std::string pad = std::string{0, 0, 0, 16} + "free" + std::string(8, '\0');
+  write_bytes(movie, good.substr(0, third) + pad + large_box("free", wrap) + good.substr(third));
   const auto start = std::chrono::steady_clock::now();
   const FragmentIndex cut = index_fragments(movie);
   EXPECT_EQ(cut.fragments.size(), 2u);
   // Sizes 2^64 - 8k for every small k, and one that overhangs by a byte: all end the walk.
   for (std::uint64_t size : {wrap, ~std::uint64_t(7), std::uint64_t(good.size() - third + 17)}) {
-    write_bytes(movie, good.substr(0, third) + large_box("free", size) + good.substr(third));
+    write_bytes(movie, good.substr(0, third) + pad + large_box("free", size) + good.substr(third));
     EXPECT_EQ(index_fragments(movie).fragments.size(), 2u) << size;
   }
 
