@@ -186,7 +186,7 @@ bool BoundedHttpServer::process_and_close_socket(socket_t sock) {
     if (h == Head::slow)
       refuse(408, "Request Timeout", "request head not received within " + std::to_string(l.head_seconds) + " s");
     if (h != Head::complete) {
-      unread_input = h != Head::closed && h != Head::idle;
+      unread_input = h == Head::line_too_long || h == Head::too_big || h == Head::slow;
       break;
     }
     const std::string_view head(buffer.data(), head_size);
@@ -196,7 +196,7 @@ bool BoundedHttpServer::process_and_close_socket(socket_t sock) {
     const bool ok = process_request(stream, served + 1 == l.max_requests, closed, nullptr);
     buffer.erase(0, head_size);
     if (!ok || closed || body || cutting_) {
-      unread_input = body || !buffer.empty();
+      unread_input = !cutting_ && (body || !buffer.empty());
       break;
     }
   }

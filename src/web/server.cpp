@@ -247,21 +247,21 @@ struct Server::Impl {
     return same_secret(cookie_value(req.get_header_value("Cookie"), "panoptes_token"), token);
   }
 
-  /// The frames the movies can hold, when the manifest claims more than the first stream's bytes
-  /// could (a frame takes at least a byte): then that stream's fragment index (cached; its work is
-  /// bounded by the file's size) says how many it holds. -1 = the claim is not contradicted.
+  /// The frames the movies can hold, when the manifest claims more than the first stream's movie has
+  /// bytes (a frame takes at least one): then that movie's fragment index (cached; its work is bounded
+  /// by the file's size) says how many it holds. -1 = not contradicted, or no movie to check against
+  /// (a missing or unreadable first movie is that stream's damage, not a measure of the others).
   std::int64_t frames_backed(const store::Database& d) {
     if (d.camera_count() == 0 || d.task_count() == 0 || d.frame_count() == 0) return -1;
     const auto movie = db_root.resolve(d.manifest().stream_relative_path(0, 0));
-    if (!movie) return 0;  // no first movie: nothing backs any frame
+    if (!movie) return -1;
     std::error_code ec;
     const auto bytes = fs::file_size(*movie, ec);
-    if (ec) return 0;
-    if (std::uintmax_t(d.frame_count()) <= bytes) return -1;
+    if (ec || std::uintmax_t(d.frame_count()) <= bytes) return -1;
     try {
       return indexes.frame_count(*movie);
     } catch (const Error&) {
-      return 0;  // not a movie: it backs no frame
+      return -1;
     }
   }
 
