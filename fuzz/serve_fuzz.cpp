@@ -68,8 +68,11 @@ const Served& served(bool with_token) {
     fs::create_directory_symlink(d, d / "db" / "movies" / "outside");
     return d;
   }();
-  static Served open(dir / "db", dir / "player", ""), closed(dir / "db", dir / "player", "fuzz-token");
-  return with_token ? closed : open;
+  // Never destroyed: their threads serve until the process ends (a destructor at exit would stop a
+  // server under a thread still inside it).
+  static const Served* open = new Served(dir / "db", dir / "player", "");
+  static const Served* closed = new Served(dir / "db", dir / "player", "fuzz-token");
+  return with_token ? *closed : *open;
 }
 
 /// Sends `request` and reads the answer until the server closes the connection, both at once (a
