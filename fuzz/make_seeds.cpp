@@ -216,7 +216,8 @@ int main(int argc, char** argv) {
   for (const fs::path d : {db, out / "_db_gop2"})
     for (const auto& e : fs::recursive_directory_iterator(d))
       if (e.path().extension() == ".mp4")
-        write(out / "movie" / (d.filename().string() + "_" + e.path().filename().string()), read(e.path()));
+        for (const char* target : {"movie", "mp4_fragments"})
+          write(out / target / (d.filename().string() + "_" + e.path().filename().string()), read(e.path()));
   fs::remove_all(db);
   fs::remove_all(out / "_db_gop2");
 
@@ -237,6 +238,23 @@ int main(int argc, char** argv) {
         "# every command\nt=0 play\nt=0.5 key=Right\nt=0.6 key=Shift+Tab\nt=1 seek=3\nt=1.2 camera=2\n"
         "t=1.3 task=1\nt=1.4 task=iso 0.5\nt=1.5 axis=isovalue:+1\nt=1.6 snap=1,0,0\nt=1.7 speed=2\n"
         "t=2 pause\nt=3 end\n");
+
+  // serve: raw requests (fuzz/serve_fuzz.cpp's server wants the token "fuzz-token").
+  const std::string auth = "Authorization: Bearer fuzz-token\r\n";
+  const std::pair<const char*, std::string> requests[] = {
+      {"index.txt", "GET /?token=fuzz-token HTTP/1.1\r\nHost: h\r\n\r\n"},
+      {"database.txt", "GET /api/database.json?times_from=1 HTTP/1.1\r\nHost: h\r\n" + auth + "\r\n"},
+      {"inline.txt", "GET /api/database.json?cameras=inline HTTP/1.1\r\nHost: h\r\nCookie: a=b; panoptes_token=fuzz-token\r\n\r\n"},
+      {"fragments.txt", "GET /api/index/1/0.json HTTP/1.1\r\nHost: h\r\n" + auth + "\r\n"},
+      {"range.txt", "GET /db/movies/c0/t1.mp4 HTTP/1.1\r\nHost: h\r\n" + auth + "Range: bytes=10-99\r\n\r\n"},
+      {"ranges.txt", "GET /db/movies/c0/t0.mp4 HTTP/1.1\r\nHost: h\r\n" + auth + "Range: bytes=0-1,-5,7-\r\n\r\n"},
+      {"escape.txt", "GET /db/movies/..%2f..%2fsecret.txt HTTP/1.1\r\nHost: h\r\n" + auth + "\r\n"},
+      {"keepalive.txt", "GET /db/panoptes.json HTTP/1.1\r\nHost: h\r\n" + auth + "\r\nHEAD /index.html HTTP/1.0\r\n" + auth +
+                            "Connection: keep-alive\r\n\r\n"},
+      {"body.txt", "POST /api/database.json HTTP/1.1\r\nHost: h\r\n" + auth + "Content-Length: 5\r\n\r\nhello"},
+      {"chunked.txt", "GET / HTTP/1.1\r\nHost: h\r\n" + auth + "Transfer-Encoding: chunked\r\n\r\n5\r\nhello\r\n0\r\n\r\n"},
+  };
+  for (const auto& [name, bytes] : requests) write(out / "serve" / name, bytes);
 
   write(out / "toml_config" / "run.toml", kRunConfig);
   write(out / "toml_config" / "seismic.toml", kSeismicConfig);

@@ -1,8 +1,12 @@
 // `panoptes serve DB`: serves a movie database and the web player over HTTP (docs/web.md).
 #include <pthread.h>
 #include <signal.h>
+#include <sys/resource.h>
 
+#include <atomic>
 #include <cctype>
+#include <cstdlib>
+#include <ctime>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -15,12 +19,17 @@
 
 namespace {
 
+// How long Ctrl+C waits for the server's threads before the process ends without them: longer than
+// the server's read/write timeout (5 s), so a normal stop always ends by itself.
+constexpr int kStopSeconds = 8;
+
 struct Args {
   std::string db;
   int port = 8080;
   std::string bind = "127.0.0.1";
   std::string token;
   int threads = 16;
+  int max_connections = 1024;
   bool quiet = false;
 };
 
@@ -37,6 +46,7 @@ void run(const Args& a) {
   o.port = a.port;
   o.token = a.token;
   o.threads = a.threads;
+  o.max_connections = a.max_connections;
   auto out_mutex = std::make_shared<std::mutex>();
   if (!a.quiet)
     o.log = [out_mutex](const std::string& line) {
@@ -51,6 +61,13 @@ void run(const Args& a) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // A connection is a socket and, while it sends a file, a descriptor more: let --max-connections of
+  // them open without EMFILE (the soft limit is often 1024; the hard one is the administrator's).
+  rlimit files{};
+  if (getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+    files.rlim_cur = files.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &files);
+  }
   web::Server server(o);
   std::string url = server.url();
   if (!a.token.empty()) url += "?token=" + a.token;
@@ -60,12 +77,25 @@ void run(const Args& a) {
                 a.bind.c_str());
   std::printf("Ctrl+C stops the server\n");
   std::fflush(stdout);
-  std::thread waiter([&server, signals] {
+  std::atomic<bool> ran{false};
+  std::thread waiter([&server, &ran, signals] {
     int sig = 0;
     sigwait(&signals, &sig);
+    if (ran) return;  // woken by the main thread after run() returned by itself
     server.stop();
+    // stop() cuts every connection at its next read or write (within the server's timeout). Should
+    // run() still not return in time, or on a second Ctrl+C, the process ends anyway: Ctrl+C stops
+    // the server whatever its threads are doing (issue 31).
+    const timespec wait{kStopSeconds, 0};
+    sigtimedwait(&signals, nullptr, &wait);  // a second signal, the main thread's wake-up or the deadline
+    if (!ran) {
+      std::printf("stopped (connections still open were cut)\n");
+      std::fflush(stdout);
+      std::_Exit(0);
+    }
   });
   server.run();
+  ran = true;
   // run() may also return without a signal (a listen error): wake the waiter so it can be joined.
   pthread_kill(waiter.native_handle(), SIGTERM);
   waiter.join();
@@ -84,7 +114,13 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       ->capture_default_str();
   sub->add_option("--token", args->token, "Require this token: open the URL with ?token=T (sets a cookie) or send "
                                           "'Authorization: Bearer T'");
-  sub->add_option("--threads", args->threads, "Requests served at once")->check(CLI::Range(1, 1024))->capture_default_str();
+  sub->add_option("--threads", args->threads, "Threads kept ready for connections (more start on demand)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  sub->add_option("--max-connections", args->max_connections,
+                  "Connections served at once (a thread each); later ones wait their turn")
+      ->check(CLI::Range(1, 65536))
+      ->capture_default_str();
   sub->add_flag("--quiet", args->quiet, "No log line per request");
   sub->callback([args] { run(*args); });
 });

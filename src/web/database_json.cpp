@@ -1,24 +1,38 @@
 #include "web/database_json.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace panoptes::web {
 
-nlohmann::json database_json(const store::Database& db, bool inline_cameras) {
+nlohmann::json database_json(const store::Database& db, const DatabaseJsonOptions& options) {
   const store::Manifest& m = db.manifest();
   using nlohmann::json;
   json j;
   j["title"] = m.title;
   j["status"] = std::string(store::to_string(db.status()));
-  j["frames"] = db.frame_count();
+  std::int64_t frames = db.frame_count();
+  if (options.frames_backed >= 0 && options.frames_backed < frames) {
+    j["frames_claimed"] = frames;
+    j["warning"] = "the manifest claims " + std::to_string(frames) + " frames but the movies hold at most " +
+                   std::to_string(options.frames_backed);
+    frames = options.frames_backed;
+  }
+  j["frames"] = frames;
   j["fps"] = m.video.fps;
   // The rate the database asks its players to use (0: none; the movies' own rate then), as the desktop player does.
   j["playback_fps"] = m.playback_fps;
   j["gop"] = m.video.gop;
   j["image"] = {{"width", m.image.width}, {"height", m.image.height}};
-  json times = json::array();
-  for (int i = 0; i < db.frame_count(); ++i) times.push_back(m.frame_time(i));
-  j["times"] = std::move(times);
+  // Only the times the manifest holds (bounded by its size): any other frame's time is its index.
+  const std::size_t listed = std::min(std::size_t(frames), m.times.size());
+  const std::size_t from = std::min(options.times_from, listed);
+  const std::size_t count = std::min(listed - from, options.max_times);
+  j["times"] = std::vector<double>(m.times.begin() + std::ptrdiff_t(from), m.times.begin() + std::ptrdiff_t(from + count));
+  j["times_from"] = from;
+  j["times_listed"] = listed;
   j["movie_pattern"] = m.movie_pattern;
   j["rig"] = m.rig.kind;
   j["domain_units"] = m.domain.units;
@@ -39,7 +53,7 @@ nlohmann::json database_json(const store::Database& db, bool inline_cameras) {
   // file as it is (GET /db/NAME) and reads its columns as typed arrays, instead of parsing ~150 bytes
   // of JSON per camera (150 MB at 10^6 cameras). Only inline (schema 1) cameras go into this JSON.
   const std::string table = store::referenced_camera_table(db.dir() / store::kManifestFileName);
-  if (!table.empty() && !inline_cameras) {
+  if (!table.empty() && !options.inline_cameras) {
     std::error_code ec;
     const auto bytes = std::filesystem::file_size(db.dir() / table, ec);
     j["cameras"] = {{"count", n}, {"table", table}, {"bytes", ec ? 0 : bytes}};

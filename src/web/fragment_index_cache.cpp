@@ -10,7 +10,11 @@ namespace fs = std::filesystem;
 
 FragmentIndexCache::FragmentIndexCache(std::size_t max_bytes) : max_bytes_(max_bytes) {}
 
-std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movie) {
+std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movie) { return get(movie).first; }
+
+int FragmentIndexCache::frame_count(const fs::path& movie) { return get(movie).second; }
+
+std::pair<std::shared_ptr<const std::string>, int> FragmentIndexCache::get(const fs::path& movie) {
   std::error_code ec;
   const auto size = fs::file_size(movie, ec);
   if (ec) throw FileError(movie.string(), "cannot read: " + ec.message());
@@ -23,7 +27,7 @@ std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movi
       if (it->second->size == size && it->second->mtime == mtime) {
         lru_.splice(lru_.begin(), lru_, it->second);
         ++hits_;
-        return it->second->json;
+        return {it->second->json, it->second->frames};
       }
       bytes_ -= it->second->json->size();
       lru_.erase(it->second);
@@ -33,14 +37,15 @@ std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movi
   }
   // Built outside the lock: other streams are served meanwhile. Two requests for the same new movie
   // may both build it; the second insert just replaces the first.
-  auto text = std::make_shared<const std::string>(fragment_index_json(index_fragments(movie)).dump());
+  const FragmentIndex index = index_fragments(movie);
+  auto text = std::make_shared<const std::string>(fragment_index_json(index).dump());
   std::lock_guard lock(mutex_);
   if (const auto it = by_path_.find(key); it != by_path_.end()) {
     bytes_ -= it->second->json->size();
     lru_.erase(it->second);
     by_path_.erase(it);
   }
-  lru_.push_front(Entry{key, size, mtime, text});
+  lru_.push_front(Entry{key, size, mtime, text, index.frame_count()});
   by_path_[key] = lru_.begin();
   bytes_ += text->size();
   while (bytes_ > max_bytes_ && lru_.size() > 1) {
@@ -48,7 +53,7 @@ std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movi
     by_path_.erase(lru_.back().path);
     lru_.pop_back();
   }
-  return text;
+  return {text, index.frame_count()};
 }
 
 std::uint64_t FragmentIndexCache::hits() const {

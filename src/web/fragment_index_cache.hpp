@@ -11,6 +11,7 @@
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 namespace panoptes::web {
 
@@ -24,6 +25,8 @@ class FragmentIndexCache {
   /// The index of `movie` as JSON (web::fragment_index_json), from the cache when the file's size and
   /// mtime are unchanged, else built (index_fragments) and kept. Throws what index_fragments throws.
   std::shared_ptr<const std::string> json(const std::filesystem::path& movie);
+  /// The frames in the complete fragments of `movie` (FragmentIndex::frame_count), from the same entry.
+  int frame_count(const std::filesystem::path& movie);
 
   /// Counters for tests and logs.
   std::uint64_t hits() const;
@@ -35,7 +38,9 @@ class FragmentIndexCache {
     std::uintmax_t size = 0;
     std::filesystem::file_time_type mtime;
     std::shared_ptr<const std::string> json;
+    int frames = 0;
   };
+  std::pair<std::shared_ptr<const std::string>, int> get(const std::filesystem::path& movie);
   mutable std::mutex mutex_;
   std::list<Entry> lru_;  // front = most recently used
   std::unordered_map<std::string, std::list<Entry>::iterator> by_path_;

@@ -16,6 +16,8 @@ std::uint32_t be32(const unsigned char* p) {
 }
 std::uint64_t be64(const unsigned char* p) { return std::uint64_t(be32(p)) << 32 | be32(p + 4); }
 
+std::string printable(const std::array<char, 4>& type);
+
 struct BoxHeader {
   std::array<char, 4> type{};
   std::uint64_t size = 0;    // whole box, header included
@@ -34,30 +36,40 @@ class File {
 
   /// Reads n bytes at offset; false if the file ends first.
   bool read(std::uint64_t offset, void* out, std::size_t n) {
-    if (offset + n > size_) return false;
+    if (offset > size_ || n > size_ - offset) return false;
     in_.clear();
     in_.seekg(std::streamoff(offset));
     in_.read(static_cast<char*>(out), std::streamsize(n));
     return bool(in_);
   }
 
-  /// The box header at offset inside [offset, end); false if it does not fit.
-  bool box(std::uint64_t offset, std::uint64_t end, BoxHeader& h) {
+  /// The box header at offset inside [offset, end); false if its header does not fit. A box that
+  /// declares more bytes than [offset, end) holds is, with `overhang_ends`, a box cut short (a movie
+  /// still being written: false), else an error. Sizes are compared as `size > end - offset`, never
+  /// by adding them to the offset: a 64-bit size near 2^64 must not wrap around to a small offset
+  /// (issue 31: 2^64-16 sent the walk backwards, forever).
+  bool box(std::uint64_t offset, std::uint64_t end, BoxHeader& h, bool overhang_ends = false) {
     unsigned char b[16];
-    if (offset + 8 > end || !read(offset, b, 8)) return false;
+    if (offset >= end || end - offset < 8 || !read(offset, b, 8)) return false;
     std::memcpy(h.type.data(), b + 4, 4);
     h.size = be32(b);
     h.header = 8;
     if (h.size == 1) {
-      if (offset + 16 > end || !read(offset + 8, b + 8, 8)) return false;
+      if (end - offset < 16 || !read(offset + 8, b + 8, 8)) return false;
       h.size = be64(b + 8);
       h.header = 16;
     } else if (h.size == 0) {
       h.size = end - offset;  // "to the end of the file"
     }
     if (h.size < h.header)
-      throw FileError(path_.string(), "box '" + std::string(h.type.data(), 4) + "' at byte " + std::to_string(offset) +
+      throw FileError(path_.string(), "box '" + printable(h.type) + "' at byte " + std::to_string(offset) +
                                           " declares size " + std::to_string(h.size) + ", smaller than its header");
+    if (h.size > end - offset) {
+      if (overhang_ends) return false;
+      throw FileError(path_.string(), "box '" + printable(h.type) + "' at byte " + std::to_string(offset) +
+                                          " declares size " + std::to_string(h.size) + ", beyond its parent's end at byte " +
+                                          std::to_string(end) + " (expected at most " + std::to_string(end - offset) + ")");
+    }
     return true;
   }
 
@@ -66,6 +78,14 @@ class File {
   std::ifstream in_;
   std::uint64_t size_ = 0;
 };
+
+/// A box type for a message: its four bytes, with anything unprintable as '?'.
+std::string printable(const std::array<char, 4>& type) {
+  std::string s(type.data(), 4);
+  for (char& c : s)
+    if (c < 0x20 || c > 0x7e) c = '?';
+  return s;
+}
 
 bool is(const BoxHeader& h, const char* type) { return std::memcmp(h.type.data(), type, 4) == 0; }
 
@@ -76,12 +96,15 @@ std::uint64_t moof_samples(File& f, std::uint64_t begin, std::uint64_t end) {
   BoxHeader traf;
   for (std::uint64_t p = begin; p < end && f.box(p, end, traf); p += traf.size) {
     if (!is(traf, "traf")) continue;
-    const std::uint64_t traf_end = std::min(end, p + traf.size);
+    const std::uint64_t traf_end = p + traf.size;  // inside [begin, end): File::box checked it
     BoxHeader child;
     for (std::uint64_t q = p + traf.header; q < traf_end && f.box(q, traf_end, child); q += child.size) {
       if (!is(child, "trun")) continue;
       unsigned char b[8];  // version + flags, sample_count
-      if (!f.read(q + child.header, b, 8)) break;
+      if (child.size - child.header < 8 || !f.read(q + child.header, b, 8))
+        throw FileError(f.path().string(), "trun box at byte " + std::to_string(q) + " of " + std::to_string(child.size) +
+                                               " bytes is too short for its sample count (expected at least " +
+                                               std::to_string(child.header + 8) + ")");
       samples += be32(b + 4);
       found = true;
     }
@@ -99,8 +122,9 @@ FragmentIndex index_fragments(const std::filesystem::path& movie) {
   bool have_moov = false;
   int next_frame = 0;
   BoxHeader h;
-  for (std::uint64_t p = 0; p < f.size() && f.box(p, f.size(), h); p += h.size) {
-    if (p + h.size > f.size()) break;  // cut short: a fragment still being written
+  // Every box is at least 8 bytes and lies inside the file (File::box), so the walk takes at most
+  // file size / 8 steps whatever the sizes claim.
+  for (std::uint64_t p = 0; p < f.size() && f.box(p, f.size(), h, /*overhang_ends=*/true); p += h.size) {
     if (is(h, "moov")) {
       have_moov = true;
       index.init_size = p + h.size;
@@ -109,7 +133,8 @@ FragmentIndex index_fragments(const std::filesystem::path& movie) {
       // The fragment is the moof plus the mdat right after it.
       BoxHeader mdat;
       const std::uint64_t q = p + h.size;
-      if (!f.box(q, f.size(), mdat) || !is(mdat, "mdat") || q + mdat.size > f.size()) break;
+      // An mdat running past the end of the file: the fragment is still being written.
+      if (!f.box(q, f.size(), mdat, /*overhang_ends=*/true) || !is(mdat, "mdat")) break;
       const std::uint64_t count = moof_samples(f, p + h.header, p + h.size);
       // A hostile trun count must not overflow the frame numbers: every sample takes at least one byte.
       if (count > mdat.size || count > std::uint64_t(INT_MAX - next_frame))

@@ -84,6 +84,64 @@ TEST(Mp4Fragments, TruncatedMovieKeepsItsCompleteFragments) {
   EXPECT_EQ(cut.frame_count(), 3);
 }
 
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void write_bytes(const fs::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+/// A box header with a 64-bit size (size field 1, then the largesize).
+std::string large_box(const char* type, std::uint64_t size) {
+  std::string b = {0, 0, 0, 1};
+  b += std::string(type, 4);
+  for (int i = 7; i >= 0; --i) b += char((size >> (8 * i)) & 0xff);
+  return b;
+}
+
+// Issue 31 row 7: a 64-bit box size of 2^64-16 wrapped the walk's offset back by 16 bytes, so the
+// indexer (serve's /api/index, export-web) looped forever. Before the fix this test hung until ctest's
+// timeout; now each case ends at once, top level (a box cut short: the fragments before it stay) and
+// inside a moof (an error naming the box).
+TEST(Mp4Fragments, WrappingBoxSizesEndTheWalk) {
+  store::testing::TempDir tmp("web-frag");
+  const fs::path movie = make_db(tmp.path / "db", 4, 1);
+  const std::string good = read_bytes(movie);
+  const FragmentIndex whole = index_fragments(movie);
+  ASSERT_EQ(whole.fragments.size(), 4u);
+  const std::uint64_t wrap = ~std::uint64_t(15);  // 2^64 - 16
+
+  // Top level, between the second and the third fragment, after a 16-byte box: the wrapped offset
+  // landed on that box again, and again.
+  const std::size_t third = whole.fragments[2].offset;
+  const std::string pad = std::string{0, 0, 0, 16} + "free" + std::string(8, '\0');
+  write_bytes(movie, good.substr(0, third) + pad + large_box("free", wrap) + good.substr(third));
+  const auto start = std::chrono::steady_clock::now();
+  const FragmentIndex cut = index_fragments(movie);
+  EXPECT_EQ(cut.fragments.size(), 2u);
+  // Sizes 2^64 - 8k for every small k, and one that overhangs by a byte: all end the walk.
+  for (std::uint64_t size : {wrap, ~std::uint64_t(7), std::uint64_t(good.size() - third + 17)}) {
+    write_bytes(movie, good.substr(0, third) + pad + large_box("free", size) + good.substr(third));
+    EXPECT_EQ(index_fragments(movie).fragments.size(), 2u) << size;
+  }
+
+  // Inside a moof: a traf whose size wraps is an error, not a loop.
+  const std::size_t traf = good.find("traf", whole.fragments[1].offset) - 4;
+  ASSERT_LT(traf, whole.fragments[1].offset + whole.fragments[1].size);
+  std::string bytes = good;
+  bytes.replace(traf, 4, std::string("\xff\xff\xff\xf0", 4));  // 32-bit size beyond the moof's end
+  write_bytes(movie, bytes);
+  try {
+    index_fragments(movie);
+    FAIL() << "a traf overhanging its moof was accepted";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond its parent's end"), std::string::npos) << e.what();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+}
+
 TEST(Mp4Fragments, RefusesFilesThatAreNotMovies) {
   store::testing::TempDir tmp("web-frag");
   const fs::path junk = tmp.path / "junk.mp4";

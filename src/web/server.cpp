@@ -4,7 +4,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <cstring>
 
 #include <chrono>
 #include <cstdio>
@@ -14,6 +19,8 @@
 
 #include "core/error.hpp"
 #include "store/database.hpp"
+#include "web/bounded_http_server.hpp"
+#include "web/connection_threads.hpp"
 #include "web/database_json.hpp"
 #include "web/fragment_index_cache.hpp"
 #include "web/mp4_fragments.hpp"
@@ -67,6 +74,12 @@ std::string cookie_value(const std::string& cookies, const std::string& name) {
   return {};
 }
 
+/// The request as one escaped log field: method and path (decoded by httplib, so "%0a" is a newline
+/// here and must not reach the log as one).
+std::string request_line(const httplib::Request& req) {
+  return escape_for_log(req.remote_addr, 64) + " " + escape_for_log(req.method, 16) + " " + escape_for_log(req.path);
+}
+
 void send_error(httplib::Response& res, int status, const std::string& message) {
   res.status = status;
   res.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
@@ -74,7 +87,8 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 
 /// Serves an opened file whole or, with a Range header, the asked bytes (httplib answers 206 / 416).
 /// Reads go through the descriptor opened by SafeRoot::open (pread: no shared offset, no re-open).
-void send_file(httplib::Response& res, store::FileHandle file, const std::string& type) {
+void send_file(httplib::Response& res, store::FileHandle file, const std::string& type,
+               const std::atomic<bool>& stopping) {
   struct stat st{};
   if (::fstat(file.get(), &st) != 0) return send_error(res, 404, "cannot read the file");
   const auto size = std::size_t(st.st_size);
@@ -82,9 +96,10 @@ void send_file(httplib::Response& res, store::FileHandle file, const std::string
   res.set_header("Accept-Ranges", "bytes");
   if (size == 0) return res.set_content("", type);
   auto fd = std::make_shared<store::FileHandle>(std::move(file));
-  res.set_content_provider(size, type, [fd](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+  res.set_content_provider(size, type, [fd, &stopping](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
     char buf[64 * 1024];
     while (length > 0) {
+      if (stopping) return false;  // stop() cuts a long download instead of waiting for it
       const ssize_t got = ::pread(fd->get(), buf, std::min(length, sizeof buf), off_t(offset));
       if (got < 0 && errno == EINTR) continue;
       if (got <= 0 || !sink.write(buf, std::size_t(got))) return false;
@@ -95,19 +110,55 @@ void send_file(httplib::Response& res, store::FileHandle file, const std::string
   });
 }
 
+/// Is the request announcing a body? Nothing here takes one: it is refused before a byte of it is read.
+bool has_body(const httplib::Request& req) {
+  if (req.has_header("Transfer-Encoding")) return true;
+  if (!req.has_header("Content-Length")) return false;
+  const std::string length = req.get_header_value("Content-Length");
+  return length.find_first_not_of('0') != std::string::npos;  // "0", "00": empty; anything else is not
+}
+
 }  // namespace
+
+std::string escape_for_log(std::string_view text, std::size_t max) {
+  static const char* const hex = "0123456789abcdef";
+  std::string out;
+  const std::size_t n = std::min(text.size(), max);
+  out.reserve(n + 16);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c >= 0x7f || c == '\\') {
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += char(c);
+    }
+  }
+  if (text.size() > n) out += "...(" + std::to_string(text.size() - n) + " more bytes)";
+  return out;
+}
 
 struct Server::Impl {
   ServerOptions options;
   SafeRoot db_root, player_root;
-  httplib::Server http;
+  BoundedHttpServer http;
   int port = 0;
   std::mutex db_mutex;
   std::shared_ptr<const store::Database> db;
   FragmentIndexCache indexes;  // per movie, checked against size + mtime per request
+  std::atomic<bool> stopping{false};
+  int listen_socket = -1;  // seen when httplib creates it, to widen its backlog
+
+  static HttpLimits limits(const ServerOptions& o) {
+    HttpLimits l;
+    l.idle_seconds = l.write_seconds = std::max(1, o.timeout_seconds);
+    l.head_seconds = 2 * l.idle_seconds;
+    return l;
+  }
 
   explicit Impl(ServerOptions o)
-      : options(std::move(o)), db_root(options.database), player_root(options.player_dir) {
+      : options(std::move(o)), db_root(options.database), player_root(options.player_dir), http(limits(options)) {
     std::error_code ec;  // stat first: a manifest replaced meanwhile is then re-read on the first request
     manifest_size = fs::file_size(db_root.dir() / store::kManifestFileName, ec);
     manifest_mtime = fs::last_write_time(db_root.dir() / store::kManifestFileName, ec);
@@ -116,8 +167,19 @@ struct Server::Impl {
       throw FileError(player_root.dir().string(), "no index.html: not the web player's directory");
   }
 
+  /// One line, whatever the parts hold: fields a client sent are escaped by escape_for_log where the
+  /// line is made; this catches a line break from anywhere else (an error message quoting a file).
   void log(const std::string& line) const {
-    if (options.log) options.log(utc_now() + " " + line);
+    if (!options.log) return;
+    std::string out = utc_now() + " ";
+    for (const char c : line) {
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+        out += escape_for_log(std::string_view(&c, 1));
+      } else {
+        out += c;
+      }
+    }
+    options.log(out);
   }
 
   /// The manifest's size and mtime when `db` was opened: database.json re-opens the database only
@@ -149,22 +211,56 @@ struct Server::Impl {
 
   /// Token check for every request; true = go on routing.
   httplib::Server::HandlerResponse authorize(const httplib::Request& req, httplib::Response& res) {
+    // httplib calls this once the request line and headers are read, before it reads any body.
+    // A refused request closes the connection: a body left unread is then never parsed as the next
+    // request (issue 31: 883 MB buffered from an unauthenticated client).
+    const auto refuse = [&](int status, const std::string& why, const std::string& message) {
+      log(request_line(req) + " " + std::to_string(status) + " refused: " + why);
+      send_error(res, status, message);
+      res.set_header("Connection", "close");
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    if (!token_ok(req, res))
+      return refuse(401, "missing or wrong token",
+                    "this server needs a token: open the URL with ?token=... as printed by panoptes serve");
+    if (has_body(req))
+      return refuse(413, "a request body (" + escape_for_log(req.get_header_value("Content-Length"), 32) + ")",
+                    "this server is read-only: requests with a body are refused");
+    if (req.method != "GET" && req.method != "HEAD")
+      return refuse(405, "method", "this server is read-only: GET and HEAD only");
+    return httplib::Server::HandlerResponse::Unhandled;
+  }
+
+  bool token_ok(const httplib::Request& req, httplib::Response& res) const {
     const std::string& token = options.token;
-    if (token.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    if (token.empty()) return true;
     const std::string query = req.has_param("token") ? req.get_param_value("token") : "";
     if (!query.empty() && same_secret(query, token)) {
       // The browser then sends the cookie with every request of the page (scripts, movies).
       res.set_header("Set-Cookie", "panoptes_token=" + token + "; Path=/; HttpOnly; SameSite=Strict");
-      return httplib::Server::HandlerResponse::Unhandled;
+      return true;
     }
     const std::string auth = req.get_header_value("Authorization");
-    if (auth.rfind("Bearer ", 0) == 0 && same_secret(auth.substr(7), token))
-      return httplib::Server::HandlerResponse::Unhandled;
-    if (same_secret(cookie_value(req.get_header_value("Cookie"), "panoptes_token"), token))
-      return httplib::Server::HandlerResponse::Unhandled;
-    log(req.remote_addr + " " + req.method + " " + req.path + " 401 refused: missing or wrong token");
-    send_error(res, 401, "this server needs a token: open the URL with ?token=... as printed by panoptes serve");
-    return httplib::Server::HandlerResponse::Handled;
+    if (auth.rfind("Bearer ", 0) == 0 && same_secret(auth.substr(7), token)) return true;
+    return same_secret(cookie_value(req.get_header_value("Cookie"), "panoptes_token"), token);
+  }
+
+  /// The frames the movies can hold, when the manifest claims more than the first stream's movie has
+  /// bytes (a frame takes at least one): then that movie's fragment index (cached; its work is bounded
+  /// by the file's size) says how many it holds. -1 = not contradicted, or no movie to check against
+  /// (a missing or unreadable first movie is that stream's damage, not a measure of the others).
+  std::int64_t frames_backed(const store::Database& d) {
+    if (d.camera_count() == 0 || d.task_count() == 0 || d.frame_count() == 0) return -1;
+    const auto movie = db_root.resolve(d.manifest().stream_relative_path(0, 0));
+    if (!movie) return -1;
+    std::error_code ec;
+    const auto bytes = fs::file_size(*movie, ec);
+    if (ec || std::uintmax_t(d.frame_count()) <= bytes) return -1;
+    try {
+      return indexes.frame_count(*movie);
+    } catch (const Error&) {
+      return -1;
+    }
   }
 
   void serve_under(const SafeRoot& root, const std::string& relative, const httplib::Request& req,
@@ -172,18 +268,28 @@ struct Server::Impl {
     std::string why;
     store::FileHandle file = root.open(relative, &why);
     if (!file) {
-      log(req.remote_addr + " " + req.method + " " + req.path + " 404 refused: " + why);
+      log(request_line(req) + " 404 refused: " + why);
       return send_error(res, 404, "not found");
     }
-    send_file(res, std::move(file), content_type(fs::path(relative)));
+    send_file(res, std::move(file), content_type(fs::path(relative)), stopping);
   }
 
   void routes() {
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) { return authorize(req, res); });
     http.Get("/api/database.json", [this](const httplib::Request& req, httplib::Response& res) {
       res.set_header("Cache-Control", "no-cache");
-      const bool inline_cameras = req.has_param("cameras") && req.get_param_value("cameras") == "inline";
-      res.set_content(database_json(*database(true), inline_cameras).dump(), "application/json");
+      DatabaseJsonOptions o;
+      o.inline_cameras = req.has_param("cameras") && req.get_param_value("cameras") == "inline";
+      o.max_times = kTimesPerPage;
+      if (req.has_param("times_from")) {
+        const std::string from = req.get_param_value("times_from");
+        if (from.empty() || from.size() > 10 || from.find_first_not_of("0123456789") != std::string::npos)
+          return send_error(res, 400, "times_from=" + escape_for_log(from, 32) + ": expected a frame number");
+        o.times_from = std::stoull(from);
+      }
+      const auto d = database(true);
+      o.frames_backed = frames_backed(*d);
+      res.set_content(database_json(*d, o).dump(), "application/json");
     });
     http.Get(R"(/api/index/(\d{1,9})/(\d{1,9})\.json)", [this](const httplib::Request& req, httplib::Response& res) {
       const auto d = database(false);
@@ -194,14 +300,14 @@ struct Server::Impl {
       std::string why;
       const auto file = db_root.resolve(relative, &why);
       if (!file) {
-        log(req.remote_addr + " GET " + req.path + " 404 " + relative + ": " + why);
+        log(request_line(req) + " 404 " + relative + ": " + why);
         return send_error(res, 404, relative + ": " + why);
       }
       try {
         res.set_header("Cache-Control", "no-cache");
         res.set_content(*indexes.json(*file), "application/json");
       } catch (const Error& e) {
-        log(req.remote_addr + " GET " + req.path + " 422 " + e.what());
+        log(request_line(req) + " 422 " + e.what());
         send_error(res, 422, e.what());
       }
     });
@@ -213,8 +319,8 @@ struct Server::Impl {
       serve_under(player_root, relative.empty() ? "index.html" : relative, req, res);
     });
     http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
-      std::string line = req.remote_addr + " " + req.method + " " + req.path + " " + std::to_string(res.status);
-      if (req.has_header("Range")) line += " " + req.get_header_value("Range");
+      std::string line = request_line(req) + " " + std::to_string(res.status);
+      if (req.has_header("Range")) line += " " + escape_for_log(req.get_header_value("Range"), 128);
       log(line);
     });
   }
@@ -222,25 +328,38 @@ struct Server::Impl {
 
 Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {
   auto& o = impl_->options;
-  const std::size_t threads = std::size_t(std::max(1, o.threads));
-  impl_->http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  // A player makes hundreds of small range requests on its (at most 6) connections: keep them open
-  // instead of httplib's default of closing a connection after 5 requests.
-  impl_->http.set_keep_alive_max_count(1000);
+  auto& http = impl_->http;
+  const std::size_t warm = std::size_t(std::max(1, o.threads));
+  const std::size_t max = std::max(warm, std::size_t(std::max(1, o.max_connections)));
+  http.new_task_queue = [warm, max] { return new ConnectionThreads(warm, max); };
+  // Keep-alive, timeouts and request bounds are BoundedHttpServer's (it reads every connection);
+  // httplib only writes these two into its Keep-Alive header.
+  http.set_keep_alive_max_count(std::size_t(http.limits().max_requests));
+  http.set_keep_alive_timeout(http.limits().idle_seconds);
+  // Nothing here takes a body (authorize() refuses one unread); should httplib get to one anyway, it
+  // keeps none of it.
+  http.set_payload_max_length(0);
   impl_->routes();
   // httplib's default sets SO_REUSEPORT, which lets a second server bind the same port and silently
   // take half of the connections; SO_REUSEADDR alone still allows a quick restart.
-  impl_->http.set_socket_options([](socket_t sock) {
+  int* listen_socket = &impl_->listen_socket;
+  http.set_socket_options([listen_socket](socket_t sock) {
     int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    *listen_socket = sock;
   });
   if (o.port == 0) {
-    impl_->port = impl_->http.bind_to_any_port(o.bind);
+    impl_->port = http.bind_to_any_port(o.bind);
   } else {
-    impl_->port = impl_->http.bind_to_port(o.bind, o.port) ? o.port : -1;
+    impl_->port = http.bind_to_port(o.bind, o.port) ? o.port : -1;
   }
   if (impl_->port <= 0)
     throw Error("cannot listen on " + o.bind + ":" + std::to_string(o.port) + " (address in use or not available)");
+  // httplib listens with a backlog of 5 (compiled into Debian's library); listen() again on the
+  // listening socket only changes its backlog.
+  if (impl_->listen_socket < 0 || ::listen(impl_->listen_socket, kListenBacklog) != 0)
+    throw Error("cannot widen the listen backlog of " + url() + " to " + std::to_string(kListenBacklog) + ": " +
+                std::strerror(errno));
 }
 
 Server::~Server() { stop(); }
@@ -255,7 +374,11 @@ std::string Server::url() const {
 
 void Server::run() { impl_->http.listen_after_bind(); }
 
-void Server::stop() { impl_->http.stop(); }
+void Server::stop() {
+  impl_->stopping = true;
+  impl_->http.cut_connections();
+  impl_->http.stop();
+}
 
 fs::path find_player_dir() {
   std::vector<fs::path> tried;

@@ -8,10 +8,20 @@
 //
 // Nothing outside the database and the player directory can be reached (web/safe_path.hpp); with a
 // token, every request must carry it (?token=T once, which sets a cookie, or Authorization: Bearer T).
+//
+// Hostile clients (issue 31): request heads are read within bounds of bytes, lines and time
+// (web/bounded_http_server.hpp); the token is checked first, before anything else of a request is
+// used; a request with a body is refused (413, connection closed) without reading it, since nothing
+// here takes one; a client idle or not reading for `timeout_seconds` is dropped; each connection has
+// a thread of its own up to `max_connections` (web/connection_threads.hpp), so slow or idle clients
+// do not starve the rest; the listen backlog is kListenBacklog, TCP_NODELAY is set, and what a client
+// sent is escaped before it reaches the log.
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace panoptes::web {
 
@@ -22,10 +32,23 @@ struct ServerOptions {
   std::string bind = "127.0.0.1";    ///< address to listen on; localhost unless told otherwise
   int port = 8080;                   ///< 0 = any free port (see Server::port())
   std::string token;                 ///< empty = no token required
-  int threads = 16;                  ///< worker threads (concurrent connections served at once)
+  int threads = 16;                  ///< threads kept ready for connections
+  int max_connections = 1024;        ///< connections served at once (a thread each); later ones wait
+  int timeout_seconds = 5;           ///< a client idle (or not reading) this long is dropped; a request
+                                     ///< head must arrive within twice this
   /// Receives one line per request and per refusal (no trailing newline); empty = silent.
   std::function<void(const std::string&)> log;
 };
+
+/// The listen backlog (cpp-httplib's own is 5: a burst of clients beyond that waited for SYN retries).
+inline constexpr int kListenBacklog = 1024;
+/// Times listed per database.json response (`?times_from=N` gives the next page).
+inline constexpr std::size_t kTimesPerPage = 65536;
+
+/// What a client sent, made safe for a one-line log: control characters, backslashes and bytes
+/// outside printable ASCII become \xNN (so "%0a" in a path cannot start a forged log line), and
+/// more than `max` bytes are cut with the count of the rest.
+std::string escape_for_log(std::string_view text, std::size_t max = 512);
 
 /// An HTTP server bound to its address from construction until destruction.
 class Server {
@@ -43,7 +66,8 @@ class Server {
   std::string url() const;
   /// Serves until stop() is called (from another thread).
   void run();
-  /// Makes run() return; safe from any thread.
+  /// Makes run() return; safe from any thread. Connections being served are cut at their next
+  /// read, write or 64 kB of a file sent, so run() returns within about `timeout_seconds`.
   void stop();
 
  private:

@@ -14,70 +14,16 @@
 #include "store/manifest.hpp"
 #include "store/synthetic.hpp"
 #include "store/test_support.hpp"
+#include "web/server_test_support.hpp"
 
 namespace panoptes::web {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// A database, a player directory and a secret file beside them that must never be served.
-struct Fixture {
-  store::testing::TempDir tmp{"web-server"};
-  fs::path db = tmp.path / "db", player = tmp.path / "player", secret = tmp.path / "secret.txt";
-  Fixture() {
-    store::SyntheticOptions o;
-    o.cameras = 3;
-    o.tasks = 2;
-    o.frames = 5;
-    o.width = 64;
-    o.height = 48;
-    o.video.gop = 2;
-    o.threads = 1;
-    store::write_synthetic_database(db, o);
-    // A preferred playback rate, as the demo records one (the web player plays at it, as the desktop one).
-    store::Manifest m = store::read_manifest(db / store::kManifestFileName);
-    m.playback_fps = 12.5;
-    store::write_manifest_atomic(db / store::kManifestFileName, m);
-    fs::create_directories(player);
-    std::ofstream(player / "index.html") << "<!doctype html><title>player</title>";
-    std::ofstream(secret) << "TOP-SECRET-CONTENT";
-    // Links out of the database (a directory and a file) and one that stays inside.
-    fs::create_directory_symlink(tmp.path, db / "movies" / "outside");
-    fs::create_symlink(secret, db / "movies" / "c0" / "secret.mp4");
-    fs::create_symlink(db / "movies" / "c0" / "t0.mp4", db / "movies" / "inside.mp4");
-  }
-};
-
-/// A server on a free port, running in a thread for the test's lifetime.
-struct Running {
-  Server server;
-  std::thread thread;
-  explicit Running(ServerOptions o) : server(std::move(o)) {
-    thread = std::thread([this] { server.run(); });
-    httplib::Client probe("127.0.0.1", server.port());
-    for (int i = 0; i < 200 && !probe.Get("/api/database.json"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ~Running() {
-    server.stop();
-    thread.join();
-  }
-};
-
-ServerOptions options(const Fixture& f, std::string token = {}) {
-  ServerOptions o;
-  o.database = f.db;
-  o.player_dir = f.player;
-  o.port = 0;
-  o.token = std::move(token);
-  return o;
-}
+using testing::Fixture;
+using testing::options;
+using testing::read_file;
+using testing::Running;
 
 TEST(Server, ServesDatabaseJsonIndexAndByteRanges) {
   Fixture f;
