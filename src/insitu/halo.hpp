@@ -65,17 +65,18 @@ std::array<std::int64_t, 3> field_strides(const LocalBlock& b, const std::array<
 /// points that r does not trust).
 bool fetches(const std::vector<BlockInfo>& blocks, int r, int s);
 
-/// Fills `out` (float32, x-fastest over `region`, resized by the caller) with the fields of rank
-/// `rank` over the box `region`: points `rank` trusts from its arrays (`inputs`, one per field), the
-/// others received from their owners; meanwhile sends other ranks what they fetch from `rank`.
-/// Collective over `comm` when `exchange` (some rank fetches); otherwise purely local.
+/// The per-snapshot field gathering of one rank (built once by the session from every rank's block).
 struct Exchange {
-  const std::vector<BlockInfo>* blocks = nullptr;
+  const std::vector<BlockInfo>* blocks = nullptr;  ///< every rank's block, in rank order
   int rank = 0, size = 1;
-  bool needed = false;  ///< some rank fetches from another
+  bool needed = false;  ///< some rank fetches from another: load() is then collective over `comm`
 #ifdef PANOPTES_HAVE_MPI
   MPI_Comm comm = MPI_COMM_NULL;
 #endif
+  /// Fills `out` (one float32 buffer per field, x-fastest over `region`, sized by the caller) with
+  /// this rank's fields over `region`: the points it trusts from its arrays (`inputs`, one per
+  /// field), the others received from their owners; meanwhile sends every other rank what it
+  /// fetches from this one.
   void load(const std::vector<const FieldInput*>& inputs, const Box& region, std::vector<std::vector<float>>& out) const;
 };
 

@@ -268,7 +268,7 @@ void Session::Impl::check_resources() {
 #endif
       refusal = memory_refusal(estimate_session_memory(cfg, points, cameras, size, omp_get_max_threads()),
                                available_memory(), sharing, "this in-situ session",
-                               "set check_memory = false in [resources] (panoptes run --force)");
+                               "set check_memory = false in [resources]");
     }
   } catch (const std::exception& e) {
     refusal = e.what();

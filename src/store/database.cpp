@@ -509,15 +509,20 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
       throw FileError(path.string(), "missing: the database's last checkpoint has " + std::to_string(frames) +
                                          " frames in every movie; cannot resume it");
     if (!S_ISREG(st.st_mode)) throw FileError(path.string(), "is not a regular file; cannot resume it");
-    const video::MovieReader old(path.string());
-    if (old.frame_count() < frames)
-      throw FileError(path.string(), "holds " + std::to_string(old.frame_count()) + " readable frames, the database's last "
+    std::unique_ptr<video::MovieReader> old;
+    try {
+      old = std::make_unique<video::MovieReader>(path.string());
+    } catch (const Error& e) {
+      throw FileError(path.string(), std::string("unreadable (") + e.what() + "); cannot resume it");
+    }
+    if (old->frame_count() < frames)
+      throw FileError(path.string(), "holds " + std::to_string(old->frame_count()) + " readable frames, the database's last "
                                          "checkpoint " + std::to_string(frames) + "; cannot resume it");
     const std::string temp = leaf + ".resume";
     FileHandle file = open_for_writing(movie_dir.get(), temp, true, "movie", path.parent_path());
     auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), man.image.width, man.image.height,
                                                        man.video);
-    writer->copy_frames(old, frames);
+    writer->copy_frames(*old, frames);
     writer->flush();
     if (::renameat(movie_dir.get(), temp.c_str(), movie_dir.get(), leaf.c_str()) != 0)
       throw FileError(path.string(), std::string("cannot replace the movie by its continued copy: ") + std::strerror(errno));
