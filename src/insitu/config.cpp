@@ -215,11 +215,18 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   only_keys(c, root, "", allowed);
   SessionConfig s;
   if (const auto* o = table(c, root, "output")) {
-    only_keys(c, *o, "output", {"dir", "overwrite", "title", "units"});
+    only_keys(c, *o, "output", {"dir", "overwrite", "title", "units", "time_units", "field_units"});
     s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
     s.overwrite = boolean(c, *o, "overwrite", "output.", false);
     s.title = str(c, *o, "title", "output.", s.title);
     s.units = str(c, *o, "units", "output.", "");
+    s.time_units = str(c, *o, "time_units", "output.", "");
+    if (const auto* fu = table(c, *o, "field_units"))
+      for (const auto& [name, value] : *fu) {
+        const auto* text = value.as_string();
+        if (!text) c.fail("output.field_units." + std::string(name.str()), "expected a string (the unit, e.g. \"1/s\")");
+        s.field_units[std::string(name.str())] = text->get();
+      }
   }
   if (const auto* im = table(c, root, "image")) {
     only_keys(c, *im, "image", {"width", "height", "background", "outline"});
@@ -367,7 +374,8 @@ SessionConfig load_session_config(const std::string& path, const std::vector<std
 const char* config_keys_help() {
   return R"(IN-SITU CONFIGURATION (TOML). Unknown keys, wrong types and impossible values are errors.
 [output]    dir = "panoptes_out" (database directory); overwrite = false; title = "in-situ visualization";
-            units = "" (length unit of the grid)
+            units = "" (length unit of the grid); time_units = "" (unit of the snapshot times, e.g. "s");
+            field_units = {} (unit of each field's values, e.g. { phi_p = "1/s" }: the players' colour legends)
 [image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box)
 [rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,
             optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R);

@@ -113,6 +113,15 @@ struct Task {
   store::TaskEntry entry;
 };
 
+// The transfer function as data (control points), so players draw its colour legend without knowing
+// the renderer's presets (issue 34).
+nlohmann::json transfer_json(const render::TransferFunction& tf) {
+  nlohmann::json colour = nlohmann::json::array(), extinction = nlohmann::json::array();
+  for (const auto& p : tf.colour) colour.push_back({p.x, p.colour.r, p.colour.g, p.colour.b});
+  for (const auto& p : tf.opacity) extinction.push_back({p.x, p.extinction});
+  return {{"colour", std::move(colour)}, {"extinction", std::move(extinction)}, {"absolute_value", tf.absolute_value}};
+}
+
 std::string fmt(double v) {
   std::ostringstream s;
   s << v;
@@ -153,6 +162,7 @@ struct Session::Impl {
   std::vector<std::vector<float>> buffers;  // per field, over blocks[rank].required
   std::vector<render::PreparedField> prepared;
   std::vector<render::RunningMax> references;
+  std::vector<double> last_references;  // per field, this snapshot's (recorded in the manifest)
   std::vector<std::vector<render::PartialImage>> partials;  // [slot][task]
   std::vector<std::vector<char>> send_buf;                  // [slot]
   std::vector<char> recv_buf;
@@ -375,7 +385,8 @@ void Session::Impl::build_tasks() {
           t.relative = w.relative;
           t.entry.method = "volume";
           t.entry.parameters = {{"preset", tc.preset}, {"window", {w.lo, w.hi}}, {"relative", w.relative},
-                                {"extinction_scale", tc.extinction_scale}};
+                                {"extinction_scale", tc.extinction_scale},
+                                {"transfer_function", transfer_json(t.spec.tf)}};
           break;
         }
         case TaskConfig::Kind::volume2: {
@@ -389,7 +400,10 @@ void Session::Impl::build_tasks() {
           t.entry.method = "volume";
           t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
                                 {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
-                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale}};
+                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale},
+                                {"relative2", tc.window2.relative},
+                                {"transfer_function", transfer_json(t.spec.tf)},
+                                {"transfer_function2", transfer_json(t.spec.tf2)}};
           break;
         }
         case TaskConfig::Kind::isosurface:
@@ -398,7 +412,8 @@ void Session::Impl::build_tasks() {
           t.iso_relative = tc.iso_relative;
           t.iso_fraction = tc.isovalues[i];
           t.entry.method = "isosurface";
-          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative}};
+          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative},
+                                {"colour", {tc.colour[0], tc.colour[1], tc.colour[2]}}};
           break;
         case TaskConfig::Kind::slice: {
           const WindowConfig& w = tc.windows[0];
@@ -409,7 +424,7 @@ void Session::Impl::build_tasks() {
           t.entry.method = "slice";
           t.entry.parameters = {{"axis", std::string(1, char('x' + a))}, {"fraction", tc.slice_positions[i]},
                                 {"position", pos}, {"preset", tc.preset}, {"window", {w.lo, w.hi}},
-                                {"relative", w.relative}};
+                                {"relative", w.relative}, {"transfer_function", transfer_json(t.spec.tf)}};
           break;
         }
       }
@@ -465,6 +480,11 @@ store::Manifest Session::Impl::make_manifest() const {
   }
   for (const Task& t : tasks) man.tasks.push_back(t.entry);
   man.axes = axes_;
+  man.time_units = cfg.time_units;
+  for (const std::string& f : field_names) {
+    const auto unit = cfg.field_units.find(f);
+    man.fields.push_back({f, unit == cfg.field_units.end() ? std::string() : unit->second, {}});
+  }
   return man;
 }
 
@@ -779,6 +799,8 @@ void Session::Impl::checkpoint(double t) {
 #endif
   if (rank == 0) {
     writer->set_time(snapshots - 1, t);
+    for (std::size_t f = 0; f < last_references.size(); ++f)
+      writer->set_field_reference(snapshots - 1, int(f), last_references[f]);
     writer->checkpoint(frames == INT_MAX ? snapshots : frames);
   }
   time.checkpoint += since(t0);
@@ -861,6 +883,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
     const double q = m.global_percentile(int(f));
     ref[f] = std::max(m.cfg.running_max ? m.references[f].update(q) : q, 1e-30);
   }
+  m.last_references = ref;
   for (std::size_t i = 0; i < m.tasks.size(); ++i) {
     const Task& t = m.tasks[i];
     render::TaskSpec& s = m.specs[i];
