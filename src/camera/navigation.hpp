@@ -41,6 +41,9 @@ class MoveTrail {
   /// are where it led, else graph_target. Records the step (a retrace removes it). O(1), and it
   /// allocates only until kMaxSteps steps were recorded once.
   int next(int camera, Move move, int graph_target);
+  /// The camera the opposite of the last move leads back to from `camera`, or −1 when the trail does
+  /// not end at `camera` (players prefetch it with the graph's neighbours).
+  int previous(int camera) const { return !steps_.empty() && steps_.back().to == camera ? steps_.back().from : -1; }
   /// Forgets every step.
   void clear() { steps_.clear(); }
   int size() const { return int(steps_.size()); }

@@ -175,6 +175,8 @@ TEST(Navigation, MoveTrailRetracesAndForgets) {
   MoveTrail t;
   EXPECT_EQ(t.next(0, Move::up, 5), 5);
   EXPECT_EQ(t.next(5, Move::up, 7), 7);
+  EXPECT_EQ(t.previous(7), 5);
+  EXPECT_EQ(t.previous(5), -1);
   EXPECT_EQ(t.next(7, Move::down, 9), 5) << "retrace, not the graph's 9";
   EXPECT_EQ(t.next(5, Move::down, 9), 0);
   EXPECT_EQ(t.size(), 0);

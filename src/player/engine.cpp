@@ -373,7 +373,8 @@ struct Engine::Impl {
       const auto& n = man.graph.neighbours[std::size_t(sel.camera)];
       const Vec3 here = man.cameras[std::size_t(sel.camera)].position;
       int slot = 0;
-      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out}) {
+      // The camera the opposite arrow key retraces to (MoveTrail) is a neighbour too, after the graph's.
+      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out, trail.previous(sel.camera)}) {
         ++slot;
         if (c < 0 || c == sel.camera || c >= cameras) continue;
         int rank = slot;
