@@ -116,9 +116,11 @@ struct Task {
 // The transfer function as data (control points), so players draw its colour legend without knowing
 // the renderer's presets (issue 34).
 nlohmann::json transfer_json(const render::TransferFunction& tf) {
+  // The presets are floats: 0.9f would read 0.8999999761581421 in the manifest.
+  const auto v = [](float x) { return std::round(double(x) * 1e6) / 1e6; };
   nlohmann::json colour = nlohmann::json::array(), extinction = nlohmann::json::array();
-  for (const auto& p : tf.colour) colour.push_back({p.x, p.colour.r, p.colour.g, p.colour.b});
-  for (const auto& p : tf.opacity) extinction.push_back({p.x, p.extinction});
+  for (const auto& p : tf.colour) colour.push_back({v(p.x), v(p.colour.r), v(p.colour.g), v(p.colour.b)});
+  for (const auto& p : tf.opacity) extinction.push_back({v(p.x), v(p.extinction)});
   return {{"colour", std::move(colour)}, {"extinction", std::move(extinction)}, {"absolute_value", tf.absolute_value}};
 }
 
