@@ -116,6 +116,12 @@ void run(const Options& o) {
                          {"covering_deg", st.covering_deg},
                          {"right_left_return", st.right_left_return},
                          {"up_down_return", st.up_down_return},
+                         {"left_right_return", st.left_right_return},
+                         {"down_up_return", st.down_up_return},
+                         {"right_left_undo", st.right_left_undo},
+                         {"left_right_undo", st.left_right_undo},
+                         {"up_down_undo", st.up_down_undo},
+                         {"down_up_undo", st.down_up_undo},
                          {"missing_moves", st.missing_moves},
                          {"reachable_from_0", st.reachable_from_0},
                          {"strongly_connected", st.strongly_connected}};
@@ -172,8 +178,17 @@ void run(const Options& o) {
       std::printf("nearest neighbour    %.3f .. %.3f deg (max/min %.3f)\n", st.min_nearest_deg, st.max_nearest_deg,
                   st.min_nearest_deg > 0 ? st.max_nearest_deg / st.min_nearest_deg : 0.0);
       std::printf("covering radius      %.3f deg (no direction farther from a camera)\n", st.covering_deg);
-      std::printf("right then left      returns for %.1f %% of cameras\n", 100 * st.right_left_return);
-      std::printf("up then down         returns for %.1f %% of cameras\n", 100 * st.up_down_return);
+      // What a user sees (the players retrace the last moves) and what the graph alone gives.
+      const struct {
+        const char* name;
+        double undo, graph;
+      } pairs[] = {{"right then left", st.right_left_undo, st.right_left_return},
+                   {"left then right", st.left_right_undo, st.left_right_return},
+                   {"up then down", st.up_down_undo, st.up_down_return},
+                   {"down then up", st.down_up_undo, st.down_up_return}};
+      for (const auto& p : pairs)
+        std::printf("%-20s returns for %.1f %% of cameras in the players (graph alone %.1f %%)\n", p.name, 100 * p.undo,
+                    100 * p.graph);
       std::printf("missing moves        %.1f %% of right/left/up/down\n", 100 * st.missing_moves);
       std::printf("reachable            %d of %d from camera 0, %s\n", st.reachable_from_0, rig.size(),
                   st.strongly_connected ? "strongly connected" : "NOT strongly connected");

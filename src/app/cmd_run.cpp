@@ -125,6 +125,9 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   cfg.program = "panoptes run";
   cfg.command_line = options.command_line;
   cfg.units = "m";
+  // The solver works in SI: times in s, velocities in m/s, so phi_p = div v and phi_s = |curl v| are in 1/s.
+  if (cfg.time_units.empty()) cfg.time_units = "s";
+  for (const char* f : {"phi_p", "phi_s"}) cfg.field_units.try_emplace(f, "1/s");
   // Depth is +z (down): the sky is −z, so the rig's poles, latitudes and the images' up follow it
   // (the free surface at the top of every image) unless the file says otherwise.
   if (cfg.up_axis.empty()) cfg.up_axis = "z_down";

@@ -29,6 +29,32 @@ int Neighbours::operator[](Move m) const {
   return -1;
 }
 
+Move opposite(Move m) {
+  switch (m) {
+    case Move::right: return Move::left;
+    case Move::left: return Move::right;
+    case Move::up: return Move::down;
+    case Move::down: return Move::up;
+    case Move::in: return Move::out;
+    case Move::out: return Move::in;
+  }
+  return m;
+}
+
+int MoveTrail::next(int camera, Move move, int graph_target) {
+  if (!steps_.empty() && steps_.back().to != camera) steps_.clear();  // moved by other means
+  if (!steps_.empty() && steps_.back().move == opposite(move)) {
+    const int back = steps_.back().from;
+    steps_.pop_back();
+    return back;
+  }
+  if (graph_target < 0 || graph_target == camera) return graph_target;
+  if (int(steps_.size()) == kMaxSteps) steps_.erase(steps_.begin(), steps_.begin() + kMaxSteps / 2);
+  if (steps_.capacity() < std::size_t(kMaxSteps)) steps_.reserve(kMaxSteps);
+  steps_.push_back({camera, graph_target, move});
+  return graph_target;
+}
+
 CameraLocator::CameraLocator(const Rig& rig) {
   std::vector<Vec3> positions;
   std::vector<int> shells;

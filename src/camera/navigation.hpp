@@ -22,6 +22,40 @@ struct Neighbours {
   bool operator==(const Neighbours&) const = default;
 };
 
+/// The opposite move (right <-> left, up <-> down, in <-> out).
+Move opposite(Move move);
+
+/// The players' arrow-key rule on top of the graph (issue 34, "navigation that undoes itself"): a
+/// move opposite to the last move(s) retraces them, so Up, Up, Down, Down comes back to the start
+/// camera even where the graph's pairs are not mutual. No static graph can make them mutual on the
+/// shipped 130-camera rigs: near the sky poles each camera's Up points at the pole, so several
+/// cameras share the camera above them, which has one Down (docs/cameras.md, "Moves that undo
+/// themselves"). Every other move follows the graph. Front ends (window, headless, Python, browser)
+/// keep one trail per viewer; a selection made otherwise (drag, mini-map, jump) starts a new trail.
+class MoveTrail {
+ public:
+  /// Steps remembered; older ones are forgotten (a retrace stops there and follows the graph).
+  static constexpr int kMaxSteps = 256;
+  /// The camera that `move` from `camera` leads to, given the graph's neighbour `graph_target` in that
+  /// direction (−1 = none): the camera the last step came from when `move` reverses that step and we
+  /// are where it led, else graph_target. Records the step (a retrace removes it). O(1), and it
+  /// allocates only until kMaxSteps steps were recorded once.
+  int next(int camera, Move move, int graph_target);
+  /// The camera the opposite of the last move leads back to from `camera`, or −1 when the trail does
+  /// not end at `camera` (players prefetch it with the graph's neighbours).
+  int previous(int camera) const { return !steps_.empty() && steps_.back().to == camera ? steps_.back().from : -1; }
+  /// Forgets every step.
+  void clear() { steps_.clear(); }
+  int size() const { return int(steps_.size()); }
+
+ private:
+  struct Step {
+    int from, to;
+    Move move;
+  };
+  std::vector<Step> steps_;
+};
+
 /// Plain-data graph: exactly one entry per camera of the rig it was built for.
 struct NavigationGraph {
   std::vector<Neighbours> neighbours;

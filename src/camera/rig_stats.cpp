@@ -147,15 +147,34 @@ RigStatistics rig_statistics(const Rig& rig, const NavigationGraph& graph) {
     }
     st.covering_deg = std::max(st.covering_deg, covering_radius(index) / kDeg);
   }
-  int rl = 0, ud = 0, missing = 0;
+  const Move moves[4] = {Move::right, Move::left, Move::up, Move::down};
+  int graph_returns[4] = {0, 0, 0, 0}, undo_returns[4] = {0, 0, 0, 0}, missing = 0;
+  MoveTrail trail;
   for (int c = 0; c < graph.size(); ++c) {
     const Neighbours& nb = graph.neighbours[c];
-    if (nb.right >= 0 && graph.neighbours[nb.right].left == c) ++rl;
-    if (nb.up >= 0 && graph.neighbours[nb.up].down == c) ++ud;
     missing += (nb.right < 0) + (nb.left < 0) + (nb.up < 0) + (nb.down < 0);
+    for (int k = 0; k < 4; ++k) {
+      const Move m = moves[k], back = opposite(m);
+      const int j = nb[m];
+      if (j >= 0 && graph.next(j, back) == c) ++graph_returns[k];
+      // As a player presses the keys: once there and back, then twice there and twice back.
+      auto press = [&](int from, Move move) { return from < 0 ? -1 : trail.next(from, move, graph.next(from, move)); };
+      trail.clear();
+      const int once = press(press(c, m), back);
+      trail.clear();
+      const int twice = press(press(press(press(c, m), m), back), back);
+      if (j >= 0 && once == c && twice == c) ++undo_returns[k];
+    }
   }
-  st.right_left_return = double(rl) / graph.size();
-  st.up_down_return = double(ud) / graph.size();
+  const double n = graph.size();
+  st.right_left_return = graph_returns[0] / n;
+  st.left_right_return = graph_returns[1] / n;
+  st.up_down_return = graph_returns[2] / n;
+  st.down_up_return = graph_returns[3] / n;
+  st.right_left_undo = undo_returns[0] / n;
+  st.left_right_undo = undo_returns[1] / n;
+  st.up_down_undo = undo_returns[2] / n;
+  st.down_up_undo = undo_returns[3] / n;
   st.missing_moves = double(missing) / (4.0 * graph.size());
   st.reachable_from_0 = reachable_count(graph, 0);
   st.strongly_connected = is_strongly_connected(graph, st.reachable_from_0);

@@ -28,6 +28,11 @@ struct RigStatistics {
   double covering_deg = 0;     ///< largest covering radius of the shells
   double right_left_return = 0;  ///< fraction of cameras c with left(right(c)) == c
   double up_down_return = 0;     ///< fraction of cameras c with down(up(c)) == c
+  double left_right_return = 0;  ///< fraction of cameras c with right(left(c)) == c
+  double down_up_return = 0;     ///< fraction of cameras c with up(down(c)) == c
+  /// As the four above, but through the players' MoveTrail (what a user sees): the fraction of cameras
+  /// where the move then the opposite move, and the move twice then the opposite twice, come back.
+  double right_left_undo = 0, left_right_undo = 0, up_down_undo = 0, down_up_undo = 0;
   double missing_moves = 0;      ///< fraction of (camera, right/left/up/down) with no neighbour
   int reachable_from_0 = 0;      ///< cameras reachable from camera 0 along graph edges
   bool strongly_connected = false;  ///< every camera reaches every other one

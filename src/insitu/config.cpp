@@ -230,7 +230,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   only_keys(c, root, "", allowed);
   SessionConfig s;
   if (const auto* o = table(c, root, "output")) {
-    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "title", "units"});
+    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "title", "units", "time_units", "field_units"});
     s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
     // `overwrite = true/false` is the key's old spelling: it still means mode "overwrite"/"create".
     if (o->get("mode") && o->get("overwrite"))
@@ -248,6 +248,13 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     }
     s.title = str(c, *o, "title", "output.", s.title);
     s.units = str(c, *o, "units", "output.", "");
+    s.time_units = str(c, *o, "time_units", "output.", "");
+    if (const auto* fu = table(c, *o, "field_units"))
+      for (const auto& [name, value] : *fu) {
+        const auto* text = value.as_string();
+        if (!text) c.fail("output.field_units." + std::string(name.str()), "expected a string (the unit, e.g. \"1/s\")");
+        s.field_units[std::string(name.str())] = text->get();
+      }
   }
   if (const auto* im = table(c, root, "image")) {
     only_keys(c, *im, "image", {"width", "height", "background", "outline"});
@@ -395,7 +402,8 @@ SessionConfig load_session_config(const std::string& path, const std::vector<std
 const char* config_keys_help() {
   return R"(IN-SITU CONFIGURATION (TOML). Unknown keys, wrong types and impossible values are errors.
 [output]    dir = "panoptes_out" (database directory); title = "in-situ visualization";
-            units = "" (length unit of the grid);
+            units = "" (length unit of the grid); time_units = "" (unit of the snapshot times, e.g. "s");
+            field_units = {} (unit of each field's values, e.g. { phi_p = "1/s" }: the players' colour legends);
             mode = "create" (refuse a directory that holds a database) | "overwrite" (replace it) |
             "resume" (continue it after a checkpoint restart: its snapshots stay, snapshots repeated by
             the restarted run (time <= the last written time) are skipped, the movies go on; rig, tasks,

@@ -2,6 +2,7 @@
 // Configuration of an in-situ session (plain data) and its TOML form, shared by the C++ API, the C
 // API and `panoptes run`. Every key is documented by config_keys_help().
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,9 @@ struct SessionConfig {
   std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
   std::string command_line;
   std::string units;                  ///< length unit of the grid, for the manifest
+  std::string time_units;             ///< unit of the snapshot times, for the manifest (e.g. "s")
+  /// Unit of each field's values by field name, for the manifest's colour legends (e.g. phi_p: "1/s").
+  std::map<std::string, std::string> field_units;
   std::string rig = "yinyang";        ///< camera::RigSpec string
   std::array<double, 3> up{0, 0, 0};  ///< requested up vector of the rig's cameras (world); 0 = the sky
   std::string up_axis;                ///< which way is up in the domain: "z_up" / "z_down"; "" = z_up

@@ -67,6 +67,17 @@ struct Task {
   store::TaskEntry entry;
 };
 
+// The transfer function as data (control points), so players draw its colour legend without knowing
+// the renderer's presets (issue 34).
+nlohmann::json transfer_json(const render::TransferFunction& tf) {
+  // The presets are floats: 0.9f would read 0.8999999761581421 in the manifest.
+  const auto v = [](float x) { return std::round(double(x) * 1e6) / 1e6; };
+  nlohmann::json colour = nlohmann::json::array(), extinction = nlohmann::json::array();
+  for (const auto& p : tf.colour) colour.push_back({v(p.x), v(p.colour.r), v(p.colour.g), v(p.colour.b)});
+  for (const auto& p : tf.opacity) extinction.push_back({v(p.x), v(p.extinction)});
+  return {{"colour", std::move(colour)}, {"extinction", std::move(extinction)}, {"absolute_value", tf.absolute_value}};
+}
+
 std::string fmt(double v) {
   std::ostringstream s;
   s << v;
@@ -111,6 +122,7 @@ struct Session::Impl {
   std::vector<std::vector<float>> buffers;  // per field, over blocks[rank].required
   std::vector<render::PreparedField> prepared;
   std::vector<render::RunningMax> references;
+  std::vector<double> last_references;  // per field, this snapshot's (recorded in the manifest)
   std::vector<std::vector<render::PartialImage>> partials;  // [slot][task]
   std::vector<std::vector<char>> send_buf;                  // [slot]
   std::vector<char> recv_buf;
@@ -330,7 +342,8 @@ void Session::Impl::build_tasks() {
           t.relative = w.relative;
           t.entry.method = "volume";
           t.entry.parameters = {{"preset", tc.preset}, {"window", {w.lo, w.hi}}, {"relative", w.relative},
-                                {"extinction_scale", tc.extinction_scale}};
+                                {"extinction_scale", tc.extinction_scale},
+                                {"transfer_function", transfer_json(t.spec.tf)}};
           break;
         }
         case TaskConfig::Kind::volume2: {
@@ -344,7 +357,10 @@ void Session::Impl::build_tasks() {
           t.entry.method = "volume";
           t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
                                 {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
-                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale}};
+                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale},
+                                {"relative2", tc.window2.relative},
+                                {"transfer_function", transfer_json(t.spec.tf)},
+                                {"transfer_function2", transfer_json(t.spec.tf2)}};
           break;
         }
         case TaskConfig::Kind::isosurface:
@@ -353,7 +369,8 @@ void Session::Impl::build_tasks() {
           t.iso_relative = tc.iso_relative;
           t.iso_fraction = tc.isovalues[i];
           t.entry.method = "isosurface";
-          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative}};
+          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative},
+                                {"colour", {tc.colour[0], tc.colour[1], tc.colour[2]}}};
           break;
         case TaskConfig::Kind::slice: {
           const WindowConfig& w = tc.windows[0];
@@ -364,7 +381,7 @@ void Session::Impl::build_tasks() {
           t.entry.method = "slice";
           t.entry.parameters = {{"axis", std::string(1, char('x' + a))}, {"fraction", tc.slice_positions[i]},
                                 {"position", pos}, {"preset", tc.preset}, {"window", {w.lo, w.hi}},
-                                {"relative", w.relative}};
+                                {"relative", w.relative}, {"transfer_function", transfer_json(t.spec.tf)}};
           break;
         }
       }
@@ -420,6 +437,11 @@ store::Manifest Session::Impl::make_manifest() const {
   }
   for (const Task& t : tasks) man.tasks.push_back(t.entry);
   man.axes = axes_;
+  man.time_units = cfg.time_units;
+  for (const std::string& f : field_names) {
+    const auto unit = cfg.field_units.find(f);
+    man.fields.push_back({f, unit == cfg.field_units.end() ? std::string() : unit->second, {}});
+  }
   return man;
 }
 
@@ -678,6 +700,8 @@ void Session::Impl::checkpoint(double t) {
       for (const render::RunningMax& r : references) refs.push_back(r.value());
       writer->set_note(kRunningMaxNote, format_references(refs));
     }
+    for (std::size_t f = 0; f < last_references.size(); ++f)
+      writer->set_field_reference(snapshots - 1, int(f), last_references[f]);
     writer->checkpoint(frames == INT_MAX ? snapshots : frames);
   }
   time.checkpoint += since(t0);
@@ -769,6 +793,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
     const double q = m.window_reference(int(f));
     ref[f] = std::max(m.cfg.running_max ? m.references[f].update(q) : q, 1e-30);
   }
+  m.last_references = ref;
   for (std::size_t i = 0; i < m.tasks.size(); ++i) {
     const Task& t = m.tasks[i];
     render::TaskSpec& s = m.specs[i];

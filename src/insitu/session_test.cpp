@@ -42,6 +42,13 @@ TEST(InsituConfig, DefaultsAndSweeps) {
   ASSERT_EQ(c.tasks.size(), 2u);
   EXPECT_EQ(c.tasks[1].isovalues.size(), 3u);
   EXPECT_TRUE(c.tasks[0].windows[0].relative);
+  EXPECT_TRUE(c.time_units.empty());
+  EXPECT_TRUE(c.field_units.empty());
+  const auto u = insitu::parse_session_config_text(
+      std::string("[output]\ntime_units = \"s\"\nfield_units = { f = \"1/s\" }\n") + kTask, "u");
+  EXPECT_EQ(u.time_units, "s");
+  EXPECT_EQ(u.field_units.at("f"), "1/s");
+  EXPECT_THROW(insitu::parse_session_config_text(std::string("[output]\nfield_units = { f = 1 }\n") + kTask, "u"), Error);
 }
 
 TEST(InsituConfig, ErrorsNameTheKey) {
@@ -199,6 +206,8 @@ TEST(InsituSession, SnapshotsScheduleAndFinalize) {
   auto cfg = small_config(dir);
   cfg.schedule.every_steps = 0;
   cfg.schedule.every_time = 0.25;
+  cfg.time_units = "s";
+  cfg.field_units = {{"f", "1/s"}};
   insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
   int taken = 0;
   for (int step = 0; step < 10; ++step) {
@@ -215,6 +224,18 @@ TEST(InsituSession, SnapshotsScheduleAndFinalize) {
   EXPECT_EQ(db.manifest().axes[0].name, "iso isovalue");
   EXPECT_EQ(db.manifest().step_task_on_axis(1, "iso isovalue", 1), 2);
   EXPECT_NEAR(db.manifest().frame_time(1), 0.3, 1e-12);
+  // Issue 34: what the colour legends need — units, each frame's reference of the relative windows
+  // (the 99.9th percentile of |f|, grows as the front does) and the transfer function as data.
+  const store::Manifest& m = db.manifest();
+  EXPECT_EQ(m.time_units, "s");
+  ASSERT_EQ(m.fields.size(), 1u);
+  EXPECT_EQ(m.fields[0].name, "f");
+  EXPECT_EQ(m.fields[0].units, "1/s");
+  ASSERT_EQ(m.fields[0].references.size(), 4u);
+  for (double r : m.fields[0].references) EXPECT_GT(r, 0.5);
+  const auto& tf = m.tasks[0].parameters.at("transfer_function");
+  EXPECT_EQ(tf.at("colour").size(), 4u);  // the "hot" preset's control points
+  EXPECT_EQ(m.tasks[1].parameters.at("colour").size(), 3u);
   fs::remove_all(dir);
 }
 

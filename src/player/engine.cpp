@@ -12,6 +12,7 @@
 #include <mutex>
 #include <thread>
 
+#include "camera/navigation.hpp"
 #include "core/error.hpp"
 #include "player/frame_cache.hpp"
 #include "player/reader_pool.hpp"
@@ -117,6 +118,7 @@ struct Engine::Impl {
   TimeSource now;
   int cameras = 0, tasks = 0, frames = 0;
   std::vector<double> times;  // frame times, refreshed with frames
+  camera::MoveTrail trail;    // arrow-key moves, so the opposite key retraces them
   store::Status db_status = store::Status::complete;
   double last_refresh = 0;  // playback-clock time of the last automatic refresh
   double fps = 30;
@@ -371,7 +373,8 @@ struct Engine::Impl {
       const auto& n = man.graph.neighbours[std::size_t(sel.camera)];
       const Vec3 here = man.cameras[std::size_t(sel.camera)].position;
       int slot = 0;
-      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out}) {
+      // The camera the opposite arrow key retraces to (MoveTrail) is a neighbour too, after the graph's.
+      for (int c : {n.left, n.right, n.up, n.down, n.in, n.out, trail.previous(sel.camera)}) {
         ++slot;
         if (c < 0 || c == sel.camera || c >= cameras) continue;
         int rank = slot;
@@ -701,14 +704,17 @@ bool Engine::navigate(Direction direction) {
   if (m.db.manifest().graph.empty()) return false;
   const auto& n = m.db.manifest().graph.neighbours[std::size_t(m.sel.camera)];
   int target = -1;
+  camera::Move move = camera::Move::right;
   switch (direction) {
-    case Direction::left: target = n.left; break;
-    case Direction::right: target = n.right; break;
-    case Direction::up: target = n.up; break;
-    case Direction::down: target = n.down; break;
-    case Direction::in: target = n.in; break;
-    case Direction::out: target = n.out; break;
+    case Direction::left: target = n.left, move = camera::Move::left; break;
+    case Direction::right: target = n.right, move = camera::Move::right; break;
+    case Direction::up: target = n.up, move = camera::Move::up; break;
+    case Direction::down: target = n.down, move = camera::Move::down; break;
+    case Direction::in: target = n.in, move = camera::Move::in; break;
+    case Direction::out: target = n.out, move = camera::Move::out; break;
   }
+  // The opposite of the last move(s) retraces them (camera/navigation.hpp, MoveTrail).
+  target = m.trail.next(m.sel.camera, move, target);
   return m.select(target, m.sel.task, "camera_" + std::string(to_string(direction)));
 }
 
@@ -730,10 +736,14 @@ int Engine::nearest_camera(const Vec3& direction, int shell) const {
 bool Engine::snap_to_direction(const Vec3& direction) {
   Impl& m = *impl_;
   const int c = nearest_camera(direction, m.shells[std::size_t(m.sel.camera)]);
+  if (c >= 0 && c != m.sel.camera) m.trail.clear();  // a drag is not an arrow move: nothing to retrace
   return c >= 0 && m.select(c, m.sel.task, "snap");
 }
 
-bool Engine::jump_to_camera(int camera) { return impl_->select(camera, impl_->sel.task, "jump_to_camera"); }
+bool Engine::jump_to_camera(int camera) {
+  if (camera != impl_->sel.camera) impl_->trail.clear();
+  return impl_->select(camera, impl_->sel.task, "jump_to_camera");
+}
 bool Engine::set_task(int task) { return impl_->select(impl_->sel.camera, task, "set_task"); }
 bool Engine::next_task() {
   Impl& m = *impl_;

@@ -619,5 +619,43 @@ TEST(Navigation, FollowsTheGraphAcrossSeamsPolesAndShells) {
   EXPECT_EQ(e.nearest_camera({std::cos(-1.0), std::sin(-1.0), 0}), 5);
 }
 
+// Issue 34: the opposite arrow key retraces the last moves even where the graph's edges are not
+// mutual (around a pole several cameras share the camera above them), and a jump starts afresh.
+TEST(Navigation, TheOppositeKeyRetracesTheLastMoves) {
+  TempDir dir("player-retrace");
+  store::Manifest m = testing::ring_manifest(6, 1);
+  auto& g = m.graph.neighbours;
+  g[0] = {.left = 2, .right = 1, .up = 3, .down = -1, .in = -1, .out = -1};
+  g[1] = {.left = 0, .right = 2, .up = 3, .down = -1, .in = -1, .out = -1};
+  g[2] = {.left = 1, .right = 0, .up = 3, .down = -1, .in = -1, .out = -1};
+  g[3] = {.left = 4, .right = 5, .up = 4, .down = 2, .in = -1, .out = -1};  // one down for three cameras below
+  g[4] = {.left = 3, .right = 3, .up = 5, .down = 1, .in = -1, .out = -1};
+  g[5] = {.left = 4, .right = 3, .up = 3, .down = 4, .in = -1, .out = -1};
+  testing::write_stamped(dir.path, m, 3);
+  EngineOptions o;
+  o.start_playing = false;
+  o.prefetch = false;
+  Engine e(dir.path, o);
+  const auto camera_after = [&](std::initializer_list<Action> keys) {
+    for (Action a : keys) e.apply(a);
+    return e.selection().camera;
+  };
+  // Up, Up, Down, Down from 0: 0 -> 3 -> 4 -> 3 -> 0 (the graph alone: 3 -> 4 -> 1 -> -1).
+  EXPECT_EQ(camera_after({Action::camera_up, Action::camera_up}), 4);
+  EXPECT_EQ(camera_after({Action::camera_down}), 3);
+  EXPECT_EQ(camera_after({Action::camera_down}), 0);
+  // Down again follows the graph (pole: no move), Left then Right returns.
+  EXPECT_EQ(camera_after({Action::camera_down}), 0);
+  EXPECT_EQ(camera_after({Action::camera_left, Action::camera_right}), 0);
+  // From 1: Up then Down returns to 1, though 3's Down is 2.
+  ASSERT_TRUE(e.jump_to_camera(1));
+  EXPECT_EQ(camera_after({Action::camera_up, Action::camera_down}), 1);
+  // A jump in between forgets the trail: Down from 3 then follows the graph.
+  EXPECT_EQ(camera_after({Action::camera_up}), 3);
+  ASSERT_TRUE(e.jump_to_camera(5));
+  ASSERT_TRUE(e.jump_to_camera(3));
+  EXPECT_EQ(camera_after({Action::camera_down}), 2);
+}
+
 }  // namespace
 }  // namespace panoptes::player

@@ -9,6 +9,7 @@
 #include <ctime>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -388,6 +389,21 @@ void DatabaseWriter::set_time(int frame, double time) {
 
 void DatabaseWriter::set_note(const std::string& key, const std::string& value) {
   impl_->manifest.provenance.extra[key] = value;
+}
+
+void DatabaseWriter::set_field_reference(int frame, int field, double reference) {
+  auto& fields = impl_->manifest.fields;
+  if (field < 0 || field >= int(fields.size()))
+    throw Error("set_field_reference: field " + std::to_string(field) + " out of range (the manifest lists " +
+                std::to_string(fields.size()) + " fields)");
+  if (frame < 0) throw Error("set_field_reference: negative frame " + std::to_string(frame));
+  if (!(std::isfinite(reference) && reference > 0))
+    throw Error("set_field_reference: reference " + std::to_string(reference) + " of field " + fields[std::size_t(field)].name +
+                "; expected a finite value > 0");
+  auto& refs = fields[std::size_t(field)].references;
+  // Frames not given (yet) take the next given value: references stay a dense per-frame list.
+  if (std::size_t(frame) >= refs.size()) refs.resize(std::size_t(frame) + 1, reference);
+  refs[std::size_t(frame)] = reference;
 }
 
 void DatabaseWriter::flush() { impl_->flush_all(); }

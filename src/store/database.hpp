@@ -94,6 +94,11 @@ class DatabaseWriter {
   /// resumed database keeps the notes it had (the in-situ session keeps its running references there).
   void set_note(const std::string& key, const std::string& value);
 
+  /// Records the reference of frame `frame` for Manifest::fields[field] (stored at the next checkpoint):
+  /// the value that frame's relative windows are multiples of. Throws Error for an unknown field, a
+  /// negative frame or a reference that is not finite and > 0.
+  void set_field_reference(int frame, int field, double reference);
+
   /// Flushes every open movie (after it returns the frames are durable), then rewrites the manifest
   /// atomically with frames_written = complete_frames(). Throws FileError on a write failure; the
   /// manifest on disk then still describes the previous checkpoint.

@@ -72,6 +72,12 @@ int Manifest::find_task(std::string_view name) const {
   return -1;
 }
 
+int Manifest::find_field(std::string_view name) const {
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    if (fields[i].name == name) return int(i);
+  return -1;
+}
+
 int Manifest::find_axis(std::string_view name) const {
   for (std::size_t i = 0; i < axes.size(); ++i)
     if (axes[i].name == name) return int(i);
@@ -183,6 +189,16 @@ void Manifest::validate() const {
           fail("navigation graph entry " + std::to_string(i) + " names camera " + std::to_string(v) +
                " (valid: -1 or 0.." + std::to_string(n - 1) + ")");
     }
+  }
+  if (time_units.size() > 64) fail("time_units is " + std::to_string(time_units.size()) + " characters; expected a unit of at most 64");
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const auto at = [i] { return "fields[" + std::to_string(i) + "]"; };
+    if (fields[i].name.empty()) fail(at() + " has an empty name");
+    if (find_field(fields[i].name) != int(i)) fail(at() + ": the name \"" + fields[i].name + "\" is used twice");
+    for (std::size_t f = 0; f < fields[i].references.size(); ++f)
+      if (!(std::isfinite(fields[i].references[f]) && fields[i].references[f] > 0))
+        fail(at() + ".references[" + std::to_string(f) + "] is " + std::to_string(fields[i].references[f]) +
+             "; expected a finite value > 0");
   }
   std::unordered_map<std::string, std::size_t> axis_size;
   for (std::size_t i = 0; i < axes.size(); ++i) {
@@ -304,6 +320,13 @@ json manifest_json(const Manifest& m, const CameraTableRef* table) {
   if (!m.domain.up_axis.empty()) j["domain"]["up_axis"] = m.domain.up_axis;
   if (m.playback_fps > 0) j["playback_fps"] = m.playback_fps;
   j["times"] = m.times;
+  // Additive (issue 34): older readers ignore them, and manifests without them stay readable.
+  if (!m.time_units.empty()) j["time_units"] = m.time_units;
+  if (!m.fields.empty()) {
+    json fields = json::array();
+    for (const auto& f : m.fields) fields.push_back({{"name", f.name}, {"units", f.units}, {"references", f.references}});
+    j["fields"] = std::move(fields);
+  }
   j["image"] = {{"width", m.image.width},
                 {"height", m.image.height},
                 {"padded_width", m.image.padded_width},
@@ -415,6 +438,24 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
     r.array(*t, "times");
     m.times.reserve(t->size());
     for (std::size_t i = 0; i < t->size(); ++i) m.times.push_back(r.num((*t)[i], "times[" + std::to_string(i) + "]"));
+  }
+  m.time_units = r.opt_str(j, "time_units", "");
+  if (const json* fs = r.optional(j, "fields", "")) {
+    r.array(*fs, "fields");
+    for (std::size_t i = 0; i < fs->size(); ++i) {
+      const std::string at = "fields[" + std::to_string(i) + "]";
+      const json& f = (*fs)[i];
+      FieldInfo info;
+      info.name = r.str(r.field(f, "name", at), at + ".name");
+      info.units = r.opt_str(f, "units", at);
+      if (const json* refs = r.optional(f, "references", at)) {
+        r.array(*refs, at + ".references");
+        info.references.reserve(refs->size());
+        for (std::size_t k = 0; k < refs->size(); ++k)
+          info.references.push_back(r.num((*refs)[k], at + ".references[" + std::to_string(k) + "]"));
+      }
+      m.fields.push_back(std::move(info));
+    }
   }
   {
     const json& im = r.field(j, "image", "");

@@ -99,6 +99,18 @@ struct RigDescription {
   bool operator==(const RigDescription&) const = default;
 };
 
+/// A field the tasks read (recorded since issue 34; older manifests have none): its unit and, per
+/// frame, the reference value its relative windows and isovalues are multiples of, so a player can
+/// label a colour bar with physical values.
+struct FieldInfo {
+  std::string name;    ///< as in TaskEntry::fields, e.g. "phi_p"
+  std::string units;   ///< unit of its values, e.g. "1/s"; empty = unknown or dimensionless
+  /// references[i]: the reference of frame i (a percentile of |field|, or its running maximum); may be
+  /// shorter than the frames (not recorded), each finite and > 0.
+  std::vector<double> references;
+  bool operator==(const FieldInfo&) const = default;
+};
+
 /// Neighbours of one camera in the navigation graph; -1 = none.
 struct Neighbours {
   int left = -1, right = -1, up = -1, down = -1;
@@ -178,6 +190,10 @@ struct Manifest {
   /// Preferred playback rate in frames per second (0 = none: players use video.fps). A database of
   /// few snapshots sets it so the whole run lasts several seconds instead of flashing by at 30 fps.
   double playback_fps = 0;
+  /// Unit of `times`, e.g. "s"; empty = unknown (older manifests).
+  std::string time_units;
+  /// The fields the tasks read, with units and per-frame references (empty in older manifests).
+  std::vector<FieldInfo> fields;
 
   int camera_count() const { return int(cameras.size()); }
   int task_count() const { return int(tasks.size()); }
@@ -191,6 +207,8 @@ struct Manifest {
 
   /// Index of the task with this name, or -1.
   int find_task(std::string_view name) const;
+  /// Index of the field with this name in `fields`, or -1.
+  int find_field(std::string_view name) const;
   /// Index of the axis with this name, or -1.
   int find_axis(std::string_view name) const;
   /// The task that sits at the same positions as `task` on every axis except `axis`, where its index

@@ -103,6 +103,39 @@ TEST(Manifest, OrientationAndPlaybackRateAreOptionalAndChecked) {
   EXPECT_THROW(manifest_from_json(j, "mem"), Error);
 }
 
+TEST(Manifest, FieldUnitsReferencesAndTimeUnitsAreOptionalAndChecked) {
+  // Issue 34 (colour legends): older manifests have neither and stay readable; written back without them.
+  Manifest m = sample_manifest(3, 2, 16, 16);
+  json j = to_json(m);
+  EXPECT_FALSE(j.contains("fields"));
+  EXPECT_FALSE(j.contains("time_units"));
+  EXPECT_TRUE(manifest_from_json(j, "mem").fields.empty());
+  m.time_units = "s";
+  m.fields = {{"phi_p", "1/s", {0.5, 0.25}}, {"phi_s", "", {}}};
+  j = to_json(m);
+  const Manifest back = manifest_from_json(j, "mem");
+  EXPECT_EQ(back.time_units, "s");
+  EXPECT_EQ(back.fields, m.fields);
+  EXPECT_EQ(back.find_field("phi_s"), 1);
+  EXPECT_EQ(back.find_field("phi"), -1);
+  // Through the file form too.
+  TempDir dir("manifest-fields");
+  write_manifest_atomic(dir.path / kManifestFileName, m);
+  EXPECT_EQ(read_manifest(dir.path / kManifestFileName).fields, m.fields);
+  json bad = j;
+  bad["fields"][0]["references"][1] = 0;
+  expect_error([&] { manifest_from_json(bad, "mem"); }, {"fields[0].references[1]", "expected a finite value > 0"});
+  bad = j;
+  bad["fields"][1]["name"] = "phi_p";
+  expect_error([&] { manifest_from_json(bad, "mem"); }, {"fields[1]", "used twice"});
+  bad = j;
+  bad["fields"][0]["references"] = "many";
+  expect_error([&] { manifest_from_json(bad, "mem"); }, {"fields[0].references"});
+  bad = j;
+  bad["time_units"] = 3;
+  expect_error([&] { manifest_from_json(bad, "mem"); }, {"time_units"});
+}
+
 TEST(Manifest, EmptyGraphAndMinimalFieldsAreValid) {
   Manifest m = sample_manifest(3, 2);
   m.graph.neighbours.clear();

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "player/keys.hpp"
-#include "ui/hud_text.hpp"
+#include "player/legend.hpp"
 
 namespace panoptes::ui {
 namespace {
@@ -109,7 +109,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       const auto& sel = info.selection;
       const auto& cam = m.cameras[std::size_t(sel.camera)];
       const auto& task = m.tasks[std::size_t(sel.task)];
-      ImGui::Text("t = %.4g   frame %d of %d   %s x%.2g%s%s", info.sim_time + 0.0, sel.frame, info.frame_count,
+      ImGui::Text("%s   frame %d of %d   %s x%.2g%s%s", player::time_text(m, info.sim_time).c_str(), sel.frame, info.frame_count,
                   info.playing ? "playing" : "paused", info.speed, info.direction < 0 ? " reverse" : "", info.loop ? "" : " once");
       const std::string shell = info.shell_count > 1 ? "   shell " + std::to_string(cam.labels.shell) : "";
       if (!info.position_label.empty())
@@ -120,7 +120,8 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
                     signed_degrees(cam.labels.lon_deg).c_str(), shell.c_str());
       if (!info.look_label.empty()) ImGui::TextUnformatted(info.look_label.c_str());
       const std::string params = format_parameters(m, task);
-      ImGui::Text("task %d of %d: %s%s%s", sel.task, int(m.tasks.size()), task.name.c_str(),
+      // Numbered from 1, as the digit keys select them.
+      ImGui::Text("task %d of %d: %s%s%s", sel.task + 1, int(m.tasks.size()), task.name.c_str(),
                   params.empty() ? "" : "   ", params.c_str());
       if (info.active_axis >= 0 && info.active_axis < int(m.axes.size()))
         ImGui::Text("PgUp/PgDn axis: %s", m.axes[std::size_t(info.active_axis)].name.c_str());
@@ -170,6 +171,8 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     }
     ImGui::End();
 
+    draw_legend(info, vw, vh);
+
     // Time slider along the bottom edge.
     ImGui::SetNextWindowPos(ImVec2(0, vh), ImGuiCond_Always, ImVec2(0, 1));
     ImGui::SetNextWindowSize(ImVec2(vw, 0), ImGuiCond_Always);
@@ -206,39 +209,124 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
   return req;
 }
 
-void Hud::draw_help(float vw, float vh) {
-  struct Row {
-    std::string_view key, what;
-  };
-  std::vector<Row> rows;
-  for (const auto& b : player::key_bindings()) rows.push_back({b.key, b.description});
-  for (const auto& r : {Row{"left drag", "rotate: snap to the camera nearest the dragged direction"},
-                        Row{"wheel", "magnify around the cursor"}, Row{"right drag", "pan the magnified frame"},
-                        Row{"mini-map click", "jump to that camera"}})
+void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
+  const auto bars = player::task_legend(*info.manifest, info.selection.task, info.selection.frame);
+  if (bars.empty()) return;
+  // Bottom left, above the time slider: the top-left corner belongs to the frame (and its stamp in
+  // tests), the right side to the status panel and the mini-map.
+  const float pad = 8, scale = ImGui::GetIO().FontGlobalScale;
+  const float slider_h = ImGui::GetFrameHeightWithSpacing() + 2 * ImGui::GetStyle().WindowPadding.y;
+  const float bar_w = std::clamp(vw * 0.22f, 120.f, 260.f * scale), bar_h = ImGui::GetTextLineHeight();
+  ImGui::SetNextWindowPos(ImVec2(pad, vh - slider_h - pad), ImGuiCond_Always, ImVec2(0, 1));
+  ImGui::SetNextWindowBgAlpha(0.6f);
+  if (!ImGui::Begin("##legend", nullptr, kOverlayFlags)) {
+    ImGui::End();
+    return;
+  }
+  remember_window();
+  for (const player::LegendBar& bar : bars) {
+    const std::string units = bar.physical && !bar.units.empty() ? "  [" + bar.units + "]" : "";
+    ImGui::Text("%s%s", bar.label.c_str(), units.c_str());
+    ImDrawList* draw = ImGui::GetWindowDrawList();
+    const ImVec2 p = ImGui::GetCursorScreenPos();
+    if (bar.isovalue) {
+      const auto c = bar.colours.empty() ? std::array<float, 3>{0.8f, 0.8f, 0.8f} : bar.colours[0];
+      draw->AddRectFilled(p, ImVec2(p.x + bar_h * 2, p.y + bar_h), ImGui::GetColorU32(ImVec4(c[0], c[1], c[2], 1)));
+      ImGui::Dummy(ImVec2(bar_h * 2, bar_h));
+      ImGui::SameLine();
+      ImGui::TextUnformatted(player::legend_range_text(bar).c_str());
+      continue;
+    }
+    if (!bar.colours.empty()) {
+      const int n = int(bar.colours.size());
+      for (int i = 0; i + 1 < n; ++i) {
+        const auto& a = bar.colours[std::size_t(i)];
+        const auto& b = bar.colours[std::size_t(i + 1)];
+        const float x0 = p.x + bar_w * float(i) / float(n - 1), x1 = p.x + bar_w * float(i + 1) / float(n - 1);
+        const ImU32 ca = ImGui::GetColorU32(ImVec4(a[0], a[1], a[2], 1)), cb = ImGui::GetColorU32(ImVec4(b[0], b[1], b[2], 1));
+        draw->AddRectFilledMultiColor(ImVec2(x0, p.y), ImVec2(x1, p.y + bar_h), ca, cb, cb, ca);
+      }
+      draw->AddRect(p, ImVec2(p.x + bar_w, p.y + bar_h), ImGui::GetColorU32(ImVec4(0.55f, 0.6f, 0.7f, 1)));
+      ImGui::Dummy(ImVec2(bar_w, bar_h));
+    }
+    // The window's ends under the bar's ends (fractions of the reference for older databases).
+    const std::string lo = player::legend_number(bar.lo), hi = player::legend_number(bar.hi) + (bar.physical ? "" : " x ref");
+    ImGui::TextUnformatted(lo.c_str());
+    const float hi_w = ImGui::CalcTextSize(hi.c_str()).x;
+    const float left = ImGui::GetStyle().WindowPadding.x;
+    ImGui::SameLine(std::max(left + ImGui::CalcTextSize(lo.c_str()).x + 12, left + bar_w - hi_w));
+    ImGui::TextUnformatted(hi.c_str());
+  }
+  ImGui::End();
+}
+
+std::vector<HelpRow> help_rows() {
+  std::vector<HelpRow> rows;
+  for (const auto& b : player::key_bindings()) {
+    // The nine digit keys are one row, numbered as the HUD numbers tasks.
+    if (b.action >= player::Action::task_1 && b.action <= player::Action::task_9) {
+      if (b.action == player::Action::task_1) rows.push_back({"1 .. 9", "select task 1 .. 9 (numbered as in the HUD)"});
+      continue;
+    }
+    // Keys that do the same thing share a row ("H / F1", "Escape / Q", "+ / =").
+    if (!rows.empty()) {
+      HelpRow& last = rows.back();
+      const std::string_view what = b.description;
+      if (what == last.what || what.rfind("same as", 0) == 0) {
+        last.key += " / " + std::string(b.key);
+        continue;
+      }
+    }
+    rows.push_back({std::string(b.key), std::string(b.description)});
+  }
+  for (const auto& r : {HelpRow{"left drag", "rotate: snap to the camera nearest the dragged direction"},
+                        HelpRow{"wheel", "magnify around the cursor"}, HelpRow{"right drag", "pan the magnified frame"},
+                        HelpRow{"mini-map click", "jump to that camera"}})
     rows.push_back(r);
-  // Always fits the window: 1, 2 or 3 key/description column pairs — the fewest that fit the height,
-  // as long as they fit the width — and whatever still does not fit scrolls (shrinking ImGui's bitmap
-  // font makes it unreadable, so it is not shrunk).
+  return rows;
+}
+
+HelpLayout help_layout(int rows, float row_h, float pair_w, float avail_w, float avail_h, float font_scale) {
+  HelpLayout l;
+  const auto height = [&](int pairs, float scale) { return float((rows + pairs - 1) / pairs) * row_h * scale; };
+  // The fewest column pairs whose height fits, as long as they fit the width.
+  while (l.pairs < 3 && height(l.pairs, 1) > avail_h && float(l.pairs + 1) * pair_w <= avail_w) ++l.pairs;
+  // Still too tall (or too wide): shrink the text, but not below ImGui's bitmap font at its own size
+  // (smaller is unreadable); whatever still does not fit scrolls.
+  const float fit = std::min(avail_h / std::max(height(l.pairs, 1), 1.f), avail_w / std::max(float(l.pairs) * pair_w, 1.f));
+  if (fit < 1) l.scale = std::max(fit, std::min(1.f, 1.f / std::max(font_scale, 1e-3f)));
+  l.fits = l.scale <= fit * (1 + 1e-6f);
+  return l;
+}
+
+void Hud::draw_help(float vw, float vh) {
+  const std::vector<HelpRow> rows = help_rows();
   const ImGuiStyle& style = ImGui::GetStyle();
   float key_w = 0, what_w = 0;
-  for (const Row& r : rows) {
-    key_w = std::max(key_w, ImGui::CalcTextSize(r.key.data(), r.key.data() + r.key.size()).x);
-    what_w = std::max(what_w, ImGui::CalcTextSize(r.what.data(), r.what.data() + r.what.size()).x);
+  for (const HelpRow& r : rows) {
+    key_w = std::max(key_w, ImGui::CalcTextSize(r.key.c_str()).x);
+    what_w = std::max(what_w, ImGui::CalcTextSize(r.what.c_str()).x);
   }
   const float pair_w = key_w + what_w + 4 * style.CellPadding.x + style.ItemSpacing.x;
   const float row_h = ImGui::GetTextLineHeight() + 2 * style.CellPadding.y;
   const float chrome_w = 2 * style.WindowPadding.x, chrome_h = 2 * style.WindowPadding.y + ImGui::GetFrameHeight();
-  int pairs = 1;
-  while (pairs < 3 && float((int(rows.size()) + pairs - 1) / pairs) * row_h > vh * 0.95f - chrome_h &&
-         float(pairs + 1) * pair_w <= vw * 0.95f - chrome_w)
-    ++pairs;
-  ImGui::SetNextWindowPos(ImVec2(vw / 2, vh / 2), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(vw * 0.98f, vh * 0.95f));
+  // Between the top edge and the time slider (when the HUD shows it), so no line hides under it.
+  const float pad = 8;
+  const float slider_h = show_panel ? ImGui::GetFrameHeightWithSpacing() + 2 * style.WindowPadding.y : 0;
+  const float avail_h = vh - slider_h - 2 * pad, avail_w = vw - 2 * pad;
+  const HelpLayout layout =
+      help_layout(int(rows.size()), row_h, pair_w, avail_w - chrome_w, avail_h - chrome_h, ImGui::GetIO().FontGlobalScale);
+  last_help_layout_ = layout;
+  ImGui::SetNextWindowPos(ImVec2(vw / 2, pad + avail_h / 2), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(avail_w, avail_h));
   ImGui::SetNextWindowBgAlpha(0.9f);
+  // Scroll bars only when it cannot fit: a sub-pixel overflow of the rounded auto-fit size would show one.
+  const ImGuiWindowFlags scroll = layout.fits ? ImGuiWindowFlags_NoScrollbar : ImGuiWindowFlags_HorizontalScrollbar;
   if (ImGui::Begin("Panoptes keys (H / F1 closes)", &show_help,
-                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse |
-                       ImGuiWindowFlags_HorizontalScrollbar)) {
+                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse | scroll)) {
     remember_window();
+    ImGui::SetWindowFontScale(layout.scale);
+    const int pairs = layout.pairs;
     const int per_column = (int(rows.size()) + pairs - 1) / pairs;
     if (ImGui::BeginTable("##keys", 2 * pairs, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
       for (int r = 0; r < per_column; ++r) {
@@ -246,13 +334,15 @@ void Hud::draw_help(float vw, float vh) {
         for (int p = 0; p < pairs; ++p) {
           const int i = p * per_column + r;
           ImGui::TableNextColumn();
-          if (i < int(rows.size())) ImGui::TextUnformatted(rows[std::size_t(i)].key.data(), rows[std::size_t(i)].key.data() + rows[std::size_t(i)].key.size());
+          if (i < int(rows.size())) ImGui::TextUnformatted(rows[std::size_t(i)].key.c_str());
           ImGui::TableNextColumn();
-          if (i < int(rows.size())) ImGui::TextUnformatted(rows[std::size_t(i)].what.data(), rows[std::size_t(i)].what.data() + rows[std::size_t(i)].what.size());
+          if (i < int(rows.size())) ImGui::TextUnformatted(rows[std::size_t(i)].what.c_str());
         }
       }
       ImGui::EndTable();
     }
+    // Less than a pixel hides nothing (the window's auto-fit size is rounded to whole pixels).
+    help_fits_ = ImGui::GetScrollMaxY() < 1 && ImGui::GetScrollMaxX() < 1;
   }
   ImGui::End();
 }

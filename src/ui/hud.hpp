@@ -48,6 +48,25 @@ struct HudRequests {
   bool toggle_play = false;
 };
 
+/// One line of the help overlay: the key(s) and what they do.
+struct HelpRow {
+  std::string key, what;
+};
+/// The help overlay's lines: the shared key table (player/keys.hpp) with the digit keys on one line and
+/// keys of the same action sharing a line, then the mouse gestures.
+std::vector<HelpRow> help_rows();
+
+/// How the help overlay is laid out: key/description column pairs side by side and the text scale.
+struct HelpLayout {
+  int pairs = 1;
+  float scale = 1;  ///< multiplies the HUD's font scale (< 1 only when columns alone do not fit)
+  bool fits = true;  ///< every line fits at that scale (else the overlay scrolls)
+};
+/// The fewest pairs (1..3) whose rows fit `avail_h` while the pairs fit `avail_w` (row_h and pair_w as
+/// measured at scale 1); if that still does not fit, a scale < 1, but never below the bitmap font's
+/// own size (1 / font_scale).
+HelpLayout help_layout(int rows, float row_h, float pair_w, float avail_w, float avail_h, float font_scale);
+
 /// The overlay. Call draw() between SdlWindow::begin_imgui_frame() and render_imgui().
 class Hud {
  public:
@@ -68,6 +87,9 @@ class Hud {
   const std::string& last_notice() const { return message_; }
   /// True if the status panel was submitted in the last draw() (the window test checks it).
   bool panel_drawn() const { return panel_drawn_; }
+  /// True if the help overlay showed every line without scrolling in the last draw() that drew it.
+  bool help_fits() const { return help_fits_; }
+  HelpLayout last_help_layout() const { return last_help_layout_; }
   /// True if window point (x, y) lies on one of the HUD's windows as drawn last frame. Mouse events
   /// there belong to the HUD; elsewhere they drive the view (hit-testing the event's own position
   /// rather than ImGui's idea of the pointer, which may lag or come from the global pointer state).
@@ -75,6 +97,7 @@ class Hud {
 
  private:
   void draw_help(float viewport_w, float viewport_h);
+  void draw_legend(const HudInfo& info, float viewport_w, float viewport_h);
   MiniMap minimap_;
   LatticeMap lattice_map_;
   bool z_down_ = false;  ///< replaces the sphere map for rigs inside the volume (lattice, path)
@@ -82,6 +105,8 @@ class Hud {
   bool message_error_ = false;
   double message_until_ = 0;
   bool panel_drawn_ = false;
+  bool help_fits_ = false;
+  HelpLayout last_help_layout_;
   struct Box {
     float x0, y0, x1, y1;
   };

@@ -634,6 +634,7 @@ WindowResult WindowApp::run() {
     result.window_h = out_h_;
     result.fullscreen = window_.fullscreen();
     result.notice = hud_.last_notice();
+    result.help_fits = hud_.help_fits();
     result.status = std::string(player::to_string(shown.status));
   }
   window_.native_size(result.native_w, result.native_h);

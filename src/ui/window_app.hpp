@@ -65,6 +65,7 @@ struct WindowResult {
   bool fullscreen = false;         ///< in full screen at exit
   std::string notice;              ///< the last notice the HUD showed (why a key did nothing, ...)
   bool hud_drawn = false;       ///< the HUD window was submitted to ImGui in the last frame
+  bool help_fits = false;       ///< the help overlay, when last drawn, showed every line without scrolling
   std::string status = "ok";    ///< health of the frame shown last: "ok", "missing", "unreadable"
   std::string summary;          ///< one-paragraph statistics (switch latency, fps, cache hits)
 };

@@ -342,7 +342,7 @@ TEST_F(WindowTest, NotADatabaseIsReportedBeforeAnyWindowOpens) {
 // a 16-camera Yin-Yang rig around the demo's domain laid out like the demo's, 3 frames. Frames are grey
 // with their stamp, so the picture is told apart from the window's clear colour and from the HUD.
 constexpr int kDemoW = 528, kDemoH = 512;
-void write_demo_like_database(const std::filesystem::path& dir) {
+void write_demo_like_database(const std::filesystem::path& dir, bool legend = false) {
   store::Manifest m;
   m.title = "demo-like";
   m.provenance.program = "ui_window_test";
@@ -374,6 +374,19 @@ void write_demo_like_database(const std::filesystem::path& dir) {
   store::TaskEntry t;
   t.name = "p+s";
   t.method = "synthetic";
+  if (legend) {  // as `panoptes run` writes a p-wave task (issue 34)
+    m.time_units = "s";
+    m.fields = {{"phi_p", "1/s", {}}};
+    t.name = "p-wave";
+    t.method = "volume";
+    t.fields = {"phi_p"};
+    t.parameters = {{"window", {0.0, 1.0}},
+                    {"relative", true},
+                    {"transfer_function",
+                     {{"colour", {{0, 0.9, 0.35, 0.05}, {1, 1.0, 0.8, 0.4}}},
+                      {"extinction", {{0, 0}, {0.1, 0}, {1, 0.5}}},
+                      {"absolute_value", true}}}};
+  }
   m.tasks.push_back(t);
   auto writer = store::DatabaseWriter::create(dir, m, true);
   Image img(kDemoW, kDemoH, 3);
@@ -384,6 +397,7 @@ void write_demo_like_database(const std::filesystem::path& dir) {
       writer.append(c, 0, img);
     }
     writer.set_time(f, f);
+    if (legend) writer.set_field_reference(f, 0, 0.01 * (f + 1));
     writer.checkpoint();
   }
   writer.finalize();
@@ -467,6 +481,43 @@ TEST_F(WindowTest, DemoAt1280x1024FillsTheWindowTheHudStaysSmallAndUpGoesToTheSk
   EXPECT_EQ(back.native_h, with_hud.native_h);
   EXPECT_EQ(with_hud.native_w, with_hud.window_w) << "SDL and the X server agree on the window's size";
   EXPECT_EQ(with_hud.native_h, with_hud.window_h);
+}
+
+// Issue 34 on the display the issue was seen on (1920x1200: the demo's window opens 1020 px high): the
+// help overlay shows every line without a scroll bar, and the colour legend draws the task's colours.
+TEST_F(WindowTest, At1920x1200TheHelpFitsAndTheLegendIsDrawn) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  SDL_Rect usable{};
+  ASSERT_EQ(SDL_InitSubSystem(SDL_INIT_VIDEO), 0);
+  const bool big = SDL_GetDisplayUsableBounds(0, &usable) == 0 && usable.w >= 1920 && usable.h >= 1200;
+  SDL_QuitSubSystem(SDL_INIT_VIDEO);
+  if (!big) GTEST_SKIP() << "needs a 1920x1200 screen (ctest runs this as ui.window_help)";
+  const auto db = dir_->path / "legend";
+  write_demo_like_database(db, true);
+  auto run = [&](const std::string& name, bool help) {
+    WindowOptions o = test_window();
+    o.show_help = help;
+    o.max_frames = 6;
+    o.screenshot_on_exit = dir_->path / (name + ".png");
+    const WindowResult r = run_window(db, o);
+    keep_for_humans(o.screenshot_on_exit, "ui_window_" + name + ".png");
+    return std::pair{r, read_png(o.screenshot_on_exit.string())};
+  };
+  const auto [with_help, shot_help] = run("help", true);
+  EXPECT_GE(with_help.window_h, 1000);
+  EXPECT_LE(with_help.window_h, 1040);
+  EXPECT_TRUE(with_help.help_fits) << "the help overlay scrolls in a " << with_help.window_w << "x" << with_help.window_h
+                                   << " window";
+  // The legend: the p-wave preset's orange, bottom left (the picture is grey, the rest of the HUD is
+  // grey-blue and white text).
+  const auto [plain, shot] = run("legend", false);
+  int orange = 0;
+  for (int y = shot.height / 2; y < shot.height; ++y)
+    for (int x = 0; x < shot.width / 3; ++x) {
+      const std::uint8_t* p = shot.at(x, y);
+      orange += p[0] > 120 && p[0] > p[1] + 30 && p[1] > p[2] + 20;
+    }
+  EXPECT_GT(orange, 500) << "no colour bar in the bottom-left corner";
 }
 
 // Issue 14: a 360° lattice database shows a look-around filling the window; the arrows and PgUp walk

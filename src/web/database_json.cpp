@@ -44,9 +44,15 @@ nlohmann::json database_json(const store::Database& db, const DatabaseJsonOption
   for (const auto& t : m.tasks) {
     json positions = json::array();
     for (const auto& p : t.axes) positions.push_back({{"axis", p.axis}, {"index", p.index}});
-    tasks.push_back({{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)}});
+    // fields and parameters carry what the colour legend shows (window, transfer function; issue 34).
+    tasks.push_back({{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)},
+                     {"fields", t.fields}, {"parameters", t.parameters}});
   }
   j["tasks"] = std::move(tasks);
+  j["time_units"] = m.time_units;
+  json fields = json::array();
+  for (const auto& f : m.fields) fields.push_back({{"name", f.name}, {"units", f.units}, {"references", f.references}});
+  j["fields"] = std::move(fields);
 
   const int n = m.camera_count();
   // A schema 2 database keeps its cameras in a binary table (docs/formats.md): the player fetches that

@@ -66,3 +66,30 @@ export function camerasFromJson(cameras, graph) {
   if (graph && graph.length === n) out.neighbours = Int32Array.from(graph.flat());
   return out;
 }
+
+const OPPOSITE = { left: "right", right: "left", up: "down", down: "up", in: "out", out: "in" };
+const MAX_TRAIL = 256;
+
+/// The players' arrow-key rule (camera::MoveTrail in src/camera/navigation.hpp): a move opposite to
+/// the last move(s) retraces them, so Up, Up, Down, Down returns to the start camera even where the
+/// navigation graph's pairs are not mutual (around the sky poles); other moves follow the graph.
+export class MoveTrail {
+  constructor() { this.steps = []; }
+  /// Forgets the moves (a drag or a mini-map click is not an arrow move).
+  clear() { this.steps.length = 0; }
+  /// The camera `move` from `camera` leads to, given the graph's neighbour `graphTarget` (-1 = none).
+  next(camera, move, graphTarget) {
+    const last = this.steps[this.steps.length - 1];
+    if (last && last.to !== camera) this.steps.length = 0;  // moved by other means (drag, mini-map)
+    if (last && last.to === camera && last.move === OPPOSITE[move]) return this.steps.pop().from;
+    if (graphTarget < 0 || graphTarget === camera) return graphTarget;
+    if (this.steps.length === MAX_TRAIL) this.steps.splice(0, MAX_TRAIL / 2);
+    this.steps.push({ from: camera, to: graphTarget, move });
+    return graphTarget;
+  }
+  /// Where `move` would lead now without recording it (for prefetching).
+  peek(camera, move, graphTarget) {
+    const last = this.steps[this.steps.length - 1];
+    return last && last.to === camera && last.move === OPPOSITE[move] ? last.from : graphTarget;
+  }
+}

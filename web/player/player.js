@@ -5,7 +5,8 @@
 import { FrameCache, Stream, traffic, marks, mark } from "./movies.js";
 import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
-import { camerasFromJson, parseCameraTable } from "./cameras.js";
+import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
+import { taskLegend, drawLegend, timeText } from "./legend.js";
 
 const params = new URLSearchParams(location.search);
 const base = new URL(".", location.href).href.split("?")[0];
@@ -37,6 +38,7 @@ const options = {
 const canvas = document.getElementById("view");
 const ctx = canvas.getContext("2d");
 const hud = document.getElementById("hud");
+const legendCanvas = document.getElementById("legend");
 const statusLine = document.getElementById("status");
 const minimap = document.getElementById("minimap");
 const mapCtx = minimap.getContext("2d");
@@ -104,6 +106,7 @@ function setPlaying(p) {
 
 // ---- navigation ---------------------------------------------------------------------------------
 const COLUMNS = ["left", "right", "up", "down", "in", "out"];
+const trail = new MoveTrail();  // the arrow keys' moves, so the opposite key retraces them
 function graphNeighbour(camera, direction) {
   const g = S.cams && S.cams.neighbours;  // null until the camera table is loaded, or without a graph
   return g && camera >= 0 && camera < S.cams.count ? g[6 * camera + COLUMNS.indexOf(direction)] : -1;
@@ -124,7 +127,8 @@ function stepTaskOnAxis(task, axisName, delta) {
 function neighbourSelections(camera, task) {
   const out = [];
   for (const dir of COLUMNS) {
-    const c = graphNeighbour(camera, dir);
+    // The current camera's moves go where the keys lead (a retrace returns to the previous camera).
+    const c = camera === S.camera ? trail.peek(camera, dir, graphNeighbour(camera, dir)) : graphNeighbour(camera, dir);
     if (c >= 0) out.push([c, task]);
   }
   const T = S.db.tasks.length;
@@ -328,7 +332,7 @@ function drawPlaceholder(camera, task, status, message) {
   ctx.font = `bold ${Math.round(Math.min(w, h) / 9)}px sans-serif`;
   ctx.fillText(`STREAM ${status.toUpperCase()}`, w / 2, h / 2 - h / 10);
   ctx.font = `${Math.round(Math.min(w, h) / 18)}px sans-serif`;
-  ctx.fillText(`camera ${camera} · task ${task}`, w / 2, h / 2 + h / 12);
+  ctx.fillText(`camera ${camera} · task ${task + 1}`, w / 2, h / 2 + h / 12);
   S.message = message;
 }
 function drawFrame(vf) {
@@ -418,16 +422,19 @@ function updateHud(frame) {
   const axes = task.axes.map((a) => `${a.axis}=${db.axes.find((x) => x.name === a.axis)?.values[a.index]}`).join(" ");
   const active = db.axes[S.axis] ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
   const text =
-    `t = ${(db.times[frame] ?? frame).toFixed(3)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
+    `${timeText(db, db.times[frame] ?? frame)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
     (S.cams ? `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°  shell ${S.cams.shell[c]}\n`
             : `camera ${c}  (loading the camera table…)\n`) +
-    `task ${S.task} "${task.name}" ${axes}  ${active}\n` +
+    `task ${S.task + 1}/${db.tasks.length} "${task.name}" ${axes}  ${active}\n` +
     `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (next frame)" : " (waited for a decode)") : "—"}` +
     `  zoom ${S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
   if (text !== lastHud) hud.textContent = lastHud = text;  // a DOM write per display frame costs a layout
+  // The legend changes with the task and, for relative windows, with the frame's reference.
+  const bars = taskLegend(db, S.task, frame), legendKey = JSON.stringify(bars);
+  if (legendKey !== lastLegend) { drawLegend(legendCanvas, bars); lastLegend = legendKey; }
   if (statusLine.textContent !== S.message) statusLine.textContent = S.message;
 }
-let lastHud = "";
+let lastHud = "", lastLegend = "";
 
 // ---- mini-map: cameras by longitude (x) and latitude (y); click picks the nearest -------------
 function mapXY(i) {
@@ -490,7 +497,7 @@ minimap.addEventListener("click", (e) => {
     const d = (x - px) ** 2 + (y - py) ** 2;
     if (d < bestD) { bestD = d; best = i; }
   }
-  if (best >= 0) select(best, S.task, "minimap");
+  if (best >= 0 && best !== S.camera) { trail.clear(); select(best, S.task, "minimap"); }
 });
 
 // ---- keys, wheel, drag --------------------------------------------------------------------------
@@ -503,13 +510,15 @@ function zoomAt(factor, px, py) {
   if (z === 1) { S.panX = 0; S.panY = 0; }
   S.shown = null;  // redraw
 }
+// Arrow keys (and Z/X): the opposite of the last move(s) retraces them (MoveTrail in cameras.js).
+const move = (d) => select(trail.next(S.camera, d, graphNeighbour(S.camera, d)), S.task, d);
 const actions = {
-  ArrowLeft: () => select(graphNeighbour(S.camera, "left"), S.task, "left"),
-  ArrowRight: () => select(graphNeighbour(S.camera, "right"), S.task, "right"),
-  ArrowUp: () => select(graphNeighbour(S.camera, "up"), S.task, "up"),
-  ArrowDown: () => select(graphNeighbour(S.camera, "down"), S.task, "down"),
-  z: () => select(graphNeighbour(S.camera, "in"), S.task, "in"),
-  x: () => select(graphNeighbour(S.camera, "out"), S.task, "out"),
+  ArrowLeft: () => move("left"),
+  ArrowRight: () => move("right"),
+  ArrowUp: () => move("up"),
+  ArrowDown: () => move("down"),
+  z: () => move("in"),
+  x: () => move("out"),
   Tab: (e) => select(S.camera, (S.task + (e.shiftKey ? S.db.tasks.length - 1 : 1)) % S.db.tasks.length, e.shiftKey ? "previous task" : "next task"),
   PageUp: () => S.db.axes[S.axis] && select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, 1), "axis +1"),
   PageDown: () => S.db.axes[S.axis] && select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, -1), "axis -1"),
@@ -560,7 +569,7 @@ canvas.addEventListener("pointermove", (e) => {
   drag.move(e.clientX - dragLast[0], e.clientY - dragLast[1], canvas.getBoundingClientRect().height);
   dragLast = [e.clientX, e.clientY];
   const c = nearestCamera(dirs(), S.cams.shell, drag.dir, S.cams.shell[S.camera]);
-  if (c >= 0) select(c, S.task, "drag");
+  if (c >= 0 && c !== S.camera) { trail.clear(); select(c, S.task, "drag"); }
 });
 const endDrag = () => { drag.end(); dragLast = null; };
 canvas.addEventListener("pointerup", endDrag);

@@ -124,6 +124,42 @@ await check("keys: every command shows the expected stamp", async () => {
   await page.close();
 });
 
+await check("keys: the opposite arrow retraces the last moves; HUD numbers tasks from 1; legend", async () => {
+  // The rule itself on a graph whose Down is not mutual (several cameras below share the one above),
+  // as around a sky pole: cameras.js's MoveTrail, which the player's arrow keys use.
+  const { MoveTrail } = await import(path.join(siteDir, "cameras.js"));
+  const g = { 0: { up: 3 }, 1: { up: 3 }, 3: { up: 4, down: 2 }, 4: { down: 1 } };
+  const t = new MoveTrail();
+  const press = (c, d) => t.next(c, d, g[c]?.[d] ?? -1);
+  let c = 1;
+  for (const d of ["up", "up", "down", "down"]) c = press(c, d);
+  assert.equal(c, 1, "Up, Up, Down, Down returns to 1 (the graph alone: 1 -> 3 -> 4 -> 1 -> -1)");
+  assert.equal(press(3, "down"), 2, "after a jump elsewhere, Down follows the graph");
+  // In the player: Right, Right, Left, Left back at the start; key 2 reads "task 2/3" in the HUD.
+  const { page, errors } = await open(serveUrl + "&play=0");
+  await expectShown(page, 0, 0, 0, "start");
+  const walked = [0];
+  for (const key of ["ArrowRight", "ArrowRight"]) {
+    const next = graph[walked[walked.length - 1]][R];
+    if (next < 0) break;
+    walked.push(next);
+    await page.keyboard.press(key);
+    await expectShown(page, next, 0, 0, key);
+  }
+  for (let k = walked.length - 2; k >= 0; k--) {
+    await page.keyboard.press("ArrowLeft");
+    await expectShown(page, walked[k], 0, 0, "ArrowLeft retraces");
+  }
+  await page.keyboard.press("2");
+  await expectShown(page, 0, 1, 0, "key 2 = task 2");
+  const hudText = await page.evaluate(() => document.getElementById("hud").textContent);
+  assert.match(hudText, new RegExp(`task 2/${db.tasks.length} `), "the HUD numbers tasks as the digit keys do");
+  // A synthetic database records no windows: no legend.
+  assert.equal(await page.evaluate(() => document.getElementById("legend").hidden), true, "no legend without windows");
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 await check("playback: frames advance and switches during playback show the right stamp", async () => {
   const { page } = await open(serveUrl + "&play=1");
   await expectShown(page, 0, 0, null, "start");

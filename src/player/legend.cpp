@@ -1,0 +1,165 @@
+#include "player/legend.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace panoptes::player {
+namespace {
+
+using nlohmann::json;
+
+// Piecewise-linear lookup over [[x, v...], ...] control points (constant beyond the ends), as the
+// renderer's TransferFunction evaluates them. Returns false when the points are malformed.
+template <std::size_t N>
+bool lookup(const json& points, double u, std::array<double, N>& out) {
+  if (!points.is_array() || points.empty()) return false;
+  auto read = [&](const json& p, double& x, std::array<double, N>& v) {
+    if (!p.is_array() || p.size() != N + 1) return false;
+    for (const auto& e : p)
+      if (!e.is_number()) return false;
+    x = p[0].get<double>();
+    for (std::size_t k = 0; k < N; ++k) v[k] = p[k + 1].get<double>();
+    return true;
+  };
+  double x0 = 0;
+  std::array<double, N> v0{};
+  if (!read(points[0], x0, v0)) return false;
+  if (u <= x0) return out = v0, true;
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    double x1 = 0;
+    std::array<double, N> v1{};
+    if (!read(points[i], x1, v1)) return false;
+    if (u <= x1) {
+      const double w = x1 > x0 ? (u - x0) / (x1 - x0) : 1.0;
+      for (std::size_t k = 0; k < N; ++k) out[k] = v0[k] + (v1[k] - v0[k]) * w;
+      return true;
+    }
+    x0 = x1;
+    v0 = v1;
+  }
+  out = v0;
+  return true;
+}
+
+std::vector<std::array<float, 3>> sample_colours(const json& tf) {
+  std::vector<std::array<float, 3>> out;
+  if (!tf.is_object() || !tf.contains("colour") || !tf.contains("extinction")) return out;
+  for (int i = 0; i < kLegendSamples; ++i) {
+    const double u = double(i) / (kLegendSamples - 1);
+    std::array<double, 3> rgb{};
+    std::array<double, 1> sigma{};
+    if (!lookup(tf["colour"], u, rgb) || !lookup(tf["extinction"], u, sigma)) return {};
+    const double alpha = 1 - std::exp(-std::max(0.0, sigma[0]) * kLegendDepthVoxels);
+    out.push_back({float(std::clamp(rgb[0], 0.0, 1.0) * alpha), float(std::clamp(rgb[1], 0.0, 1.0) * alpha),
+                   float(std::clamp(rgb[2], 0.0, 1.0) * alpha)});
+  }
+  return out;
+}
+
+bool number_pair(const json& p, const char* key, double& a, double& b) {
+  const auto it = p.find(key);
+  if (it == p.end() || !it->is_array() || it->size() != 2 || !(*it)[0].is_number() || !(*it)[1].is_number())
+    return false;
+  a = (*it)[0].get<double>();
+  b = (*it)[1].get<double>();
+  return std::isfinite(a) && std::isfinite(b);
+}
+
+bool flag(const json& p, const char* key, bool fallback) {
+  const auto it = p.find(key);
+  return it != p.end() && it->is_boolean() ? it->get<bool>() : fallback;
+}
+
+// The reference of `field` at `frame` (its last recorded one for later frames), or 0 if unknown.
+double reference(const store::Manifest& m, const std::string& field, int frame) {
+  const int f = m.find_field(field);
+  if (f < 0) return 0;
+  const auto& refs = m.fields[std::size_t(f)].references;
+  if (refs.empty()) return 0;
+  return refs[std::size_t(std::clamp(frame, 0, int(refs.size()) - 1))];
+}
+
+std::string units_of(const store::Manifest& m, const std::string& field) {
+  const int f = m.find_field(field);
+  return f < 0 ? std::string() : m.fields[std::size_t(f)].units;
+}
+
+LegendBar window_bar(const store::Manifest& m, const std::string& field, const json& p, const char* window_key,
+                     const char* relative_key, const char* tf_key, int frame) {
+  LegendBar bar;
+  bar.field = field;
+  bar.units = units_of(m, field);
+  const json tf = p.contains(tf_key) ? p[tf_key] : json();
+  bar.label = tf.is_object() && flag(tf, "absolute_value", false) ? "|" + field + "|" : field;
+  number_pair(p, window_key, bar.lo, bar.hi);
+  if (flag(p, relative_key, false)) {
+    const double ref = reference(m, field, frame);
+    if (ref > 0) {
+      bar.lo *= ref;
+      bar.hi *= ref;
+    } else {
+      bar.physical = false;
+    }
+  }
+  bar.colours = sample_colours(tf);
+  return bar;
+}
+
+}  // namespace
+
+std::vector<LegendBar> task_legend(const store::Manifest& m, int task, int frame) {
+  std::vector<LegendBar> bars;
+  if (task < 0 || task >= m.task_count()) return bars;
+  const store::TaskEntry& t = m.tasks[std::size_t(task)];
+  const json& p = t.parameters;
+  if (!p.is_object() || t.fields.empty()) return bars;
+  double lo = 0, hi = 0;
+  if (number_pair(p, "window", lo, hi)) {
+    bars.push_back(window_bar(m, t.fields[0], p, "window", "relative", "transfer_function", frame));
+    if (t.fields.size() > 1 && number_pair(p, "window2", lo, hi))
+      bars.push_back(window_bar(m, t.fields[1], p, "window2", "relative2", "transfer_function2", frame));
+  } else if (t.method == "isosurface" && p.contains("isovalue") && p["isovalue"].is_number()) {
+    LegendBar bar;
+    bar.field = bar.label = t.fields[0];
+    bar.units = units_of(m, t.fields[0]);
+    bar.isovalue = true;
+    bar.lo = bar.hi = p["isovalue"].get<double>();
+    if (flag(p, "relative", false)) {
+      const double ref = reference(m, t.fields[0], frame);
+      if (ref > 0)
+        bar.lo = bar.hi = bar.lo * ref;
+      else
+        bar.physical = false;
+    }
+    const auto c = p.find("colour");
+    if (c != p.end() && c->is_array() && c->size() == 3 && std::all_of(c->begin(), c->end(), [](const json& x) { return x.is_number(); }))
+      bar.colours.push_back({std::clamp((*c)[0].get<float>(), 0.f, 1.f), std::clamp((*c)[1].get<float>(), 0.f, 1.f),
+                             std::clamp((*c)[2].get<float>(), 0.f, 1.f)});
+    bars.push_back(std::move(bar));
+  }
+  return bars;
+}
+
+std::string legend_number(double v) {
+  if (v == 0 || !std::isfinite(v)) return v == 0 ? "0" : "?";
+  char buf[32];
+  const double a = std::abs(v);
+  std::snprintf(buf, sizeof buf, a >= 1e-3 && a < 1e5 ? "%.3g" : "%.2e", v);
+  return buf;
+}
+
+std::string legend_range_text(const LegendBar& bar) {
+  const std::string unit = bar.physical && !bar.units.empty() ? " " + bar.units : std::string();
+  const std::string rel = bar.physical ? std::string() : " x reference";
+  if (bar.isovalue) return "iso " + legend_number(bar.lo) + unit + rel;
+  return legend_number(bar.lo) + " .. " + legend_number(bar.hi) + unit + rel;
+}
+
+std::string time_text(const store::Manifest& m, double time) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "t = %.4g", time + 0.0);
+  return m.time_units.empty() ? std::string(buf) : std::string(buf) + " " + m.time_units;
+}
+
+}  // namespace panoptes::player

@@ -1,0 +1,47 @@
+#pragma once
+// Colour legends (issue 34): what a task's colours stand for, in physical values and units, at one
+// frame. Built from the manifest alone (the transfer function's control points, the window and, for
+// relative windows, the field's per-frame reference), so every front end shows the same numbers.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "store/manifest.hpp"
+
+namespace panoptes::player {
+
+/// Optical depth (in voxels) the legend's colours are drawn at: a sample's colour is shown with the
+/// opacity 1 − exp(−σ·kLegendDepthVoxels) over black, the renderer's background, so transparent
+/// values look dark as they do in the picture.
+inline constexpr double kLegendDepthVoxels = 4;
+/// Colours sampled along a bar (evenly over the window, both ends included).
+inline constexpr int kLegendSamples = 32;
+
+/// One colour bar (or, for an isosurface, one swatch) of a task.
+struct LegendBar {
+  std::string field;   ///< field name, e.g. "phi_p"
+  std::string label;   ///< what the axis shows: "|phi_p|" when the transfer function colours |v|
+  std::string units;   ///< the field's unit ("" = unknown)
+  double lo = 0, hi = 1;  ///< window in physical values (an isosurface: lo == hi == the isovalue)
+  /// False when the window is relative and the manifest does not record the reference (older
+  /// databases): lo and hi are then fractions of that unknown reference.
+  bool physical = true;
+  bool isovalue = false;  ///< an isosurface: one value, one colour
+  /// Colours (r, g, b in [0, 1], premultiplied by the opacity described at kLegendDepthVoxels) at
+  /// kLegendSamples evenly spaced values from lo to hi; one entry for an isovalue; empty when the
+  /// manifest does not record the transfer function (the bar then shows numbers only).
+  std::vector<std::array<float, 3>> colours;
+};
+
+/// The bars of `task` at `frame` (two for a two-field volume, none for tasks without a window, e.g.
+/// synthetic ones). Never throws on a malformed or older manifest: what cannot be read is left out.
+std::vector<LegendBar> task_legend(const store::Manifest& manifest, int task, int frame);
+
+/// A value as the legend prints it: 3 significant digits, "0" for zero, e.g. "2.41e-03", "0.015", "120".
+std::string legend_number(double value);
+/// "0 .. 2.41e-03 1/s", "0.2 .. 1 x reference" (not physical), "iso 0.015 1/s".
+std::string legend_range_text(const LegendBar& bar);
+/// "t = 4.2 s" (time and the manifest's time unit; no unit when it has none).
+std::string time_text(const store::Manifest& manifest, double time);
+
+}  // namespace panoptes::player

@@ -1,0 +1,100 @@
+#include "player/legend.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace panoptes;
+using namespace panoptes::player;
+
+namespace {
+
+// A manifest as `panoptes run` writes it: phi_p in 1/s with per-frame references, a relative window on
+// the p-wave preset's control points, and a two-field task.
+store::Manifest seismic_like() {
+  store::Manifest m;
+  m.time_units = "s";
+  m.fields = {{"phi_p", "1/s", {0.5, 2.0}}, {"phi_s", "1/s", {4.0}}};
+  const nlohmann::json pwave = {{"colour", {{0, 0.9, 0.35, 0.05}, {1, 1.0, 0.8, 0.4}}},
+                                {"extinction", {{0, 0}, {0.1, 0}, {1, 0.5}}},
+                                {"absolute_value", true}};
+  store::TaskEntry p;
+  p.id = 0, p.name = "p-wave", p.method = "volume", p.fields = {"phi_p"};
+  p.parameters = {{"window", {0.0, 1.0}}, {"relative", true}, {"transfer_function", pwave}};
+  store::TaskEntry ps;
+  ps.id = 1, ps.name = "p+s", ps.method = "volume", ps.fields = {"phi_p", "phi_s"};
+  ps.parameters = {{"window", {0.0, 1.0}}, {"relative", true}, {"window2", {0.0, 0.5}}, {"relative2", true},
+                   {"transfer_function", pwave}, {"transfer_function2", pwave}};
+  store::TaskEntry iso;
+  iso.id = 2, iso.name = "iso", iso.method = "isosurface", iso.fields = {"phi_s"};
+  iso.parameters = {{"isovalue", 0.25}, {"relative", true}, {"colour", {0.2, 0.4, 0.6}}};
+  store::TaskEntry synthetic;
+  synthetic.id = 3, synthetic.name = "synthetic", synthetic.method = "synthetic", synthetic.fields = {"x"};
+  m.tasks = {p, ps, iso, synthetic};
+  return m;
+}
+
+}  // namespace
+
+TEST(Legend, RelativeWindowsFollowTheFramesReference) {
+  const store::Manifest m = seismic_like();
+  auto bars = task_legend(m, 0, 0);
+  ASSERT_EQ(bars.size(), 1u);
+  EXPECT_EQ(bars[0].label, "|phi_p|");
+  EXPECT_EQ(bars[0].units, "1/s");
+  EXPECT_TRUE(bars[0].physical);
+  EXPECT_DOUBLE_EQ(bars[0].hi, 0.5);
+  EXPECT_DOUBLE_EQ(task_legend(m, 0, 1)[0].hi, 2.0);
+  EXPECT_DOUBLE_EQ(task_legend(m, 0, 7)[0].hi, 2.0) << "frames past the recorded ones keep the last reference";
+  EXPECT_EQ(legend_range_text(bars[0]), "0 .. 0.5 1/s");
+  // Colours: black (transparent) below 10 % of the window, the preset's orange brightening above.
+  ASSERT_EQ(bars[0].colours.size(), std::size_t(kLegendSamples));
+  EXPECT_EQ(bars[0].colours[0], (std::array<float, 3>{0, 0, 0}));
+  const auto& top = bars[0].colours.back();
+  const float alpha = float(1 - std::exp(-0.5 * kLegendDepthVoxels));
+  EXPECT_NEAR(top[0], 1.0f * alpha, 1e-6);
+  EXPECT_NEAR(top[1], 0.8f * alpha, 1e-6);
+  EXPECT_GT(top[0], top[2]);
+}
+
+TEST(Legend, TwoFieldsIsovaluesAndTasksWithoutWindows) {
+  const store::Manifest m = seismic_like();
+  const auto ps = task_legend(m, 1, 0);
+  ASSERT_EQ(ps.size(), 2u);
+  EXPECT_EQ(ps[1].field, "phi_s");
+  EXPECT_DOUBLE_EQ(ps[1].hi, 2.0);  // 0.5 x phi_s's 4.0
+  const auto iso = task_legend(m, 2, 0);
+  ASSERT_EQ(iso.size(), 1u);
+  EXPECT_TRUE(iso[0].isovalue);
+  EXPECT_DOUBLE_EQ(iso[0].lo, 1.0);
+  EXPECT_EQ(legend_range_text(iso[0]), "iso 1 1/s");
+  ASSERT_EQ(iso[0].colours.size(), 1u);
+  EXPECT_FLOAT_EQ(iso[0].colours[0][2], 0.6f);
+  EXPECT_TRUE(task_legend(m, 3, 0).empty());
+  EXPECT_TRUE(task_legend(m, 99, 0).empty());
+}
+
+TEST(Legend, OlderManifestsShowFractionsOfTheReference) {
+  store::Manifest m = seismic_like();
+  m.fields.clear();
+  m.time_units.clear();
+  m.tasks[0].parameters.erase("transfer_function");
+  const auto bars = task_legend(m, 0, 0);
+  ASSERT_EQ(bars.size(), 1u);
+  EXPECT_FALSE(bars[0].physical);
+  EXPECT_TRUE(bars[0].colours.empty());
+  EXPECT_EQ(bars[0].label, "phi_p");
+  EXPECT_EQ(legend_range_text(bars[0]), "0 .. 1 x reference");
+  EXPECT_EQ(time_text(m, 4.25), "t = 4.25");
+  m.time_units = "s";
+  EXPECT_EQ(time_text(m, 4.25), "t = 4.25 s");
+  // Malformed parameters are left out, never thrown.
+  m.tasks[0].parameters["transfer_function"] = {{"colour", "red"}, {"extinction", {{0, 1}}}};
+  EXPECT_TRUE(task_legend(m, 0, 0)[0].colours.empty());
+}
+
+TEST(Legend, Numbers) {
+  EXPECT_EQ(legend_number(0), "0");
+  EXPECT_EQ(legend_number(0.015), "0.015");
+  EXPECT_EQ(legend_number(120), "120");
+  EXPECT_EQ(legend_number(2.4123e-4), "2.41e-04");
+  EXPECT_EQ(legend_number(3e6), "3.00e+06");
+}

@@ -1,0 +1,61 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "player/keys.hpp"
+#include "ui/hud.hpp"
+
+namespace panoptes::ui {
+namespace {
+
+// Issue 34: the help overlay must fit the default window of the demo (1052 x 1020 on a 1920 x 1200
+// display) — it used to list 51 lines in one column, with a scroll bar and its last lines under the
+// time slider.
+TEST(HudHelp, DigitKeysAndSynonymsShareLines) {
+  const auto rows = help_rows();
+  EXPECT_LE(rows.size(), 42u) << "one line per action, not per key";
+  const auto has = [&](const std::string& key) {
+    return std::any_of(rows.begin(), rows.end(), [&](const HelpRow& r) { return r.key == key; });
+  };
+  EXPECT_TRUE(has("1 .. 9"));
+  EXPECT_TRUE(has("H / F1"));
+  EXPECT_TRUE(has("Escape / Q"));
+  EXPECT_TRUE(has("+ / ="));
+  EXPECT_FALSE(has("5"));
+  // Every binding of the shared key table still appears.
+  for (const auto& b : player::key_bindings()) {
+    const std::string key(b.key);
+    const bool found = std::any_of(rows.begin(), rows.end(), [&](const HelpRow& r) {
+      return r.key == key || r.key.find(key + " /") == 0 || r.key.find("/ " + key) != std::string::npos ||
+             (key.size() == 1 && key[0] >= '1' && key[0] <= '9' && r.key == "1 .. 9");
+    });
+    EXPECT_TRUE(found) << key;
+  }
+}
+
+TEST(HudHelp, LayoutFitsByColumnsThenByTextSizeButNotBelowTheBitmapFont) {
+  // Fits in one column: nothing changes.
+  HelpLayout l = help_layout(40, 20, 500, 1000, 900, 1.3f);
+  EXPECT_EQ(l.pairs, 1);
+  EXPECT_FLOAT_EQ(l.scale, 1);
+  EXPECT_TRUE(l.fits);
+  // Too tall, two columns fit the width: two pairs.
+  l = help_layout(40, 20, 450, 1000, 600, 1.3f);
+  EXPECT_EQ(l.pairs, 2);
+  EXPECT_FLOAT_EQ(l.scale, 1);
+  // Too tall and only one column wide: the text shrinks to fit...
+  l = help_layout(40, 20, 600, 1000, 700, 1.3f);
+  EXPECT_EQ(l.pairs, 1);
+  EXPECT_NEAR(l.scale, 700.f / 800.f, 1e-6);
+  EXPECT_LE(40 * 20 * l.scale, 700.f + 1e-3f);
+  // ... but never below the bitmap font's own size (then it scrolls).
+  EXPECT_TRUE(l.fits);
+  l = help_layout(40, 20, 600, 1000, 300, 1.3f);
+  EXPECT_NEAR(l.scale, 1 / 1.3f, 1e-6);
+  EXPECT_FALSE(l.fits);
+  l = help_layout(40, 20, 600, 1000, 300, 1.0f);
+  EXPECT_FLOAT_EQ(l.scale, 1);
+}
+
+}  // namespace
+}  // namespace panoptes::ui

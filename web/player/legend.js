@@ -1,0 +1,122 @@
+// Colour legends (issue 34): each bar of the current task — its transfer function's colours and its
+// window in physical values and units at the shown frame — as the desktop HUD draws them
+// (src/player/legend.cpp holds the same rules: the colours are shown with the opacity of a
+// LEGEND_DEPTH_VOXELS-thick layer over black, the renderer's background).
+export const LEGEND_DEPTH_VOXELS = 4, LEGEND_SAMPLES = 32;
+
+// Piecewise-linear lookup over [[x, v...], ...] control points, constant beyond the ends; null if malformed.
+function lookup(points, u) {
+  if (!Array.isArray(points) || points.length === 0 || !points.every((p) => Array.isArray(p) && p.length >= 2)) return null;
+  if (u <= points[0][0]) return points[0].slice(1);
+  for (let i = 1; i < points.length; i++) {
+    const [x0, ...a] = points[i - 1], [x1, ...b] = points[i];
+    if (u <= x1) { const w = x1 > x0 ? (u - x0) / (x1 - x0) : 1; return a.map((v, k) => v + (b[k] - v) * w); }
+  }
+  return points[points.length - 1].slice(1);
+}
+
+function sampleColours(tf) {
+  if (!tf || !tf.colour || !tf.extinction) return [];
+  const out = [];
+  for (let i = 0; i < LEGEND_SAMPLES; i++) {
+    const u = i / (LEGEND_SAMPLES - 1), rgb = lookup(tf.colour, u), s = lookup(tf.extinction, u);
+    if (!rgb || rgb.length !== 3 || !s) return [];
+    const alpha = 1 - Math.exp(-Math.max(0, s[0]) * LEGEND_DEPTH_VOXELS);
+    out.push(rgb.map((c) => Math.min(1, Math.max(0, c)) * alpha));
+  }
+  return out;
+}
+
+function reference(db, field, frame) {
+  const f = (db.fields || []).find((x) => x.name === field);
+  const refs = f ? f.references : [];
+  return refs.length ? refs[Math.min(Math.max(frame, 0), refs.length - 1)] : 0;
+}
+const unitsOf = (db, field) => ((db.fields || []).find((x) => x.name === field) || {}).units || "";
+
+function windowBar(db, field, p, windowKey, relativeKey, tfKey, frame) {
+  const tf = p[tfKey];
+  const bar = { field, label: tf && tf.absolute_value ? `|${field}|` : field, units: unitsOf(db, field),
+                lo: p[windowKey][0], hi: p[windowKey][1], physical: true, isovalue: false, colours: sampleColours(tf) };
+  if (p[relativeKey]) {
+    const ref = reference(db, field, frame);
+    if (ref > 0) { bar.lo *= ref; bar.hi *= ref; } else bar.physical = false;
+  }
+  return bar;
+}
+
+/// The bars of task `t` at `frame` (see LegendBar in src/player/legend.hpp).
+export function taskLegend(db, t, frame) {
+  const task = db.tasks[t];
+  const p = task && task.parameters, fields = (task && task.fields) || [];
+  if (!p || fields.length === 0) return [];
+  const pair = (k) => Array.isArray(p[k]) && p[k].length === 2 && p[k].every(Number.isFinite);
+  if (pair("window")) {
+    const bars = [windowBar(db, fields[0], p, "window", "relative", "transfer_function", frame)];
+    if (fields.length > 1 && pair("window2")) bars.push(windowBar(db, fields[1], p, "window2", "relative2", "transfer_function2", frame));
+    return bars;
+  }
+  if (task.method === "isosurface" && Number.isFinite(p.isovalue)) {
+    let v = p.isovalue, physical = true;
+    if (p.relative) { const ref = reference(db, fields[0], frame); if (ref > 0) v *= ref; else physical = false; }
+    return [{ field: fields[0], label: fields[0], units: unitsOf(db, fields[0]), lo: v, hi: v, physical, isovalue: true,
+              colours: Array.isArray(p.colour) && p.colour.length === 3 ? [p.colour] : [] }];
+  }
+  return [];
+}
+
+/// As legend_number() in C++: 3 significant digits, exponent form outside [1e-3, 1e5).
+export function legendNumber(v) {
+  if (v === 0) return "0";
+  if (!Number.isFinite(v)) return "?";
+  const a = Math.abs(v);
+  if (a >= 1e-3 && a < 1e5) return String(Number(v.toPrecision(3)));
+  const [m, e] = v.toExponential(2).split("e");
+  return `${m}e${e[0] === "-" ? "-" : "+"}${e.replace(/^[-+]/, "").padStart(2, "0")}`;
+}
+
+/// "t = 4.2 s" (as time_text() in C++).
+export function timeText(db, t) {
+  return `t = ${Number(t.toPrecision(4))}${db.time_units ? " " + db.time_units : ""}`;
+}
+
+/// Draws the bars into `canvas` (sized to fit, in CSS pixels × devicePixelRatio); hides it when empty.
+export function drawLegend(canvas, bars) {
+  canvas.hidden = bars.length === 0;
+  if (!bars.length) return;
+  const dpr = window.devicePixelRatio || 1, W = 220, rowH = 44, barW = 200, barH = 12;
+  canvas.style.width = `${W}px`;
+  canvas.style.height = `${bars.length * rowH + 4}px`;
+  canvas.width = Math.round(W * dpr);
+  canvas.height = Math.round((bars.length * rowH + 4) * dpr);
+  const ctx = canvas.getContext("2d");
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, W, bars.length * rowH + 4);
+  ctx.font = "12px ui-monospace, monospace";
+  ctx.textBaseline = "top";
+  bars.forEach((bar, i) => {
+    const y = i * rowH + 4, x = 10;
+    ctx.fillStyle = "#e5e9f0";
+    ctx.textAlign = "left";
+    ctx.fillText(`${bar.label}${bar.physical && bar.units ? `  [${bar.units}]` : ""}`, x, y);
+    const rgb = (c) => `rgb(${c.map((v) => Math.round(v * 255)).join(",")})`;
+    if (bar.isovalue) {
+      if (bar.colours.length) { ctx.fillStyle = rgb(bar.colours[0]); ctx.fillRect(x, y + 15, 24, barH); }
+      ctx.fillStyle = "#e5e9f0";
+      ctx.fillText(`iso ${legendNumber(bar.lo)}${bar.physical ? "" : " x ref"}`, x + 32, y + 15);
+      return;
+    }
+    if (bar.colours.length) {
+      const g = ctx.createLinearGradient(x, 0, x + barW, 0);
+      bar.colours.forEach((c, k) => g.addColorStop(k / (bar.colours.length - 1), rgb(c)));
+      ctx.fillStyle = g;
+      ctx.fillRect(x, y + 15, barW, barH);
+      ctx.strokeStyle = "#8c99b3";
+      ctx.strokeRect(x + 0.5, y + 15.5, barW - 1, barH - 1);
+    }
+    ctx.fillStyle = "#e5e9f0";
+    ctx.fillText(legendNumber(bar.lo), x, y + 29);
+    ctx.textAlign = "right";
+    ctx.fillText(`${legendNumber(bar.hi)}${bar.physical ? "" : " x ref"}`, x + barW, y + 29);
+  });
+}
