@@ -20,7 +20,7 @@
 namespace {
 
 // How long Ctrl+C waits for the server's threads before the process ends without them: longer than
-// the server's read/write timeout (5 s), so a normal stop always ends by itself.
+// the server's timeouts (5 s), so a normal stop always ends by itself.
 constexpr int kStopSeconds = 8;
 
 struct Args {
@@ -83,9 +83,10 @@ void run(const Args& a) {
     sigwait(&signals, &sig);
     if (ran) return;  // woken by the main thread after run() returned by itself
     server.stop();
-    // stop() cuts every connection at its next read or write (within the server's timeout). Should
-    // run() still not return in time, or on a second Ctrl+C, the process ends anyway: Ctrl+C stops
-    // the server whatever its threads are doing (issue 31).
+    // stop() cuts every connection within 100 ms of its next wait (web/bounded_http_server.hpp), so
+    // run() returns at once unless a handler is busy (indexing a huge movie, say). Should it still not
+    // return in time, or on a second Ctrl+C, the process ends anyway: Ctrl+C stops the server whatever
+    // its threads are doing (issue 31).
     const timespec wait{kStopSeconds, 0};
     sigtimedwait(&signals, nullptr, &wait);  // a second signal, the main thread's wake-up or the deadline
     if (!ran) {

@@ -126,6 +126,10 @@ FragmentIndex index_fragments(const std::filesystem::path& movie) {
   // file size / 8 steps whatever the sizes claim.
   for (std::uint64_t p = 0; p < f.size() && f.box(p, f.size(), h, /*overhang_ends=*/true); p += h.size) {
     if (is(h, "moov")) {
+      // One init segment, before every fragment: a second moov would make [0, init_size) swallow the
+      // fragments before it (found by fuzz/mp4_fragments_fuzz.cpp).
+      if (have_moov)
+        throw FileError(movie.string(), "a second moov box at byte " + std::to_string(p) + " (not a Panoptes movie)");
       have_moov = true;
       index.init_size = p + h.size;
     } else if (is(h, "moof")) {

@@ -148,6 +148,18 @@ TEST(Mp4Fragments, RefusesFilesThatAreNotMovies) {
   std::ofstream(junk) << "this is not a movie, just some text long enough to look like boxes";
   EXPECT_THROW(index_fragments(junk), FileError);
   EXPECT_THROW(index_fragments(tmp.path / "missing.mp4"), FileError);
+  // A second moov after a fragment (the fuzzer's find): the init segment would swallow the fragment.
+  const fs::path movie = make_db(tmp.path / "db", 2, 1);
+  const std::string good = read_bytes(movie);
+  const std::size_t moov = good.find("moov") - 4, moof = good.find("moof") - 4;
+  const std::size_t second = index_fragments(movie).fragments[1].offset;
+  write_bytes(movie, good.substr(0, second) + good.substr(moov, moof - moov) + good.substr(second));
+  try {
+    index_fragments(movie);
+    FAIL() << "a second moov was accepted";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("a second moov box"), std::string::npos) << e.what();
+  }
 }
 
 TEST(FragmentIndexCache, ReindexesOnlyWhenSizeOrMtimeChange) {
