@@ -105,6 +105,7 @@ void run(const Args& a) {
     j["video"] = {{"codec", "h264"}, {"crf", m.video.crf}, {"preset", m.video.preset},
                   {"gop", m.video.gop}, {"fps", m.video.fps}};
     j["movie_pattern"] = m.movie_pattern;
+    j["frame_checks"] = m.frame_checks.recorded() ? nlohmann::json(m.frame_checks.scheme) : nlohmann::json(nullptr);
     j["bytes_on_disk"] = disk;
     if (!a.no_check) {
       nlohmann::json problems = nlohmann::json::array();
@@ -138,6 +139,9 @@ void run(const Args& a) {
     std::printf("video      h264, crf %d, preset %s, gop %d, %g fps\n", m.video.crf, m.video.preset.c_str(),
                 m.video.gop, m.video.fps);
     std::printf("streams    %lld (movies %s)\n", (long long)db.stream_count(), m.movie_pattern.c_str());
+    std::printf("checks     %s\n", m.frame_checks.recorded()
+                                      ? "every frame: checksum, movie identity, index and timestamp (panoptes-frame-2)"
+                                      : "checksums where a movie carries them (written before frame checks were recorded)");
     std::printf("on disk    %s", human_bytes(double(disk)).c_str());
     if (!a.no_check && db.stream_count() > 0)
       std::printf(" (movies %s, %s per stream)", human_bytes(double(report.bytes)).c_str(),

@@ -1,6 +1,8 @@
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -88,7 +90,22 @@ void explain_number_options(CLI::App& app) {
 }  // namespace
 }  // namespace panoptes::app
 
+namespace {
+
+// The one error line, with what the system's terse words mean for the user.
+std::string explained(std::string message) {
+  // EFBIG from write(2) (and FFmpeg's copy of it) once `ulimit -f` is reached.
+  if (message.find("File too large") != std::string::npos)
+    message += " (the file size limit was reached: see `ulimit -f`; the file ends at its last complete write)";
+  return message;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  // Past `ulimit -f` the kernel would kill us with SIGXFSZ (a core dump, no message); ignored, the
+  // write fails with EFBIG instead and the error names the file.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App root{
       "Panoptes: in-situ visualization from very many cameras, kept as compressed movies, explored "
       "interactively afterwards.",
@@ -116,8 +133,16 @@ int main(int argc, char** argv) {
   } catch (const panoptes::Interrupted& e) {
     std::fprintf(stderr, "panoptes: interrupted: %s\n", e.what());
     return 128 + e.signal();
+  } catch (const std::bad_alloc&) {
+    std::string what = "panoptes";
+    for (const CLI::App* sub : root.get_subcommands()) what += " " + sub->get_name();
+    std::fprintf(stderr,
+                 "panoptes: error: out of memory while running `%s` (its input asks for more memory than this "
+                 "machine or its limit gives; see the command's size options or PANOPTES_MEMORY_LIMIT)\n",
+                 what.c_str());
+    return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "panoptes: error: %s\n", e.what());
+    std::fprintf(stderr, "panoptes: error: %s\n", explained(e.what()).c_str());
     return 1;
   }
   return panoptes::app::exit_code();

@@ -553,6 +553,33 @@ TEST(DamagedMovie, ConcealedFramesShowAPlaceholderNeverAnotherFrame) {
   EXPECT_GT(damaged, 0) << "the concealed frames were shown as ok";
 }
 
+TEST(DamagedMovie, AnotherStreamsMovieShowsAPlaceholderNeverItsFrames) {
+  // Issue #31 row 6: camera 1's movie copied over camera 0's played as camera 0, every frame "ok".
+  TempDir dir("player-foreign");
+  auto m = testing::ring_manifest(2, 1);
+  m.video.gop = 1;
+  {
+    auto w = store::DatabaseWriter::create(dir.path, m, true);
+    for (int f = 0; f < 4; ++f)
+      for (int c = 0; c < 2; ++c) w.append(c, 0, testing::stamped_frame(c, 0, f, 64, 64));
+    w.finalize();
+  }
+  std::filesystem::copy_file(dir.path / "movies/c1/t0.mp4", dir.path / "movies/c0/t0.mp4",
+                             std::filesystem::copy_options::overwrite_existing);
+  VirtualClock clock;
+  EngineOptions o;
+  o.time_source = clock.source();
+  o.start_playing = false;
+  Engine e(dir.path, o);
+  ASSERT_EQ(e.selection().camera, 0);
+  for (int f = 0; f < e.frame_count(); ++f) {
+    e.seek(f);
+    const ShownFrame s = e.current_frame();
+    EXPECT_EQ(s.status, FrameStatus::damaged) << "frame " << f << ": " << s.message;
+    EXPECT_NE(s.message.find("another movie"), std::string::npos) << s.message;
+  }
+}
+
 TEST(EngineErrors, ClearErrorsForBadInput) {
   EXPECT_THROW(Engine("/nonexistent/db"), FileError);
   TempDir dir("player-empty");

@@ -7,7 +7,9 @@
 #include <regex>
 #include <sstream>
 
+#include "core/echo.hpp"
 #include "core/error.hpp"
+#include "core/file_read.hpp"
 
 namespace panoptes::seismic {
 
@@ -27,6 +29,8 @@ bool MediumBlock::attenuating() const {
 }
 
 std::vector<float> read_npy_planes(const std::string& path, int nx, int ny, int nz, int k_begin, int k_end) {
+  // A FIFO or device named as a medium file must be refused, not block the run (or read forever).
+  regular_file_size(path, UINT64_MAX, "medium file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, "cannot open medium file");
   char magic[8];
@@ -52,7 +56,7 @@ std::vector<float> read_npy_planes(const std::string& path, int nx, int ny, int 
   std::smatch m;
   if (!std::regex_search(header, m, std::regex(R"('descr'\s*:\s*'([^']*)')")))
     throw FileError(path, ".npy header has no 'descr'");
-  if (m[1] != "<f4") throw FileError(path, "dtype '" + m[1].str() + "' (expected float32 '<f4')");
+  if (m[1] != "<f4") throw FileError(path, "dtype '" + echo(m[1].str()) + "' (expected float32 '<f4')");
   if (!std::regex_search(header, m, std::regex(R"('fortran_order'\s*:\s*(True|False))")))
     throw FileError(path, ".npy header has no 'fortran_order'");
   if (m[1] == "True") throw FileError(path, "Fortran-ordered array (expected C order, shape (nz, ny, nx))");
@@ -70,7 +74,7 @@ std::vector<float> read_npy_planes(const std::string& path, int nx, int ny, int 
   }
   const std::string want = "(" + std::to_string(nz) + ", " + std::to_string(ny) + ", " + std::to_string(nx) + ")";
   if (shape.size() != 3 || shape[0] != nz || shape[1] != ny || shape[2] != nx)
-    throw FileError(path, "shape (" + m[1].str() + ") does not match the grid: expected (nz, ny, nx) = " + want);
+    throw FileError(path, "shape (" + echo(m[1].str()) + ") does not match the grid: expected (nz, ny, nx) = " + want);
   const std::size_t plane = std::size_t(nx) * ny;
   in.seekg(0, std::ios::end);
   const auto size = static_cast<std::streamoff>(in.tellg());

@@ -32,6 +32,17 @@ MemoryEstimate estimate_solver_memory(const SolverConfig& c, int ranks) {
   const double samples = std::floor(double(c.steps) / std::max(c.record_every, 1)) + 2;
   // The time axis of the traces is reserved for every step even without receivers.
   e.add("receiver traces", (1 + 3.0 * double(c.receivers.size())) * 8 * samples);
+  // Per-item tables (issue #31: 10^5 [[source]] tables took 8.8 GB unseen by this estimate). Each
+  // point source is spread over up to 8x8x8 nodes per component it drives (solver.cpp, Kaiser sinc):
+  // one 40-byte Injection per node, kept twice (the list and its copy sorted by row), for 6 stress
+  // components (moment) or 3 velocity components (force); plus the two copies of the SourceSpec.
+  double injections = 0;
+  for (const SourceSpec& s : c.sources) injections += s.kind == SourceSpec::Kind::moment ? 6 * 512 : 3 * 512;
+  if (!c.sources.empty()) e.add("source tables", 2 * 40 * injections + 2 * double(sizeof(SourceSpec)) * double(c.sources.size()));
+  // Receivers: the spec (name and position), 3 components x 8 interpolation weights and indices.
+  double receiver_bytes = 0;
+  for (const ReceiverSpec& r : c.receivers) receiver_bytes += double(sizeof(ReceiverSpec) + r.name.size()) + 3 * 8 * 16;
+  if (!c.receivers.empty()) e.add("receiver tables", receiver_bytes);
   return e;
 }
 

@@ -1,12 +1,15 @@
 #include "store/atomic_file.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "store/safe_file.hpp"
@@ -40,8 +43,11 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view data,
   } catch (const FileError& e) {
     throw FileError(path.string(), "cannot create the " + std::string(what) + ": " + e.what());
   }
-  // A unique temp name per writer: two processes writing at once must not share a temp file.
-  const std::string tmp = name + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(std::random_device{}());
+  // A unique temp name per writer: two processes writing at once must not share a temp file. Hidden
+  // and starting with kTempPrefix, so one left by a killed writer is never taken for a movie (no
+  // movie pattern may start with ".panoptes"), is not served, and the next writer removes it.
+  const std::string tmp = kTempPrefix + name + ".tmp." + std::to_string(::getpid()) + "." +
+                          std::to_string(std::random_device{}());
   const std::string tmp_name = (dir / tmp).string();
   const int fd = ::openat(dfd.get(), tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd < 0)
@@ -64,6 +70,33 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view data,
   }
   // Make the rename itself durable (best effort: some file systems refuse fsync on directories).
   ::fsync(dfd.get());
+}
+
+std::int64_t remove_stale_temp_files(int dirfd) {
+  const int fd = ::openat(dirfd, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return 0;
+  DIR* d = ::fdopendir(fd);
+  if (!d) {
+    ::close(fd);
+    return 0;
+  }
+  std::vector<std::string> stale;
+  const std::string prefix = kTempPrefix;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    // Also the visible names of earlier versions ("panoptes.json.tmp.<pid>.<n>").
+    if ((name.rfind(prefix, 0) == 0 && name.find(".tmp.") != std::string::npos) ||
+        name.rfind("panoptes.json.tmp.", 0) == 0)
+      stale.push_back(name);
+  }
+  ::closedir(d);
+  std::int64_t removed = 0;
+  for (const auto& name : stale) {
+    struct stat st{};
+    if (::fstatat(dirfd, name.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISREG(st.st_mode)) continue;
+    if (::unlinkat(dirfd, name.c_str(), 0) == 0) ++removed;
+  }
+  return removed;
 }
 
 }  // namespace panoptes::store

@@ -18,13 +18,16 @@
 #include <exception>
 #include <fstream>
 #include <mutex>
+#include <random>
 #include <thread>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "store/atomic_file.hpp"
 #include "store/bounded_json.hpp"
 #include "store/camera_table.hpp"
 #include "store/manifest_diff.hpp"
+#include "store/owned_files.hpp"
 #include "store/safe_file.hpp"
 #include "video/movie_reader.hpp"
 #include "video/movie_writer.hpp"
@@ -86,6 +89,40 @@ void parallel_for(std::int64_t n, int threads, Body body) {
   work();
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+}
+
+// 64 random bits as 16 lowercase hex digits: the database's identity in every frame it writes.
+std::string random_database_id() {
+  std::random_device rd;
+  const std::uint64_t v = (std::uint64_t(rd()) << 32) ^ rd();
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+// The frame checks recorded by the manifest the root writer wrote in dir (non-root ranks stamp their
+// movies with the same identity). Empty if it records none or cannot be read.
+FrameCheckRecord frame_checks_on_disk(int dir_fd, const fs::path& dir) {
+  FrameCheckRecord record;
+  try {
+    const nlohmann::json j = parse_bounded_json(
+        read_regular_file(dir_fd, kManifestFileName, kMaxManifestBytes, "manifest", dir),
+        (dir / kManifestFileName).string(), {}, "manifest");
+    const auto& fc = j.at("frame_checks");
+    record.scheme = fc.at("scheme").get<std::string>();
+    record.database_id = fc.at("database_id").get<std::string>();
+  } catch (const std::exception&) {
+    return {};
+  }
+  return record;
+}
+
+// The overwrite of an old database: removes the movies its manifest lists (and the directories
+// left empty); reports its camera table for removal after the new one is written.
+void remove_old_database_files(int dir_fd, const fs::path& dir, std::string* old_table) {
+  const OldDatabaseFiles old = describe_old_database(dir_fd, dir);
+  remove_owned_files(dir_fd, find_listed_movies(dir_fd, old.movie_pattern, old.cameras, old.tasks), dir);
+  *old_table = old.camera_table;
 }
 
 }  // namespace
@@ -218,6 +255,9 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   manifest.status = Status::running;
   manifest.frames_written = 0;
   manifest.schema_version = kSchemaVersion;
+  // Every frame this writer encodes carries the movie's identity (kept when the caller passes a
+  // manifest that already has one, e.g. an older run's).
+  if (!manifest.frame_checks.recorded()) manifest.frame_checks = {kFrameCheckScheme, random_database_id()};
   try {
     manifest.validate();
   } catch (const Error& e) {
@@ -245,6 +285,7 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist (create it on the root writer first)");
     impl->dir_fd = open_directory(dir);
+    impl->manifest.frame_checks = frame_checks_on_disk(impl->dir_fd.get(), dir);
     return DatabaseWriter(std::move(impl));
   }
 
@@ -255,8 +296,7 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   impl->dir_fd = open_directory(dir);
   impl->take_lock();  // before looking at an old database, so two creators cannot both proceed
 
-  const fs::path manifest_path = dir / kManifestFileName;
-  std::string old_table;
+  std::string old_table;  // the old camera table, removed once the new one is written
   struct stat manifest_stat{};
   if (::fstatat(impl->dir_fd.get(), kManifestFileName, &manifest_stat, AT_SYMLINK_NOFOLLOW) == 0) {
     if (!options.overwrite) {
@@ -264,39 +304,17 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
       throw FileError(dir.string(), "already holds a Panoptes database (panoptes.json); refusing to overwrite it "
                                     "(use --overwrite / WriterOptions::overwrite to replace it)");
     }
-    // Remove the old movie tree: the top directory of the old and the new pattern, when the pattern
-    // has a fixed first directory (a flat pattern's files are simply truncated when rewritten).
-    std::vector<std::string> patterns{impl->manifest.movie_pattern};
+    // Only what the old manifest lists goes (owned_files.hpp): its movies, the directories that
+    // become empty, its camera table; a user's file beside them, or a link's target, stays.
     try {
-      // The JSON only: the old camera table does not matter here (and may be damaged).
-      const nlohmann::json old = parse_bounded_json(
-          read_regular_file(impl->dir_fd.get(), kManifestFileName, kMaxManifestBytes, "manifest", dir),
-          manifest_path.string(), {}, "manifest");
-      const std::string pattern = old.at("movie_pattern").get<std::string>();
-      validate_movie_pattern(pattern);
-      patterns.push_back(pattern);
-    } catch (const std::exception&) {
-      // An unreadable old manifest: only the new pattern's tree is removed.
-    }
-    old_table = referenced_camera_table(manifest_path);
-    for (const auto& pattern : patterns) {
-      const auto slash = pattern.find('/');
-      if (slash == std::string::npos) continue;
-      const std::string top = pattern.substr(0, slash);
-      if (top.find('{') != std::string::npos) continue;
-      const fs::path tree = dir / top;
-      if (fs::is_symlink(tree, ec)) {
-        fs::remove(tree, ec);  // never follow a link out of the directory
-      } else {
-        fs::remove_all(tree, ec);
-      }
-      if (ec) {
-        impl->release_lock();
-        throw FileError(tree.string(), "cannot remove the old movies: " + ec.message());
-      }
+      remove_old_database_files(impl->dir_fd.get(), dir, &old_table);
+    } catch (...) {
+      impl->release_lock();
+      throw;
     }
     ::unlinkat(impl->dir_fd.get(), kManifestFileName, 0);  // a link is removed, never followed
   }
+  remove_stale_temp_files(impl->dir_fd.get());  // a killed writer's half-written manifest or table
   try {
     impl->table = write_camera_table(dir, impl->manifest);
     impl->write_manifest(Status::running, 0);
@@ -354,8 +372,10 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
     }
     FileHandle file = open_for_writing(movie_dir.get(), relative.substr(slash == std::string::npos ? 0 : slash + 1),
                                        true, "movie", path.parent_path());
+    std::optional<video::MovieIdentity> identity;
+    if (impl_->manifest.frame_checks.recorded()) identity = movie_identity(impl_->manifest, camera, task);
     auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), im.width, im.height,
-                                                       impl_->manifest.video);
+                                                       impl_->manifest.video, identity);
     if (writer->padded_width() != im.padded_width || writer->padded_height() != im.padded_height) {
       std::lock_guard lock(impl_->mutex);
       impl_->manifest.image.padded_width = writer->padded_width();
@@ -479,6 +499,9 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
   impl->manifest = std::move(manifest);
   if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist; nothing to resume");
   impl->dir_fd = open_directory(dir);
+  // Frames appended after the seam carry the identity the copied ones do (frame checks): the root
+  // writer takes it from the old manifest, the others from the manifest the root has rewritten.
+  if (!options.writes_manifest) impl->manifest.frame_checks = frame_checks_on_disk(impl->dir_fd.get(), dir);
   std::string old_table;
   if (options.writes_manifest) {
     impl->take_lock();  // a live writer of this database refuses the resume here
@@ -490,6 +513,7 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
                                           "; a resumed run must use the configuration it was written with");
       frames = old.frames_written;
       Manifest& m = impl->manifest;
+      m.frame_checks = old.frame_checks;  // an older database without them stays without
       m.times.assign(old.times.begin(), old.times.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(old.times.size()), frames));
       m.provenance.created = old.provenance.created.empty() ? utc_now_iso8601() : old.provenance.created;
       if (m.provenance.host.empty()) m.provenance.host = old.provenance.host.empty() ? host_name() : old.provenance.host;
@@ -536,8 +560,10 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
                                          "checkpoint " + std::to_string(frames) + "; cannot resume it");
     const std::string temp = leaf + ".resume";
     FileHandle file = open_for_writing(movie_dir.get(), temp, true, "movie", path.parent_path());
+    std::optional<video::MovieIdentity> identity;
+    if (man.frame_checks.recorded()) identity = movie_identity(man, camera, task);
     auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), man.image.width, man.image.height,
-                                                       man.video);
+                                                       man.video, identity);
     writer->copy_frames(*old, frames);
     writer->flush();
     if (::renameat(movie_dir.get(), temp.c_str(), movie_dir.get(), leaf.c_str()) != 0)
@@ -677,7 +703,7 @@ std::unique_ptr<video::MovieReader> Database::stream(int camera, int task) const
   const std::string which = " (stream camera " + std::to_string(camera) + ", task " + std::to_string(task) + ")";
   std::unique_ptr<video::MovieReader> reader;
   try {
-    reader = std::make_unique<video::MovieReader>(resolved.string());
+    reader = std::make_unique<video::MovieReader>(resolved.string(), frame_checks(camera, task));
   } catch (const Error& e) {
     throw StreamFileError(path, "not a readable movie" + which + ": " + without_path(e, resolved.string()),
                           StreamProblem::Kind::unreadable);
@@ -690,6 +716,33 @@ std::unique_ptr<video::MovieReader> Database::stream(int camera, int task) const
                         std::to_string(manifest_.frames_written) + " frames the manifest records",
                           StreamProblem::Kind::truncated);
   return reader;
+}
+
+video::FrameChecks Database::frame_checks(int camera, int task) const {
+  video::FrameChecks checks;
+  if (manifest_.frame_checks.recorded()) {
+    checks.required = true;
+    checks.identity = movie_identity(manifest_, camera, task);
+  }
+  return checks;
+}
+
+std::vector<int> Database::damaged_frames(int camera, int task) const {
+  std::vector<int> bad = stream(camera, task)->check_frames();
+  bad.erase(std::lower_bound(bad.begin(), bad.end(), frame_count()), bad.end());
+  return bad;
+}
+
+video::MovieIdentity movie_identity(const Manifest& manifest, int camera, int task) {
+  video::MovieIdentity id{};
+  const std::string& hex = manifest.frame_checks.database_id;
+  for (std::size_t i = 0; i < 8 && 2 * i + 1 < hex.size(); ++i)
+    id[i] = std::uint8_t(std::stoi(hex.substr(2 * i, 2), nullptr, 16));
+  for (int i = 0; i < 4; ++i) {
+    id[std::size_t(8 + i)] = std::uint8_t(std::uint32_t(camera) >> (24 - 8 * i));
+    id[std::size_t(12 + i)] = std::uint8_t(std::uint32_t(task) >> (24 - 8 * i));
+  }
+  return id;
 }
 
 StreamReport Database::validate_streams(int threads, bool decode_all,

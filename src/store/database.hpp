@@ -174,6 +174,15 @@ class Database {
   /// truncated to nothing or not a movie.
   std::unique_ptr<video::MovieReader> stream(int camera, int task) const;
 
+  /// What readers of the stream's movie demand of every frame: with frame checks recorded in the
+  /// manifest (databases written since they are), a good checksum, this stream's identity, the
+  /// frame's index and timestamp; without (older databases), checksums when the movie carries them.
+  video::FrameChecks frame_checks(int camera, int task) const;
+  /// The checkpointed frames of the stream that fail those checks, found without decoding (reads
+  /// the movie once): what a reader that does not decode through MovieReader (the web server's
+  /// index, a browser) must show as damaged. Throws what stream() throws.
+  std::vector<int> damaged_frames(int camera, int task) const;
+
   /// Deep check: opens every stream's movie (in parallel with `threads` threads, 0 = hardware) and
   /// reports missing, unsafe, unreadable and truncated (fewer than frame_count() frames) ones. With
   /// decode_all, also decodes every checkpointed frame of every movie (in order: one decode per
@@ -187,6 +196,10 @@ class Database {
   Manifest manifest_;
   Status stored_status_ = Status::running;
 };
+
+/// The identity stamped on every frame of stream (camera, task): the manifest's database id (8 bytes),
+/// camera and task (4 bytes each, big-endian).
+video::MovieIdentity movie_identity(const Manifest& manifest, int camera, int task);
 
 /// True if a live process holds the writer lock of the database in dir.
 bool writer_is_alive(const std::filesystem::path& dir);

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "core/echo.hpp"
 #include "core/error.hpp"
 #include "store/atomic_file.hpp"
 #include "store/bounded_json.hpp"
@@ -37,7 +38,7 @@ Status parse_status(std::string_view text) {
   if (text == "running") return Status::running;
   if (text == "complete") return Status::complete;
   if (text == "interrupted") return Status::interrupted;
-  throw Error("status \"" + std::string(text) + "\" is not one of running, complete, interrupted");
+  throw Error("status \"" + echo(text) + "\" is not one of running, complete, interrupted");
 }
 
 double Manifest::frame_time(int frame) const {
@@ -107,7 +108,7 @@ int Manifest::step_task_on_axis(int task, std::string_view axis, int delta) cons
 
 void validate_movie_pattern(const std::string& pattern) {
   const auto bad = [&](const std::string& why) {
-    throw Error("movie pattern \"" + pattern + "\" " + why);
+    throw Error("movie pattern \"" + echo(pattern) + "\" " + why);
   };
   if (pattern.empty()) bad("is empty");
   if (pattern.find('\0') != std::string::npos) bad("contains a NUL character");
@@ -154,7 +155,15 @@ void Manifest::validate() const {
       fail("padded image size " + std::to_string(image.padded_width) + "x" + std::to_string(image.padded_height) +
            " is smaller than the image size " + std::to_string(image.width) + "x" + std::to_string(image.height));
   if (!domain.up_axis.empty() && domain.up_axis != "z_up" && domain.up_axis != "z_down")
-    fail("domain.up_axis \"" + domain.up_axis + "\"; expected \"z_up\" or \"z_down\"");
+    fail("domain.up_axis \"" + echo(domain.up_axis) + "\"; expected \"z_up\" or \"z_down\"");
+  if (frame_checks.recorded()) {
+    if (frame_checks.scheme != kFrameCheckScheme)
+      fail("frame_checks.scheme \"" + echo(frame_checks.scheme) + "\" is not known to this build (expected \"" +
+           kFrameCheckScheme + "\")");
+    const auto& id = frame_checks.database_id;
+    if (id.size() != 16 || id.find_first_not_of("0123456789abcdef") != std::string::npos)
+      fail("frame_checks.database_id \"" + echo(id) + "\" is not 16 lowercase hex digits");
+  }
   if (!(playback_fps == 0 || (std::isfinite(playback_fps) && playback_fps > 0 && playback_fps <= 1000)))
     fail("playback_fps " + std::to_string(playback_fps) + "; expected 0 (none) or a rate in (0, 1000] frames per second");
   try {
@@ -204,7 +213,7 @@ void Manifest::validate() const {
   for (std::size_t i = 0; i < axes.size(); ++i) {
     if (axes[i].name.empty()) fail("axes[" + std::to_string(i) + "] has an empty name");
     if (!axis_size.emplace(axes[i].name, axes[i].values.size()).second)
-      fail("axis \"" + axes[i].name + "\" is defined twice");
+      fail("axis \"" + echo(axes[i].name) + "\" is defined twice");
   }
   std::set<std::string_view> names;
   for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -212,13 +221,13 @@ void Manifest::validate() const {
     const std::string at = "tasks[" + std::to_string(i) + "]";
     if (t.id != int(i)) fail(at + ".id is " + std::to_string(t.id) + ", expected its index " + std::to_string(i));
     if (t.name.empty()) fail(at + " has an empty name");
-    if (!names.insert(t.name).second) fail("task name \"" + t.name + "\" is used twice");
+    if (!names.insert(t.name).second) fail("task name \"" + echo(t.name) + "\" is used twice");
     if (!t.parameters.is_object()) fail(at + ".parameters is not a JSON object");
     for (const auto& p : t.axes) {
       const auto it = axis_size.find(p.axis);
-      if (it == axis_size.end()) fail(at + " sits on unknown axis \"" + p.axis + "\"");
+      if (it == axis_size.end()) fail(at + " sits on unknown axis \"" + echo(p.axis) + "\"");
       if (p.index < 0 || std::size_t(p.index) >= it->second)
-        fail(at + " has index " + std::to_string(p.index) + " on axis \"" + p.axis + "\" of " +
+        fail(at + " has index " + std::to_string(p.index) + " on axis \"" + echo(p.axis) + "\" of " +
              std::to_string(it->second) + " values");
     }
   }
@@ -319,6 +328,8 @@ json manifest_json(const Manifest& m, const CameraTableRef* table) {
                  {"units", m.domain.units}};
   if (!m.domain.up_axis.empty()) j["domain"]["up_axis"] = m.domain.up_axis;
   if (m.playback_fps > 0) j["playback_fps"] = m.playback_fps;
+  if (m.frame_checks.recorded())
+    j["frame_checks"] = {{"scheme", m.frame_checks.scheme}, {"database_id", m.frame_checks.database_id}};
   j["times"] = m.times;
   // Additive (issue 34): older readers ignore them, and manifests without them stay readable.
   if (!m.time_units.empty()) j["time_units"] = m.time_units;
@@ -434,6 +445,10 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
     m.domain.up_axis = r.opt_str(*d, "up_axis", "domain");
   }
   if (const json* v = r.optional(j, "playback_fps", "")) m.playback_fps = r.num(*v, "playback_fps");
+  if (const json* fc = r.optional(j, "frame_checks", "")) {
+    m.frame_checks.scheme = r.str(r.field(*fc, "scheme", "frame_checks"), "frame_checks.scheme");
+    m.frame_checks.database_id = r.str(r.field(*fc, "database_id", "frame_checks"), "frame_checks.database_id");
+  }
   if (const json* t = r.optional(j, "times", "")) {
     r.array(*t, "times");
     m.times.reserve(t->size());

@@ -162,6 +162,22 @@ struct CameraTableRef {
   bool operator==(const CameraTableRef&) const = default;
 };
 
+/// How a database's movies prove their frames (field `frame_checks`). Databases written before it
+/// was recorded have none: their readers check a movie's checksums when its first packets carry
+/// them, as before.
+struct FrameCheckRecord {
+  /// kFrameCheckScheme: every frame of every movie carries a checksum message with its CRC, the
+  /// movie's identity (database_id, camera, task) and its index (video/packet_checksum.hpp, version 2).
+  /// Empty: not recorded.
+  std::string scheme;
+  std::string database_id;  ///< 16 lowercase hex digits, random per database
+  bool recorded() const { return !scheme.empty(); }
+  bool operator==(const FrameCheckRecord&) const = default;
+};
+
+/// The frame check scheme this build writes and reads.
+inline constexpr const char* kFrameCheckScheme = "panoptes-frame-2";
+
 /// Lifecycle of a database. `running` on disk with no live writer is reported as interrupted by
 /// Database::open (see database.hpp).
 enum class Status { running, complete, interrupted };
@@ -194,6 +210,8 @@ struct Manifest {
   std::string time_units;
   /// The fields the tasks read, with units and per-frame references (empty in older manifests).
   std::vector<FieldInfo> fields;
+  /// How its movies prove their frames (empty in older databases; DatabaseWriter::create fills it in).
+  FrameCheckRecord frame_checks;
 
   int camera_count() const { return int(cameras.size()); }
   int task_count() const { return int(tasks.size()); }

@@ -81,6 +81,9 @@ struct MovieReader::Impl {
   int nal_length_size = 0;       // MP4 (avcC) H.264: bytes of each NAL length field; 0 = not checked
   bool checksummed = false;      // the movie's packets carry checksums (packet_checksum.hpp)
   std::vector<std::uint8_t> header;  // the stream's extradata
+  FrameChecks checks;            // what the caller demands of every frame
+  std::int64_t pts_step = 0;     // checks.required: the frame duration; frame f must sit at f * pts_step
+  std::string bad_reason;        // why the last bad packet was bad, for the damaged frame's message
 
   ~Impl() {
     avcodec_free_context(&dec);
@@ -312,16 +315,53 @@ struct MovieReader::Impl {
     crop_width = coded_width;
     crop_height = coded_height;
 
-    // Packets written by MovieWriter carry a checksum; if the first keyframe has one, every packet must.
+    // Packets written by MovieWriter carry a checksum. A database that records its frame checks says
+    // so (checks.required); otherwise one of the first packets carrying a checksum message (good or
+    // damaged: a damaged first packet must not switch the checks off) means every packet must.
     const AVCodecParameters* par = st->codecpar;
     if (par->extradata_size > 0) header.assign(par->extradata, par->extradata + par->extradata_size);
-    if (par->codec_id == AV_CODEC_ID_H264 && par->extradata_size >= 7 && par->extradata[0] == 1 && !packets.empty()) {
+    if (par->codec_id == AV_CODEC_ID_H264 && par->extradata_size >= 7 && par->extradata[0] == 1)
       nal_length_size = (par->extradata[4] & 3) + 1;
-      const PacketInfo& first = packets.front();
-      std::vector<std::uint8_t> bytes(std::size_t(first.size));
-      if (::pread(fd, bytes.data(), bytes.size(), first.pos) == ssize_t(bytes.size()))
-        checksummed = verify_packet_checksum(bytes.data(), first.size, nal_length_size) == PacketChecksum::good;
+    if (checks.required) {
+      checksummed = true;
+      // Every frame lasts one frame duration (MovieWriter writes constant frame rate from 0).
+      pts_step = durations.empty() ? 0 : durations[durations.size() / 2];
+    } else if (nal_length_size > 0) {
+      std::vector<std::uint8_t> bytes;
+      for (std::size_t k = 0; k < packets.size() && k < 3 && !checksummed; ++k) {
+        bytes.resize(std::size_t(packets[k].size));
+        if (::pread(fd, bytes.data(), bytes.size(), packets[k].pos) == ssize_t(bytes.size()))
+          checksummed = inspect_packet(bytes.data(), packets[k].size, nal_length_size).has_sei;
+      }
     }
+  }
+
+  // True if packet k's bytes pass the checks; else sets bad_reason.
+  bool packet_ok(int k, const std::uint8_t* data) {
+    const PacketInfo& pi = packets[std::size_t(k)];
+    if (!checks.required) {
+      if (nal_length_size > 0 && verify_packet_checksum(data, pi.size, nal_length_size) == PacketChecksum::good) return true;
+      bad_reason = "its checksum does not match";
+      return false;
+    }
+    const PacketCheck c = nal_length_size > 0 ? inspect_packet(data, pi.size, nal_length_size) : PacketCheck{};
+    const int f = frame_of_pts(pi.pts);
+    if (!c.has_sei || !c.stamped) {
+      bad_reason = "it carries no frame checksum although its database records that every frame has one";
+    } else if (c.checksum != PacketChecksum::good) {
+      bad_reason = "its checksum does not match";
+    } else if (c.stamp.movie != checks.identity) {
+      bad_reason = "it belongs to another movie (foreign or spliced)";
+    } else if (f < 0 || c.stamp.frame != std::uint32_t(f)) {
+      bad_reason = "it is frame " + std::to_string(c.stamp.frame) + " of its movie, shown at index " + std::to_string(f) +
+                   " (re-ordered or spliced timestamps)";
+    } else if (pts_step <= 0 || pi.pts != std::int64_t(f) * pts_step) {
+      bad_reason = "its timestamp " + std::to_string(pi.pts) + " does not match its index " + std::to_string(f) +
+                   " (expected " + std::to_string(std::int64_t(f) * pts_step) + ")";
+    } else {
+      return true;
+    }
+    return false;
   }
 
   void send_packet(int k) {
@@ -343,8 +383,7 @@ struct MovieReader::Impl {
     std::memset(storage->data + pi.size, 0, AV_INPUT_BUFFER_PADDING_SIZE);
     // Accumulates until a frame comes out: a bad packet whose picture never appears still taints
     // the next picture (it may predict from the lost one).
-    if (checksummed && verify_packet_checksum(storage->data, pi.size, nal_length_size) != PacketChecksum::good)
-      packet_bad = true;
+    if (checksummed && !packet_ok(k, storage->data)) packet_bad = true;
     pkt->buf = av_buffer_ref(storage);
     if (!pkt->buf) throw Error("out of memory");
     pkt->data = storage->data;
@@ -357,7 +396,10 @@ struct MovieReader::Impl {
     ++packets_sent;
     // A damaged packet is not fatal by itself: the frame it carried never comes out (or comes out
     // concealed), and the frames predicted from it are flagged (see `tainted`).
-    if (ret == AVERROR_INVALIDDATA) packet_bad = true;
+    if (ret == AVERROR_INVALIDDATA) {
+      packet_bad = true;
+      bad_reason = "the decoder refused its data";
+    }
     if (ret < 0 && ret != AVERROR_INVALIDDATA)
       throw Error("movie " + path + ": decoder refused packet " + std::to_string(k) + ": " + av_error_string(ret));
   }
@@ -365,6 +407,7 @@ struct MovieReader::Impl {
   void seek_to(int start_packet) {
     avcodec_flush_buffers(dec);
     packet_bad = false;
+    bad_reason.clear();
     next_packet = start_packet;
     current_frame = -1;
     draining = false;
@@ -460,9 +503,10 @@ struct MovieReader::Impl {
   }
 };
 
-MovieReader::MovieReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+MovieReader::MovieReader(const std::string& path, const FrameChecks& checks) : impl_(std::make_unique<Impl>()) {
   quiet_ffmpeg_logs();
   impl_->path = path;
+  impl_->checks = checks;
   impl_->build_index();
 }
 
@@ -491,6 +535,37 @@ bool MovieReader::is_keyframe(int index) const {
   const Impl& m = *impl_;
   if (index < 0 || index >= frame_count()) return false;
   return m.packets[m.frame_packet[index]].key;
+}
+
+std::vector<int> MovieReader::check_frames() {
+  Impl& m = *impl_;
+  std::vector<int> bad;
+  if (!m.checksummed) return bad;
+  std::vector<std::uint8_t> bytes;
+  for (std::size_t k = 0; k < m.packets.size(); ++k) {
+    const PacketInfo& pi = m.packets[k];
+    bytes.resize(std::size_t(pi.size));
+    std::int64_t done = 0;
+    while (done < pi.size) {
+      const ssize_t n = ::pread(m.fd, bytes.data() + done, std::size_t(pi.size - done), pi.pos + done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw FileError(m.path, "cannot read frame data at byte " + std::to_string(pi.pos + done));
+      done += n;
+    }
+    const int f = m.frame_of_pts(pi.pts);
+    if (f >= 0 && !m.packet_ok(int(k), bytes.data())) bad.push_back(f);
+  }
+  m.bad_reason.clear();
+  std::sort(bad.begin(), bad.end());
+  // Frames predicted from a bad one are damaged too, up to the next keyframe.
+  std::vector<int> out;
+  for (std::size_t i = 0, f = 0; f < m.frame_pts.size(); ++f) {
+    while (i < bad.size() && bad[i] < int(f)) ++i;
+    const bool own = i < bad.size() && bad[i] == int(f);
+    if (own || (!out.empty() && out.back() == int(f) - 1 && !m.packets[std::size_t(m.frame_packet[f])].key))
+      out.push_back(int(f));
+  }
+  return out;
 }
 
 std::int64_t MovieReader::packets_decoded() const { return impl_->packets_sent; }
@@ -526,8 +601,12 @@ void MovieReader::read(int index, YuvFrame& out) {
   impl_->decode(index);
   if (impl_->current_damaged)
     throw DamagedFrameError("movie " + impl_->path + ": frame " + std::to_string(index) +
-                            " is damaged (the decoder had to conceal missing or corrupt data in it or in a frame it "
-                            "predicts from)");
+                            " is damaged (" +
+                            (impl_->bad_reason.empty()
+                                 ? std::string("the decoder had to conceal missing or corrupt data in it or in a frame "
+                                               "it predicts from")
+                                 : impl_->bad_reason + ", in it or in a frame it predicts from") +
+                            ")");
   impl_->export_yuv(out);
 }
 

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "video/packet_checksum.hpp"
 
 namespace panoptes::video {
 
@@ -25,12 +26,24 @@ class DamagedFrameError : public Error {
   using Error::Error;
 };
 
+/// What a reader demands of every frame (the store fills it in from what the manifest records).
+struct FrameChecks {
+  /// The movie was written with version-2 checksum messages (packet_checksum.hpp): every frame must
+  /// carry one whose CRC matches, whose identity is `identity` and whose frame index is the frame's,
+  /// at the timestamp its index gives (index × frame duration). A frame failing any of these is
+  /// damaged. False (a movie whose database records nothing, or any other movie): checksums are
+  /// checked when one of the movie's first packets carries a checksum message (good or not), and
+  /// frames are otherwise taken as they come.
+  bool required = false;
+  MovieIdentity identity{};
+};
+
 /// An open movie. Not thread-safe: use one reader per thread.
 class MovieReader {
  public:
   /// Opens the file and indexes its packets (no decoding). Throws FileError if the file is missing,
   /// not a movie, or holds no decodable video stream. A truncated movie opens with the frames it has.
-  explicit MovieReader(const std::string& path);
+  explicit MovieReader(const std::string& path, const FrameChecks& checks = {});
   ~MovieReader();
   MovieReader(const MovieReader&) = delete;
   MovieReader& operator=(const MovieReader&) = delete;
@@ -64,6 +77,10 @@ class MovieReader {
   /// True when every frame's packet comes in presentation order (no B-frames), so frames 0..n-1 are
   /// the first n packets.
   bool in_decode_order() const;
+  /// The frames that fail the frame checks (checksum, identity, index, timestamp), found without
+  /// decoding: reads every packet once. Empty for a movie without checksums (checks not required).
+  /// Throws FileError if the file cannot be read.
+  std::vector<int> check_frames();
   /// Packets sent to the decoder since open (a measure of decoding work: reading frames i, i+1, ...
   /// in order costs one packet each; a random read costs the distance from its keyframe plus one).
   std::int64_t packets_decoded() const;

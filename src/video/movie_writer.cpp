@@ -31,6 +31,7 @@ struct MovieWriter::Impl {
   std::int64_t fd_pos = 0;
   int width = 0, height = 0, padded_width = 0, padded_height = 0;
   VideoSettings settings;
+  std::optional<MovieIdentity> identity;  // stamped on every frame when set
 
   AVFormatContext* fmt = nullptr;
   AVStream* stream = nullptr;
@@ -176,7 +177,13 @@ struct MovieWriter::Impl {
     if (pkt->duration <= 0) pkt->duration = 1;  // one frame; the muxer needs it for the last sample
     // Every packet carries the CRC-32 of its pictures (packet_checksum.hpp): readers then tell a
     // damaged picture from a good one even when the damage decodes without a decoder error.
-    append_packet_checksum(pkt);
+    // With an identity the message also says whose frame this is and where it belongs.
+    FrameStamp stamp;
+    if (identity) {
+      stamp.movie = *identity;
+      stamp.frame = std::uint32_t(pkt->pts != AV_NOPTS_VALUE && pkt->pts >= 0 ? pkt->pts : packets_out);  // encoder clock = frame index
+    }
+    append_packet_checksum(pkt, identity ? &stamp : nullptr);
     av_packet_rescale_ts(pkt, enc_time_base, stream->time_base);
     pkt->stream_index = stream->index;
     int ret = av_write_frame(fmt, pkt);
@@ -234,9 +241,11 @@ struct MovieWriter::Impl {
 MovieWriter::MovieWriter(const std::string& path, int width, int height, const VideoSettings& settings)
     : MovieWriter(-1, path, width, height, settings) {}
 
-MovieWriter::MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings)
+MovieWriter::MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings,
+                         const std::optional<MovieIdentity>& identity)
     : impl_(std::make_unique<Impl>()) {
   impl_->fd = fd;  // owned from here on, also if a check below throws
+  impl_->identity = identity;
   settings.validate();
   if (width < 1 || height < 1 || width > 16384 || height > 16384)
     throw Error("movie " + path + ": frame size " + std::to_string(width) + "x" + std::to_string(height) +

@@ -4,7 +4,10 @@
 #include <memory>
 #include <string>
 
+#include <optional>
+
 #include "core/image.hpp"
+#include "video/packet_checksum.hpp"
 #include "video/video_settings.hpp"
 
 namespace panoptes::video {
@@ -24,8 +27,11 @@ class MovieWriter {
   MovieWriter(const std::string& path, int width, int height, const VideoSettings& settings = {});
   /// Writes to `fd`, an empty regular file opened for writing (taken over: closed by the writer, also
   /// when the constructor throws); `path` only names it in messages. The store opens its movies this
-  /// way, relative to the database directory and without following links.
-  MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings = {});
+  /// way, relative to the database directory and without following links. With `identity`, every
+  /// frame's checksum message also carries it and the frame's index (packet_checksum.hpp, version 2),
+  /// so readers can tell this movie's frames from any other's.
+  MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings = {},
+              const std::optional<MovieIdentity>& identity = std::nullopt);
   ~MovieWriter();  ///< Closes the movie if still open; never throws.
   MovieWriter(const MovieWriter&) = delete;
   MovieWriter& operator=(const MovieWriter&) = delete;

@@ -15,10 +15,19 @@ namespace panoptes::video {
 
 namespace {
 
-// "panoptes-crc32-1" as the SEI's UUID.
+// "panoptes-crc32-1" as the SEI's UUID: CRC only.
 constexpr std::array<std::uint8_t, 16> kUuid = {'p', 'a', 'n', 'o', 'p', 't', 'e', 's',
                                                 '-', 'c', 'r', 'c', '3', '2', '-', '1'};
 constexpr int kPayloadSize = 16 + 4;
+// "panoptes-frame-2": CRC, movie identity, frame index.
+constexpr std::array<std::uint8_t, 16> kUuid2 = {'p', 'a', 'n', 'o', 'p', 't', 'e', 's',
+                                                 '-', 'f', 'r', 'a', 'm', 'e', '-', '2'};
+constexpr int kPayloadSize2 = 16 + 4 + 16 + 4;
+constexpr int kMaxPayload = kPayloadSize2;
+
+std::uint32_t be32(const std::uint8_t* p) {
+  return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | p[3];
+}
 
 std::uint32_t crc_update(std::uint32_t crc, const std::uint8_t* p, std::size_t n) {
   return av_crc(av_crc_get_table(AV_CRC_32_IEEE_LE), crc, p, n);
@@ -30,13 +39,15 @@ std::size_t trimmed(const std::uint8_t* p, std::size_t n) {
   return n;
 }
 
-// True if the NAL unit (header byte first, escaped) is our checksum SEI; then *crc is its value.
-bool is_checksum_sei(const std::uint8_t* nal, std::size_t n, std::uint32_t* crc) {
-  if (n < 3 || (nal[0] & 0x1f) != 6 || nal[1] != 5 || nal[2] != kPayloadSize) return false;
+// True if the NAL unit (header byte first, escaped) is our checksum SEI (either version); then *crc
+// is its value and, for version 2, *stamp its identity and frame (*stamped = true).
+bool is_checksum_sei(const std::uint8_t* nal, std::size_t n, std::uint32_t* crc, FrameStamp* stamp, bool* stamped) {
+  if (n < 3 || (nal[0] & 0x1f) != 6 || nal[1] != 5 || (nal[2] != kPayloadSize && nal[2] != kPayloadSize2)) return false;
+  const int size = nal[2];
   // Unescape (remove emulation-prevention 0x03 after 00 00) the payload.
-  std::uint8_t payload[kPayloadSize];
+  std::uint8_t payload[kMaxPayload];
   int got = 0, zeros = 0;
-  for (std::size_t i = 3; i < n && got < kPayloadSize; ++i) {
+  for (std::size_t i = 3; i < n && got < size; ++i) {
     if (zeros >= 2 && nal[i] == 3) {
       zeros = 0;
       continue;
@@ -44,15 +55,21 @@ bool is_checksum_sei(const std::uint8_t* nal, std::size_t n, std::uint32_t* crc)
     zeros = nal[i] == 0 ? zeros + 1 : 0;
     payload[got++] = nal[i];
   }
-  if (got != kPayloadSize || std::memcmp(payload, kUuid.data(), kUuid.size()) != 0) return false;
-  *crc = std::uint32_t(payload[16]) << 24 | std::uint32_t(payload[17]) << 16 | std::uint32_t(payload[18]) << 8 |
-         payload[19];
+  if (got != size) return false;
+  const auto& uuid = size == kPayloadSize ? kUuid : kUuid2;
+  if (std::memcmp(payload, uuid.data(), uuid.size()) != 0) return false;
+  *crc = be32(payload + 16);
+  *stamped = size == kPayloadSize2;
+  if (*stamped) {
+    std::memcpy(stamp->movie.data(), payload + 20, 16);
+    stamp->frame = be32(payload + 36);
+  }
   return true;
 }
 
 }  // namespace
 
-bool append_packet_checksum(AVPacket* pkt) {
+bool append_packet_checksum(AVPacket* pkt, const FrameStamp* stamp) {
   const std::uint8_t* d = pkt->data;
   const int n = pkt->size;
   auto start_code = [&](int from) { return next_start_code(d, n, from); };
@@ -69,12 +86,18 @@ bool append_packet_checksum(AVPacket* pkt) {
     sc = next;
   }
   if (first_vcl < 0) first_vcl = n;
-  std::vector<std::uint8_t> sei = {0, 0, 0, 1, 0x06, 0x05, kPayloadSize};
-  std::uint8_t payload[kPayloadSize];
-  std::memcpy(payload, kUuid.data(), kUuid.size());
+  const int size = stamp ? kPayloadSize2 : kPayloadSize;
+  std::vector<std::uint8_t> sei = {0, 0, 0, 1, 0x06, 0x05, std::uint8_t(size)};
+  std::uint8_t payload[kMaxPayload];
+  std::memcpy(payload, (stamp ? kUuid2 : kUuid).data(), 16);
   for (int i = 0; i < 4; ++i) payload[16 + i] = std::uint8_t(crc >> (24 - 8 * i));
+  if (stamp) {
+    std::memcpy(payload + 20, stamp->movie.data(), 16);
+    for (int i = 0; i < 4; ++i) payload[36 + i] = std::uint8_t(stamp->frame >> (24 - 8 * i));
+  }
   int zeros = 0;
-  for (std::uint8_t b : payload) {
+  for (int k = 0; k < size; ++k) {
+    const std::uint8_t b = payload[k];
     if (zeros >= 2 && b <= 3) {  // emulation prevention
       sei.push_back(3);
       zeros = 0;
@@ -89,28 +112,43 @@ bool append_packet_checksum(AVPacket* pkt) {
   return true;
 }
 
-PacketChecksum verify_packet_checksum(const std::uint8_t* data, int size, int length_size) {
-  if (length_size < 1 || length_size > 4) return PacketChecksum::absent;
+PacketCheck inspect_packet(const std::uint8_t* data, int size, int length_size) {
+  PacketCheck check;
+  if (length_size < 1 || length_size > 4) return check;
   std::uint32_t crc = 0, recorded = 0;
-  bool found = false;
   for (int pos = 0; pos < size;) {
-    if (size - pos < length_size) return PacketChecksum::bad;
+    if (size - pos < length_size) {
+      check.checksum = PacketChecksum::bad;
+      return check;
+    }
     std::uint32_t len = 0;
     for (int i = 0; i < length_size; ++i) len = len << 8 | data[pos + i];
     pos += length_size;
-    if (len > std::uint32_t(size - pos)) return PacketChecksum::bad;
+    if (len > std::uint32_t(size - pos)) {
+      check.checksum = PacketChecksum::bad;
+      return check;
+    }
     const std::uint8_t* nal = data + pos;
     std::uint32_t value = 0;
-    if (is_checksum_sei(nal, len, &value)) {
+    FrameStamp stamp;
+    bool stamped = false;
+    if (!check.has_sei && is_checksum_sei(nal, len, &value, &stamp, &stamped)) {
       recorded = value;
-      found = true;
+      check.has_sei = true;
+      check.stamped = stamped;
+      check.stamp = stamp;
     } else {
       crc = crc_update(crc, nal, trimmed(nal, len));
     }
     pos += int(len);
   }
-  if (!found) return PacketChecksum::absent;
-  return crc == recorded ? PacketChecksum::good : PacketChecksum::bad;
+  if (!check.has_sei) return check;
+  check.checksum = crc == recorded ? PacketChecksum::good : PacketChecksum::bad;
+  return check;
+}
+
+PacketChecksum verify_packet_checksum(const std::uint8_t* data, int size, int length_size) {
+  return inspect_packet(data, size, length_size).checksum;
 }
 
 }  // namespace panoptes::video

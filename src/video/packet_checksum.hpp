@@ -4,6 +4,12 @@
 // the damage decodes "validly": zeroed or flipped CABAC data often decodes without any error the
 // decoder could report, as skipped macroblocks (a copy of the previous frame) or as garbage.
 // Decoders and other players ignore the message. Movies without it are simply not checked.
+//
+// Version 2 of the message (UUID "panoptes-frame-2") also carries the movie's identity (16 bytes the
+// writer's caller chooses: the store puts its database id, camera and task there) and the frame's
+// index, so a movie that is not the one a manifest describes (foreign, spliced) and a frame shown at
+// another index (a corrupted `tfdt` re-orders fragments) are told from good ones.
+#include <array>
 #include <cstdint>
 
 extern "C" {
@@ -12,12 +18,33 @@ extern "C" {
 
 namespace panoptes::video {
 
-/// Appends the checksum SEI to an Annex B H.264 packet (as libx264 produces them). Returns false and
-/// leaves the packet unchanged if it is not Annex B or memory runs out.
-bool append_packet_checksum(AVPacket* pkt);
+/// Identity of one movie, carried by every frame's checksum message (version 2).
+using MovieIdentity = std::array<std::uint8_t, 16>;
+
+/// What a version-2 checksum message stamps on a packet besides the CRC.
+struct FrameStamp {
+  MovieIdentity movie{};
+  std::uint32_t frame = 0;  ///< index of the frame in its movie
+};
+
+/// Appends the checksum SEI to an Annex B H.264 packet (as libx264 produces them): version 2 with
+/// `stamp` when given, else version 1 (CRC only). Returns false and leaves the packet unchanged if it
+/// is not Annex B or memory runs out.
+bool append_packet_checksum(AVPacket* pkt, const FrameStamp* stamp = nullptr);
 
 /// Result of verify_packet_checksum.
 enum class PacketChecksum { absent, good, bad };
+
+/// Everything a packet's checksum message says.
+struct PacketCheck {
+  PacketChecksum checksum = PacketChecksum::absent;
+  bool has_sei = false;   ///< a checksum message was found (even if the CRC then failed)
+  bool stamped = false;   ///< it was version 2: `stamp` holds its identity and frame index
+  FrameStamp stamp;
+};
+
+/// As verify_packet_checksum, with the message's version-2 stamp.
+PacketCheck inspect_packet(const std::uint8_t* data, int size, int length_size);
 
 /// Checks a length-prefixed (MP4 "avcC") H.264 packet whose NAL length fields have `length_size`
 /// bytes: `bad` if its NAL structure is broken or the CRC of its other NAL units differs from the

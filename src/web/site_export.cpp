@@ -1,9 +1,20 @@
 #include "web/site_export.hpp"
 
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
+#include <random>
+#include <set>
 
 #include "core/error.hpp"
 #include "store/database.hpp"
+#include "store/owned_files.hpp"
+#include "store/safe_file.hpp"
 #include "web/database_json.hpp"
 #include "web/mp4_fragments.hpp"
 #include "web/safe_path.hpp"
@@ -14,51 +25,203 @@ namespace fs = std::filesystem;
 
 namespace {
 
-void write_text(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw FileError(path.string(), "cannot write");
+// The staging directory: everything is written into a fresh directory this run created (no link in
+// it but the ones it makes), and moved into OUT only once the whole site is there.
+class Staging {
+ public:
+  Staging(const fs::path& parent, const std::string& name) {
+    std::random_device rd;
+    for (int attempt = 0;; ++attempt) {
+      dir_ = parent / ("." + name + ".export-web." + std::to_string(::getpid()) + "." + std::to_string(rd()));
+      if (::mkdir(dir_.c_str(), 0700) == 0) break;
+      if (errno != EEXIST || attempt > 8)
+        throw FileError(dir_.string(), std::string("cannot create the staging directory: ") + std::strerror(errno));
+    }
+  }
+  ~Staging() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);  // removes links themselves, never what they point to
+  }
+  Staging(const Staging&) = delete;
+  Staging& operator=(const Staging&) = delete;
+  const fs::path& dir() const { return dir_; }
+
+  void write_text(const std::string& relative, const std::string& text) {
+    const fs::path path = dir_ / relative;
+    fs::create_directories(path.parent_path());
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) throw FileError(path.string(), "cannot write");
+    files_.push_back(relative);
+  }
+
+  std::int64_t copy_in(const fs::path& from, const std::string& relative) {
+    const fs::path to = dir_ / relative;
+    fs::create_directories(to.parent_path());
+    std::error_code ec;
+    fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw FileError(to.string(), "cannot copy " + from.string() + ": " + ec.message());
+    files_.push_back(relative);
+    return std::int64_t(fs::file_size(to));
+  }
+
+  void link(const fs::path& target, const std::string& relative) {
+    fs::create_directory_symlink(target, dir_ / relative);
+    files_.push_back(relative);
+  }
+
+  const std::vector<std::string>& files() const { return files_; }
+
+ private:
+  fs::path dir_;
+  std::vector<std::string> files_;
+};
+
+// A listing line must name a plain relative path inside OUT.
+bool plain_relative(const std::string& p) {
+  if (p.empty() || p.front() == '/' || p.find('\0') != std::string::npos || p.find('\\') != std::string::npos)
+    return false;
+  for (std::size_t start = 0;;) {
+    const std::size_t end = p.find('/', start);
+    const std::string part = p.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    if (part.empty() || part == "." || part == "..") return false;
+    if (end == std::string::npos) return true;
+    start = end + 1;
+  }
 }
 
-std::int64_t copy_into(const fs::path& from, const fs::path& to) {
-  fs::create_directories(to.parent_path());
-  std::error_code ec;
-  fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
-  if (ec) throw FileError(to.string(), "cannot copy " + from.string() + ": " + ec.message());
-  return std::int64_t(fs::file_size(to));
+// The files a previous export listed in OUT; throws if OUT holds no listing (then it was not written
+// by export-web, or by a version that did not list its files: nothing in it is known to be ours).
+std::set<std::string> read_listing(int out_fd, const fs::path& out) {
+  std::string text;
+  try {
+    text = store::read_regular_file(out_fd, kSiteListingFileName, std::uint64_t(256) << 20, "site listing", out);
+  } catch (const FileError& e) {
+    throw FileError(out.string(), "is not empty and holds no readable " + std::string(kSiteListingFileName) +
+                                      " (the list of files an export-web wrote), so nothing in it is known to be ours "
+                                      "to replace; remove it yourself or choose another output directory (" +
+                                      e.what() + ")");
+  }
+  std::set<std::string> files;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    start = end + 1;
+    if (line.empty()) continue;
+    if (!plain_relative(line) || line == kSiteListingFileName) continue;  // not ours to remove
+    files.insert(std::move(line));
+  }
+  return files;
+}
+
+// True if the directory `relative` in OUT holds nothing but files the old listing owns (at any
+// depth): removing them empties it, so it is pruned before the new file takes its place.
+bool emptied_by_removal(int out_fd, const std::string& relative, const std::set<std::string>& owned, int depth = 0) {
+  if (depth > 64) return false;
+  const int fd = ::openat(out_fd, relative.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return false;
+  DIR* d = ::fdopendir(fd);
+  if (!d) {
+    ::close(fd);
+    return false;
+  }
+  std::vector<std::string> names;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    if (name != "." && name != "..") names.push_back(name);
+  }
+  ::closedir(d);
+  for (const auto& name : names) {
+    const std::string path = relative + "/" + name;
+    struct stat st{};
+    if (::fstatat(out_fd, path.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) return false;
+    if (S_ISDIR(st.st_mode) ? !emptied_by_removal(out_fd, path, owned, depth + 1) : !owned.count(path)) return false;
+  }
+  return true;
+}
+
+// Refuses, before anything in OUT changes, a new file whose place in OUT holds something the old
+// listing does not own (the user's file, a link planted on the way, a directory).
+void check_no_conflict(int out_fd, const fs::path& out, const std::vector<std::string>& files,
+                       const std::set<std::string>& owned) {
+  for (const auto& file : files) {
+    std::string prefix;
+    for (std::size_t start = 0;;) {
+      const std::size_t end = file.find('/', start);
+      const bool last = end == std::string::npos;
+      prefix = file.substr(0, last ? std::string::npos : end);
+      struct stat st{};
+      if (::fstatat(out_fd, prefix.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) break;  // absent: free from here on
+      const bool removed = S_ISDIR(st.st_mode) ? last && emptied_by_removal(out_fd, prefix, owned) : owned.count(prefix) > 0;
+      if (last ? !removed : !(S_ISDIR(st.st_mode) || removed))
+        throw FileError((out / prefix).string(),
+                        "exists and was not written by export-web (it is not in " + std::string(kSiteListingFileName) +
+                            "); refusing to replace it");
+      if (last || !S_ISDIR(st.st_mode)) break;  // an owned file or link on the way: removed before the move
+      start = end + 1;
+    }
+  }
+}
+
+// Moves the staged files into OUT one by one, creating directories without following links.
+void move_in(const Staging& staging, int out_fd, const fs::path& out) {
+  const store::FileHandle stage_fd = store::open_directory(staging.dir());
+  std::vector<std::string> files = staging.files();
+  files.push_back(kSiteListingFileName);
+  for (const auto& file : files) {
+    const auto slash = file.rfind('/');
+    const std::string dir = slash == std::string::npos ? "" : file.substr(0, slash);
+    const std::string name = file.substr(slash == std::string::npos ? 0 : slash + 1);
+    const store::FileHandle from = store::open_subdirectory(stage_fd.get(), dir, false, staging.dir());
+    const store::FileHandle to = store::open_subdirectory(out_fd, dir, true, out);
+    if (::renameat(from.get(), name.c_str(), to.get(), name.c_str()) != 0)
+      throw FileError((out / file).string(), std::string("cannot move the exported file in: ") + std::strerror(errno));
+  }
 }
 
 }  // namespace
 
-SiteExport export_site(const fs::path& database, const fs::path& out, const fs::path& player_dir, DatabaseCopy mode,
-                       bool overwrite, const std::function<void(std::int64_t, std::int64_t)>& progress) {
+SiteExport export_site(const fs::path& database, const fs::path& out_arg, const fs::path& player_dir,
+                       DatabaseCopy mode, bool overwrite, const std::function<void(std::int64_t, std::int64_t)>& progress) {
   const store::Database db = store::Database::open(database);
   const SafeRoot root(database);
   std::error_code ec;
-  if (fs::exists(out) && !fs::is_empty(out, ec) && !overwrite)
-    throw FileError(out.string(), "exists and is not empty (use --overwrite to replace the exported files)");
-  if (fs::equivalent(root.dir(), out, ec) || (fs::exists(out) && fs::weakly_canonical(out).string().rfind(root.dir().string() + "/", 0) == 0))
-    throw FileError(out.string(), "is inside the database directory; choose another output directory");
-  fs::create_directories(out);
+  // OUT itself is the user's choice and may be reached through links; everything inside it is not.
+  const fs::path out = fs::weakly_canonical(fs::absolute(out_arg), ec);
+  if (ec) throw FileError(out_arg.string(), "cannot resolve the output directory: " + ec.message());
+  if (out == root.dir() || out.lexically_relative(root.dir()).begin()->string() != "..")
+    throw FileError(out_arg.string(), "is inside the database directory; choose another output directory");
+  const bool exists = fs::exists(out, ec);
+  if (exists && !fs::is_directory(out, ec)) throw FileError(out_arg.string(), "exists and is not a directory");
+  const bool empty = !exists || fs::is_empty(out, ec);
+  if (!empty && !overwrite)
+    throw FileError(out_arg.string(), "exists and is not empty (use --overwrite to replace the exported files)");
+  fs::create_directories(out.parent_path(), ec);
+  store::FileHandle out_fd;
+  std::set<std::string> owned;
+  if (!empty) {
+    out_fd = store::open_directory(out);
+    owned = read_listing(out_fd.get(), out_arg);
+  }
 
+  Staging staging(out.parent_path(), out.filename().string());
   // The player's files, as the server would serve them.
   for (const auto& entry : fs::recursive_directory_iterator(player_dir)) {
     if (!entry.is_regular_file()) continue;
-    copy_into(entry.path(), out / entry.path().lexically_relative(player_dir));
+    staging.copy_in(entry.path(), entry.path().lexically_relative(player_dir).generic_string());
   }
-  write_text(out / "api" / "database.json", database_json(db).dump());
+  staging.write_text("api/database.json", database_json(db).dump());
 
   SiteExport summary;
   summary.streams = db.stream_count();
-  const fs::path db_out = out / "db";
   if (mode == DatabaseCopy::link) {
-    if (fs::is_symlink(db_out) || fs::exists(db_out)) fs::remove_all(db_out);
-    fs::create_directory_symlink(root.dir(), db_out);
+    staging.link(root.dir(), "db");
   } else {
-    summary.bytes_copied += copy_into(root.dir() / store::kManifestFileName, db_out / store::kManifestFileName);
+    summary.bytes_copied += staging.copy_in(root.dir() / store::kManifestFileName, std::string("db/") + store::kManifestFileName);
     const std::string table = store::referenced_camera_table(root.dir() / store::kManifestFileName);
-    if (!table.empty()) summary.bytes_copied += copy_into(root.dir() / table, db_out / table);
+    if (!table.empty()) summary.bytes_copied += staging.copy_in(root.dir() / table, "db/" + table);
   }
   std::int64_t done = 0;
   for (int c = 0; c < db.camera_count(); ++c) {
@@ -73,11 +236,38 @@ SiteExport export_site(const fs::path& database, const fs::path& out, const fs::
       } catch (const Error&) {
         continue;  // unreadable: same
       }
-      write_text(out / "api" / "index" / std::to_string(c) / (std::to_string(t) + ".json"),
-                 fragment_index_json(index).dump());
+      nlohmann::json index_json = fragment_index_json(index);
+      // Frames that fail the manifest's frame checks (checksum, identity, index, timestamp): the
+      // browser decodes by itself, so the index says which ones to show as damaged.
+      try {
+        const std::vector<int> damaged = db.damaged_frames(c, t);
+        if (!damaged.empty()) index_json["damaged_frames"] = damaged;
+      } catch (const Error&) {
+        // Truncated or not decodable here: the browser finds out by itself, as before.
+      }
+      staging.write_text("api/index/" + std::to_string(c) + "/" + std::to_string(t) + ".json", index_json.dump());
       ++summary.indexed;
-      if (mode == DatabaseCopy::copy) summary.bytes_copied += copy_into(*movie, db_out / relative);
+      if (mode == DatabaseCopy::copy) summary.bytes_copied += staging.copy_in(*movie, "db/" + relative);
     }
+  }
+  std::string listing;
+  for (const auto& f : staging.files()) listing += f + "\n";
+  {
+    std::ofstream l(staging.dir() / kSiteListingFileName, std::ios::binary | std::ios::trunc);
+    l << listing;
+    if (!l.flush()) throw FileError((staging.dir() / kSiteListingFileName).string(), "cannot write");
+  }
+
+  if (empty) {
+    // A fresh OUT: the whole staged tree becomes it in one rename.
+    if (exists && ::rmdir(out.c_str()) != 0)
+      throw FileError(out_arg.string(), std::string("cannot replace the empty directory: ") + std::strerror(errno));
+    if (::rename(staging.dir().c_str(), out.c_str()) != 0)
+      throw FileError(out_arg.string(), std::string("cannot move the exported site in: ") + std::strerror(errno));
+  } else {
+    check_no_conflict(out_fd.get(), out_arg, staging.files(), owned);
+    store::remove_owned_files(out_fd.get(), {owned.begin(), owned.end()}, out_arg);
+    move_in(staging, out_fd.get(), out_arg);
   }
   if (progress) progress(summary.streams, summary.streams);
   return summary;

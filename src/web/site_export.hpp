@@ -6,6 +6,10 @@
 
 namespace panoptes::web {
 
+/// The list of files an export wrote, one relative path a line, kept in OUT: a later --overwrite
+/// removes exactly these and nothing else.
+inline constexpr const char* kSiteListingFileName = ".panoptes-site";
+
 /// What export_site does with the database's files.
 enum class DatabaseCopy {
   copy,  ///< copy the manifest, camera table and movies into OUT/db (self-contained site)
@@ -21,8 +25,12 @@ struct SiteExport {
 
 /// Writes OUT/index.html and the player's files, OUT/api/database.json, OUT/api/index/C/T.json per
 /// stream (what `panoptes serve` computes per request), and the database under OUT/db. Missing or
-/// unreadable movies get no index (the player shows its placeholder for them). Refuses an OUT that
-/// exists and is not empty unless overwrite (then only the files it writes are replaced).
+/// unreadable movies get no index (the player shows its placeholder for them). The site is built in
+/// a fresh staging directory beside OUT and moved in only when complete, so a failed export leaves
+/// nothing behind, and nothing is ever written through a link found in OUT. Refuses an OUT that
+/// exists and is not empty unless overwrite; then OUT must hold the listing of an earlier export
+/// (kSiteListingFileName): exactly the files it lists are removed (a listed link is removed, never
+/// followed) and an unlisted file where the new site needs a place is refused before OUT changes.
 /// progress(done, total) is called now and then.
 SiteExport export_site(const std::filesystem::path& database, const std::filesystem::path& out,
                        const std::filesystem::path& player_dir, DatabaseCopy mode, bool overwrite,

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Frames never lie (issue #31, rows 5 and 6): `info --decode` reports a garbled first frame, a movie
+# in another stream's place and a re-ordered movie as damaged, never "all readable".
+set -euo pipefail
+panoptes=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "frame_checks: $*"; exit 1; }
+py=/usr/bin/python3
+
+"$panoptes" synth-db "$tmp/db" --cameras 3 --tasks 1 --frames 4 --size 48x32 --gop 1 >/dev/null
+"$panoptes" info "$tmp/db" --decode > "$tmp/out" || { cat "$tmp/out"; fail "a fresh database is not all readable"; }
+grep -q "^checks     every frame" "$tmp/out" || { cat "$tmp/out"; fail "info does not say how frames are checked"; }
+
+# Row 5: one byte of the first frame's picture (the first mdat) flipped.
+"$py" - "$tmp/db/movies/c0/t0.mp4" <<'PY'
+import sys
+p = sys.argv[1]; b = bytearray(open(p, 'rb').read())
+i = b.find(b'mdat'); size = int.from_bytes(b[i - 4:i], 'big')
+b[i - 4 + size - 6] ^= 0x10
+open(p, 'wb').write(b)
+PY
+# Row 6: camera 2's movie replaced by camera 1's (a foreign movie), and camera 1's first tfdt made late.
+cp "$tmp/db/movies/c1/t0.mp4" "$tmp/db/movies/c2/t0.mp4"
+"$py" - "$tmp/db/movies/c1/t0.mp4" <<'PY'
+import sys
+p = sys.argv[1]; b = bytearray(open(p, 'rb').read())
+i = b.find(b'tfdt'); at = i + 8 + (4 if b[i + 4] == 1 else 0)
+b[at:at + 4] = (1 << 24).to_bytes(4, 'big')
+open(p, 'wb').write(b)
+PY
+set +e
+"$panoptes" info "$tmp/db" --decode --json > "$tmp/out"
+status=$?
+set -e
+[ "$status" = 2 ] || { cat "$tmp/out"; fail "info --decode exit status $status, expected 2"; }
+"$py" - "$tmp/out" <<'PY' || { cat "$tmp/out"; exit 1; }
+import json, sys
+problems = {p['camera']: p for p in json.load(open(sys.argv[1]))['check']['problems']}
+assert sorted(problems) == [0, 1, 2], problems
+assert problems[0]['kind'] == 'damaged' and problems[0]['damaged_frames'] == [0], problems[0]
+assert problems[1]['kind'] == 'damaged' and problems[1]['damaged_frames'] == [0, 1, 2, 3], problems[1]
+assert 'shown at index' in problems[1]['message'] or 'timestamp' in problems[1]['message'], problems[1]
+assert problems[2]['kind'] == 'damaged' and 'another movie' in problems[2]['message'], problems[2]
+PY
+echo "frame_checks: ok"
