@@ -6,8 +6,11 @@
 !                                section (strides into the original array), real(4) grid/time, integer(8) steps
 !   layout_test errors  CONFIG   wrong shapes and layouts are refused with ierr and a message naming both
 !                                shapes; nothing is bound, nothing crashes
-! Ranks are split 2 x 2 in x and y (or 1 x 1 with one rank). Ghost values come from the same analytic
-! field as owned ones, i.e. a FULL halo (edges and corners valid), declared with panoptes_halo.
+! Ranks are split 2 x 2 in x and y (or 1 x 1 with one rank). xyz: ghost values come from the same
+! analytic field as owned ones, i.e. a FULL halo (edges and corners valid, declared so with
+! panoptes_halo). zxy and sleeve: a FACE-ONLY halo, as most codes exchange it: the edge/corner ghosts
+! (outside the owned range in both x and y) hold stale garbage (1e30) and are declared not valid, so
+! Panoptes must fetch them from their owners; the frames must still equal xyz's.
 program layout_test
   use mpi
   use panoptes
@@ -17,6 +20,7 @@ program layout_test
   character(len=16) :: mode
   character(len=512) :: config
   integer :: rank, nranks, ierr, px, py, cx, cy, g, s
+  logical :: face_only
   integer :: off(3), ext(3), glo(3), ghi(3)
   real(real64), allocatable, target :: u(:, :, :), v(:, :, :)
   real(real32), allocatable, target :: w(:, :, :)
@@ -51,7 +55,8 @@ program layout_test
     call panoptes_grid(viz, [nx, ny, nz], [0d0, 0d0, 0d0], [1d0, 1d0, 1d0])  ! real(8)
   end if
   call panoptes_block(viz, off, ext, glo, ghi)
-  call panoptes_halo(viz, [-1, -1, -1], [-1, -1, -1], edges_valid=.true.)
+  face_only = mode /= 'xyz'
+  call panoptes_halo(viz, [-1, -1, -1], [-1, -1, -1], edges_valid=.not. face_only)
 
   ! Index ranges below are GLOBAL 0-based point indices: i = off(1)-glo(1) .. off(1)+ext(1)-1+ghi(1), etc.
   select case (trim(mode))
@@ -103,6 +108,12 @@ contains
     f = exp(-(x * x + y * y + z * z) / 40d0) + 0.6d0 * exp(-((i - 0.7d0 * nx)**2 + y * y + (k - 0.3d0 * nz - s)**2) / 25d0)
   end function
 
+  ! An edge or corner ghost of a face-only halo exchange: outside the owned range in x and in y.
+  logical function stale(i, j)
+    integer, intent(in) :: i, j
+    stale = face_only .and. (i < off(1) .or. i >= off(1) + ext(1)) .and. (j < off(2) .or. j >= off(2) + ext(2))
+  end function
+
   subroutine fill_xyz(a, s)
     real(real64), intent(out) :: a(off(1) - glo(1):, off(2) - glo(2):, 0:)
     integer, intent(in) :: s
@@ -123,7 +134,7 @@ contains
     do j = lbound(a, 3), ubound(a, 3)
       do i = lbound(a, 2), ubound(a, 2)
         do k = lbound(a, 1), ubound(a, 1)
-          a(k, i, j) = f(i, j, k, s)
+          a(k, i, j) = merge(1d30, f(i, j, k, s), stale(i, j))
         end do
       end do
     end do
@@ -135,7 +146,7 @@ contains
     do j = off(2) - glo(2), off(2) + ext(2) - 1 + ghi(2)
       do i = off(1) - glo(1), off(1) + ext(1) - 1 + ghi(1)
         do k = 0, nz - 1
-          w(k, i, j) = real(f(i, j, k, s), real32)
+          w(k, i, j) = merge(1e30, real(f(i, j, k, s), real32), stale(i, j))
         end do
       end do
     end do

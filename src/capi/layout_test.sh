@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fortran arrays as real codes hold them (issue 28), through the Panoptes module. On 2 x 2 ranks, a
-# z-fastest array (layout='zxy') and a real(4) sleeved, padded z-fastest array handed over as a section
-# must give exactly the frames of the x-fastest array (every camera, task and snapshot); the same on
+# z-fastest array (layout='zxy') and a real(4) sleeved, padded z-fastest array handed over as a section,
+# both with a face-only halo (stale edge/corner ghosts), must give exactly the frames of the x-fastest
+# array with a full halo (every camera, task and snapshot); the same on
 # 1 rank for z-fastest; and 2 x 2 ranks must match 1 rank within the rank bar of insitu_mpi_test
 # (PSNR >= 45 dB: partial images composite in another order, measured worst difference 4/255). Then the
 # refusals (layout_test errors), and an expression (a temporary the library would keep the address of)
