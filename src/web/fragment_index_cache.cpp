@@ -10,11 +10,15 @@ namespace fs = std::filesystem;
 
 FragmentIndexCache::FragmentIndexCache(std::size_t max_bytes) : max_bytes_(max_bytes) {}
 
-std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movie) { return get(movie).first; }
+std::shared_ptr<const std::string> FragmentIndexCache::json(const fs::path& movie,
+                                                        const std::function<void(nlohmann::json&)>& extra) {
+  return get(movie, extra).first;
+}
 
-int FragmentIndexCache::frame_count(const fs::path& movie) { return get(movie).second; }
+int FragmentIndexCache::frame_count(const fs::path& movie) { return get(movie, {}).second; }
 
-std::pair<std::shared_ptr<const std::string>, int> FragmentIndexCache::get(const fs::path& movie) {
+std::pair<std::shared_ptr<const std::string>, int> FragmentIndexCache::get(
+    const fs::path& movie, const std::function<void(nlohmann::json&)>& extra) {
   std::error_code ec;
   const auto size = fs::file_size(movie, ec);
   if (ec) throw FileError(movie.string(), "cannot read: " + ec.message());
@@ -38,7 +42,9 @@ std::pair<std::shared_ptr<const std::string>, int> FragmentIndexCache::get(const
   // Built outside the lock: other streams are served meanwhile. Two requests for the same new movie
   // may both build it; the second insert just replaces the first.
   const FragmentIndex index = index_fragments(movie);
-  auto text = std::make_shared<const std::string>(fragment_index_json(index).dump());
+  nlohmann::json j = fragment_index_json(index);
+  if (extra) extra(j);
+  auto text = std::make_shared<const std::string>(j.dump());
   std::lock_guard lock(mutex_);
   if (const auto it = by_path_.find(key); it != by_path_.end()) {
     bytes_ -= it->second->json->size();

@@ -6,12 +6,15 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <list>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <unordered_map>
 #include <utility>
+
+#include <nlohmann/json.hpp>
 
 namespace panoptes::web {
 
@@ -24,7 +27,10 @@ class FragmentIndexCache {
 
   /// The index of `movie` as JSON (web::fragment_index_json), from the cache when the file's size and
   /// mtime are unchanged, else built (index_fragments) and kept. Throws what index_fragments throws.
-  std::shared_ptr<const std::string> json(const std::filesystem::path& movie);
+  /// `extra`, if given, adds to the JSON object before it is cached (e.g. the frames that fail their
+  /// frame checks): it runs once per build of the entry, not per request.
+  std::shared_ptr<const std::string> json(const std::filesystem::path& movie,
+                                          const std::function<void(nlohmann::json&)>& extra = {});
   /// The frames in the complete fragments of `movie` (FragmentIndex::frame_count), from the same entry.
   int frame_count(const std::filesystem::path& movie);
 
@@ -40,7 +46,8 @@ class FragmentIndexCache {
     std::shared_ptr<const std::string> json;
     int frames = 0;
   };
-  std::pair<std::shared_ptr<const std::string>, int> get(const std::filesystem::path& movie);
+  std::pair<std::shared_ptr<const std::string>, int> get(const std::filesystem::path& movie,
+                                                         const std::function<void(nlohmann::json&)>& extra);
   mutable std::mutex mutex_;
   std::list<Entry> lru_;  // front = most recently used
   std::unordered_map<std::string, std::list<Entry>::iterator> by_path_;

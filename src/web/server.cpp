@@ -305,7 +305,18 @@ struct Server::Impl {
       }
       try {
         res.set_header("Cache-Control", "no-cache");
-        res.set_content(*indexes.json(*file), "application/json");
+        // Frames that fail the manifest's frame checks (checksum, identity, index, timestamp): the
+        // browser decodes by itself, so the index names them, as export-web's does.
+        res.set_content(*indexes.json(*file,
+                                      [&](nlohmann::json& j) {
+                                        try {
+                                          const std::vector<int> damaged = d->damaged_frames(camera, task);
+                                          if (!damaged.empty()) j["damaged_frames"] = damaged;
+                                        } catch (const Error&) {
+                                          // Truncated or unreadable here: the browser finds out by itself.
+                                        }
+                                      }),
+                        "application/json");
       } catch (const Error& e) {
         log(request_line(req) + " 422 " + e.what());
         send_error(res, 422, e.what());

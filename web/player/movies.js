@@ -202,6 +202,9 @@ export class Stream {
       traffic.bytes += text.length;
       traffic.requests++;
       this.index = JSON.parse(text);
+      // Frames that fail their database's frame checks (checksum, identity, position): the server
+      // and export-web name them; the player shows a placeholder instead of a frame that lies.
+      this.damaged = new Set(Array.isArray(this.index.damaged_frames) ? this.index.damaged_frames : []);
       mark("index");
       const n = this.index.init_size, guess = await head;
       this.init = !(guess instanceof Error) && guess.byteLength >= n ? guess.slice(0, n) : await fetchBytes(this.url, [0, n]);

@@ -369,7 +369,11 @@ function tick(now) {
   if (S.pending) S.pending.seen = true;
   if (!same) {
     const vf = cache.get(key);
-    if (vf) {
+    if (st.status === "ok" && st.damaged && st.damaged.has(frame)) {
+      status = "damaged";
+      drawPlaceholder(S.camera, S.task, status, `${st.url}: frame ${frame} fails its frame checks (checksum, movie identity or position)`);
+      drawn = true;
+    } else if (vf) {
       drawFrame(vf);
       drawn = true;
       S.message = "";

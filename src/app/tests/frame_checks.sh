@@ -43,4 +43,26 @@ assert problems[1]['kind'] == 'damaged' and problems[1]['damaged_frames'] == [0,
 assert 'shown at index' in problems[1]['message'] or 'timestamp' in problems[1]['message'], problems[1]
 assert problems[2]['kind'] == 'damaged' and 'another movie' in problems[2]['message'], problems[2]
 PY
+
+# The web server's index names the same damaged frames, so the browser shows its placeholder.
+"$panoptes" serve "$tmp/db" --port 0 > "$tmp/log" 2>&1 &
+server=$!
+trap 'kill "$server" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+port=""
+for _ in $(seq 100); do
+  port=$(sed -n 's|^serving .* at http://127.0.0.1:\([0-9]*\)/.*$|\1|p' "$tmp/log")
+  [ -n "$port" ] && break
+  sleep 0.1
+done
+[ -n "$port" ] || { cat "$tmp/log"; fail "serve printed no address"; }
+"$py" - "$port" <<'PY' || fail "serve's fragment indexes do not name the damaged frames"
+import json, sys, urllib.request
+port = sys.argv[1]
+def index(c):
+    return json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}/api/index/{c}/0.json", timeout=20))
+assert index(0).get("damaged_frames") == [0], index(0)
+assert index(1).get("damaged_frames") == [0, 1, 2, 3], index(1)
+assert index(2).get("damaged_frames") == [0, 1, 2, 3], index(2)
+PY
+kill "$server" 2>/dev/null || true
 echo "frame_checks: ok"
