@@ -189,8 +189,11 @@ SiteExport export_site(const fs::path& database, const fs::path& out_arg, const 
   const SafeRoot root(database);
   std::error_code ec;
   // OUT itself is the user's choice and may be reached through links; everything inside it is not.
-  const fs::path out = fs::weakly_canonical(fs::absolute(out_arg), ec);
+  fs::path out = fs::weakly_canonical(fs::absolute(out_arg), ec);
   if (ec) throw FileError(out_arg.string(), "cannot resolve the output directory: " + ec.message());
+  // "site/" names the directory site: without this its parent would be site itself, and the staging
+  // directory would be made inside OUT.
+  if (!out.has_filename()) out = out.parent_path();
   if (out == root.dir() || out.lexically_relative(root.dir()).begin()->string() != "..")
     throw FileError(out_arg.string(), "is inside the database directory; choose another output directory");
   const bool exists = fs::exists(out, ec);

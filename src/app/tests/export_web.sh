@@ -48,6 +48,12 @@ if (ulimit -f 64; "$panoptes" export-web "$tmp/B" "$tmp/site2") 2>"$tmp/err" >/d
 [ ! -e "$tmp/site2" ] || fail "a failed export left $tmp/site2"
 ! ls -A "$tmp" | grep -q "export-web" || fail "a failed export left its staging directory"
 
+# OUT named with a trailing slash, existing and empty (the README's `export-web out/demo site/`): the
+# staging directory goes beside it, not inside it.
+mkdir "$tmp/site3"
+"$panoptes" export-web "$tmp/A" "$tmp/site3/" >/dev/null || fail "export into an empty OUT/ failed"
+[ -f "$tmp/site3/index.html" ] && [ -f "$tmp/site3/api/database.json" ] || fail "OUT/ holds no site"
+
 # Row 12: past `ulimit -f` a writer says so in one line (no SIGXFSZ core dump).
 set +e
 (ulimit -f 8; "$panoptes" synth-db "$tmp/big" --cameras 2 --tasks 1 --frames 30 --size 256x256 --gop 1 >/dev/null 2>"$tmp/err")
