@@ -41,18 +41,32 @@ std::string megabytes(std::size_t bytes) {
 
 }  // namespace
 
-Hud::Hud(const store::Manifest& manifest) {
+std::vector<Vec3> minimap_directions(const store::Manifest& manifest) {
+  // East, north, sky as world vectors (a proper rotation, so the map keeps the rig's handedness).
+  Vec3 east{1, 0, 0}, north{0, 1, 0}, sky{0, 0, 1};
+  if (manifest.domain.up_axis == "z_down") east = {0, 1, 0}, north = {1, 0, 0}, sky = {0, 0, -1};
+  const auto& params = manifest.rig.parameters;
+  if (manifest.rig.kind == "cinema" && params.is_object() && params.contains("pole") && params["pole"].is_array() &&
+      params["pole"].size() == 3 && params["pole"][0].is_number() && params["pole"][1].is_number() &&
+      params["pole"][2].is_number()) {
+    const Vec3 pole{params["pole"][0].get<double>(), params["pole"][1].get<double>(), params["pole"][2].get<double>()};
+    if (std::abs(pole.y) > 0.5) east = {0, 0, 1}, north = {1, 0, 0}, sky = {0, 1, 0};
+    if (std::abs(pole.x) > 0.5) east = {0, 1, 0}, north = {0, 0, 1}, sky = {1, 0, 0};
+  }
   std::vector<Vec3> dirs;
-  std::vector<int> shells;
   dirs.reserve(manifest.cameras.size());
-  // The mini-map draws the sky at the top: directions go into the domain's sky frame (east, north,
-  // sky), the same frame camera::SkyFrame lays rigs out in (z_down: east = +y, north = +x, sky = −z).
-  const bool z_down = manifest.domain.up_axis == "z_down";
   for (const auto& c : manifest.cameras) {
     const Vec3 d = c.position - c.look_at;
-    dirs.push_back(z_down ? Vec3{d.y, d.x, -d.z} : d);
-    shells.push_back(c.labels.shell);
+    dirs.push_back({dot(d, east), dot(d, north), dot(d, sky)});
   }
+  return dirs;
+}
+
+Hud::Hud(const store::Manifest& manifest) {
+  std::vector<Vec3> dirs = minimap_directions(manifest);
+  std::vector<int> shells;
+  for (const auto& c : manifest.cameras) shells.push_back(c.labels.shell);
+  const bool z_down = manifest.domain.up_axis == "z_down";
   minimap_.set_cameras(std::move(dirs), std::move(shells));
   // Rigs inside the volume (issue 14) get a 3-D overview of the box and the cameras instead.
   const auto& params = manifest.rig.parameters;

@@ -67,6 +67,12 @@ struct HelpLayout {
 /// own size (1 / font_scale).
 HelpLayout help_layout(int rows, float row_h, float pair_w, float avail_w, float avail_h, float font_scale);
 
+/// The direction from the rig centre towards each camera, in the sky frame the mini-map draws
+/// (x east, y north, z the sky): the domain's sky (z_down: east = +y, north = +x, sky = -z), or, for
+/// an imported Cinema database, the producer's pole (rig parameter "pole": ParaView's extractor turns
+/// over +y), in the same proper frame as the cameras' lat/lon labels (cinema/import.cpp).
+std::vector<Vec3> minimap_directions(const store::Manifest& manifest);
+
 /// The overlay. Call draw() between SdlWindow::begin_imgui_frame() and render_imgui().
 class Hud {
  public:
