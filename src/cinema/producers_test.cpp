@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 
@@ -37,6 +38,8 @@ struct Checked {
 };
 
 // Compares every recorded producer camera with the imported camera of the same (phi, theta).
+// Positions: absolute when the database records the scene (positions_recorded), else after mapping
+// the producer's scene onto the import's stand-in scene.
 Checked compare_cameras(const cinema::ImportPlan& plan, const fs::path& cdb, bool positions_recorded) {
   std::ifstream in(cdb / "cameras.json");
   const auto rec = nlohmann::json::parse(in);
@@ -60,11 +63,26 @@ Checked compare_cameras(const cinema::ImportPlan& plan, const fs::path& cdb, boo
     out.worst_up = std::max(out.worst_up, angle_deg(turned ? -up_p : up_p, up_i));
     // The producer's up pointed away from its pole exactly when the picture was turned.
     EXPECT_EQ(turned, dot(up_p, vec(m.rig.parameters["pole"])) < -1e-9) << "phi " << phi << " theta " << theta;
-    const double dist = norm(pos - focal);
-    const Vec3 imported = positions_recorded ? c.position : focal + fwd_i * -dist;  // no scene recorded: direction only
-    out.worst_pos = std::max(out.worst_pos, norm(imported - pos) / dist);
+    if (positions_recorded) {
+      out.worst_pos = std::max(out.worst_pos, norm(c.position - pos) / norm(pos - focal));
+    } else {
+      // The database records no scene: the import frames a stand-in (a unit box at the origin) as the
+      // producer frames its own. Map the producer's scene (the bounds it framed, recorded by the
+      // fixture's script) onto the stand-in by the similarity that takes one bounding sphere to the
+      // other; the producer's camera must then land on the imported one, focal point and distance.
+      const auto& b = img.at("scene_bounds");
+      const Vec3 lo{b[0].get<double>(), b[2].get<double>(), b[4].get<double>()};
+      const Vec3 hi{b[1].get<double>(), b[3].get<double>(), b[5].get<double>()};
+      const double scale = (std::sqrt(3.0) / 2) / (norm(hi - lo) / 2);
+      const Vec3 mid = (lo + hi) * 0.5;
+      const double dist = norm(c.position - c.look_at);
+      out.worst_pos = std::max(out.worst_pos, norm((pos - mid) * scale - c.position) / dist);
+      out.worst_pos = std::max(out.worst_pos, norm((focal - mid) * scale - c.look_at) / dist);
+    }
     ++out.images;
   }
+  std::printf("%s: %d images, worst direction %.2g deg, up %.2g deg, position %.2g of the distance\n",
+              cdb.filename().c_str(), out.images, out.worst_dir, out.worst_up, out.worst_pos);
   return out;
 }
 
