@@ -134,7 +134,8 @@ try {
       (i) => i.getAttribute("src") && i.getAttribute("src").includes(db + "/image/") && i.complete && i.naturalWidth > 1).length >= 1,
       { timeout: 20000 }, database);
     const n = await ex.evaluate((db) => [...document.querySelectorAll("img")].filter((i) => (i.getAttribute("src") || "").includes(db + "/image/")).length, database);
-    assert.ok(await ex.evaluate(() => /36 out of 36 results selected/.test(document.body.innerText)), "explorer did not select all 36 rows");
+    assert.ok(await ex.evaluate((n) => new RegExp(`${n} out of ${n} results selected`).test(document.body.innerText), images),
+              `explorer did not select all ${images} rows`);
     console.log(`     explorer shows ${n} images on its first page`);
     if (screenshot) await ex.screenshot({ path: screenshot.replace(/\.png$/, "-explorer.png") });
   });
