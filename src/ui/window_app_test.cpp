@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <random>
 #include <string>
+#include <thread>
 
 #include "core/error.hpp"
 #include "core/frame_stamp.hpp"
@@ -215,6 +218,48 @@ TEST_F(WindowTest, ScriptedKeysShowTheExpectedStampUnderTheHud) {
   EXPECT_LE(reader.frame_count(), 32);
   EXPECT_EQ(read_frame_stamp(reader.read_rgba(0)), (FrameStamp{0, 0, 0}));
   EXPECT_EQ(read_frame_stamp(reader.read_rgba(reader.frame_count() - 1)), (FrameStamp{1, 1, 2}));
+}
+
+// A recording lasts as long as the user recorded (issue 34: a 5 s path is a 5 s movie), on the wall
+// clock, also when the display draws fewer pictures per second than the movie has: here every window
+// frame takes at least 80 ms (12.5 fps or less against the database's 30 fps). R at 0.2 s and at
+// 2.2 s: 2 s of movie at 30 fps; a recorder that only encoded the pictures drawn made ~0.8 s of it.
+TEST_F(WindowTest, RecordingOnASlowDisplayLastsAsLongAsTheRecording) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  const auto out = dir_->path / "slow_recording";
+  std::filesystem::create_directories(out);
+  const auto script = out / "keys.txt";
+  std::ofstream(script) << "t=0.2 key=R\nt=2.2 key=R\n";
+  WindowOptions o = test_window(false);
+  o.virtual_time = false;
+  o.script = script;
+  o.width = kW;
+  o.height = kH;
+  o.output_dir = out;
+  o.max_frames = 400;  // a safety net; the window closes itself at 2.6 s
+  std::chrono::steady_clock::time_point t0;  // the script's clock starts with the first frame
+  o.before_frame = [&](int frame) {
+    if (frame == 0) t0 = std::chrono::steady_clock::now();
+    std::this_thread::sleep_for(std::chrono::milliseconds(80));
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::milliseconds(2600)) {
+      SDL_Event e{};
+      e.type = SDL_QUIT;
+      SDL_PushEvent(&e);
+    }
+  };
+  const WindowResult r = run_window(dir_->path / "db", o);
+  std::filesystem::path movie;
+  for (const auto& e : std::filesystem::directory_iterator(out))
+    if (e.path().extension() == ".mp4") movie = e.path();
+  ASSERT_FALSE(movie.empty()) << "no recording in " << out;
+  video::MovieReader reader(movie.string());
+  const double seconds = reader.frame_count() / 30.0;
+  std::printf("recorded %d frames = %.2f s of movie in %d window frames\n", reader.frame_count(), seconds,
+              r.frames_presented);
+  EXPECT_LT(r.frames_presented, 40) << "the display was not slower than the movie's rate";
+  // R is seen at the first window frame after 0.2 s and after 2.2 s: each up to one slow frame late.
+  EXPECT_GE(seconds, 1.6);
+  EXPECT_LE(seconds, 2.4);
 }
 
 TEST_F(WindowTest, MouseDragSnapsWheelZoomsAroundTheCursorRightDragPans) {
