@@ -18,6 +18,13 @@ jq '.playback_fps = 10' db/panoptes.json > m.json && mv m.json db/panoptes.json
 "$panoptes" export-path db --script s.txt --out slow.mp4 | grep "wrote slow.mp4: 6 frames at 10 fps = 0.6 s" >/dev/null
 duration=$(ffprobe -v error -select_streams v:0 -show_entries stream=duration -of csv=p=0 slow.mp4)
 awk -v d="$duration" 'BEGIN { exit !(d > 0.55 && d < 0.65) }' || { echo "slow.mp4 lasts $duration s, expected 0.6"; exit 1; }
+# A 5 s path is a 5 s movie at the player's rate (issue 34), as ffprobe reads the file.
+printf 't=0.1 key=Right\nt=2.0 key=Tab\nt=4.5 key=Right\n' > five.txt
+"$panoptes" export-path db --script five.txt --duration 5 --out five.mp4 | grep "wrote five.mp4: 50 frames at 10 fps = 5.0 s" >/dev/null
+probe=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=r_frame_rate,nb_read_frames,duration \
+        -of csv=p=0 five.mp4)
+awk -F, -v p="$probe" 'BEGIN { split(p, f, ","); exit !(f[1] == "10/1" && f[2] > 4.99 && f[2] < 5.01 && f[3] == 50) }' ||
+  { echo "five.mp4: ffprobe says $probe, expected 10/1,5.0,50"; exit 1; }
 if "$panoptes" export-path db --script s.txt --out /nonexistent/dir/x.mp4 2>err.txt; then
   echo "unwritable output accepted"; exit 1
 fi
