@@ -35,6 +35,16 @@ grep -q '^panoptes: error: .*cannot tell which producer.*--angles paraview|cinem
   fail "bad message: $(cat "$tmp/err")"
 out=$("$panoptes" import-cinema "$tmp/x.cdb" "$tmp/amb" --angles elevation --azimuth-zero -x)
 grep "cameras: generic Cinema (theta = elevation) (--angles elevation)" <<<"$out" >/dev/null || fail "unexpected import output: $out"
+# The databases the real producers wrote (src/cinema/fixtures) import as they are, each recognised.
+fixtures=$(cd "$(dirname "$0")/../../cinema/fixtures" && pwd)
+for want in "paraview_extracts:12 cameras x 2 tasks = 24 movies, 3 frames each:ParaView image extractor (camera mode Phi-Theta)" \
+            "paraview_cinema_python:12 cameras x 3 tasks = 36 movies, 3 frames each:ParaView cinema_python (phi-theta camera)" \
+            "ascent_convention:12 cameras x 1 tasks = 12 movies, 2 frames each:Ascent cinema extract"; do
+  IFS=: read -r name counts producer <<<"$want"
+  out=$("$panoptes" import-cinema "$fixtures/$name.cdb" "$tmp/$name") || fail "$name: import failed"
+  grep -F "$counts" <<<"$out" >/dev/null || fail "$name: unexpected import output: $out"
+  grep -F "cameras: $producer" <<<"$out" >/dev/null || fail "$name: producer not recognised: $out"
+done
 "$panoptes" export-cinema --help | grep -- "--format" >/dev/null || fail "export-cinema --help"
 "$panoptes" import-cinema --help | grep -- "--group-by" >/dev/null || fail "import-cinema --help"
 echo "cinema.sh: ok"
