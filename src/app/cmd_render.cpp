@@ -196,6 +196,7 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   cfg.projection = a.projection;
   cfg.tasks = insitu::tasks_from_shorthand(a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks, "volume");
   cfg.schedule.every_steps = 1;  // every volume is a snapshot
+  if (a.crf > 51) throw Error("--crf " + std::to_string(a.crf) + ": expected an x264 quality 0..51");
   if (a.crf >= 0) cfg.video.crf = a.crf;
   cfg.render.sample_distance = a.sample_distance;
   cfg.render.adaptive = a.adaptive;

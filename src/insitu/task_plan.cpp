@@ -1,7 +1,9 @@
 #include "insitu/task_plan.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <sstream>
 
@@ -216,22 +218,22 @@ std::vector<TaskConfig> tasks_from_shorthand(const std::vector<std::string>& tex
   if (isos < 2) return tasks;
   // Several isosurfaces form one sweep on an "isovalue" axis, so the player can step the isovalue.
   std::vector<TaskConfig> merged;
-  TaskConfig* sweep = nullptr;
+  std::size_t sweep = SIZE_MAX;  // an index: merged grows, a pointer into it would dangle
   for (TaskConfig& t : tasks) {
     if (t.kind != TaskConfig::Kind::isosurface) {
       merged.push_back(std::move(t));
       continue;
     }
-    if (!sweep) {
+    if (sweep == SIZE_MAX) {
       t.name = "iso";
       t.axis = "isovalue";
       merged.push_back(std::move(t));
-      sweep = &merged.back();
+      sweep = merged.size() - 1;
       continue;
     }
-    for (double v : sweep->isovalues)
+    for (double v : merged[sweep].isovalues)
       if (v == t.isovalues[0]) throw Error("--task \"" + t.name + "\": the isovalue is given twice");
-    sweep->isovalues.push_back(t.isovalues[0]);
+    merged[sweep].isovalues.push_back(t.isovalues[0]);
   }
   for (const TaskConfig& t : merged)
     if (t.kind != TaskConfig::Kind::isosurface && t.name == "iso")
@@ -253,6 +255,14 @@ std::string task_table_toml(const TaskConfig& t) {
     if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
     return text;
   };
+  // Floats (colours, extinction scales) in their shortest form: 0.85, not 0.85000002384185791.
+  auto numf = [](float v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    std::string text(buf, r.ptr);
+    if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+    return text;
+  };
   auto list = [&](const std::vector<double>& v) {
     std::string s = "[";
     for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + num(v[i]);
@@ -268,7 +278,7 @@ std::string task_table_toml(const TaskConfig& t) {
     case TaskConfig::Kind::volume:
     case TaskConfig::Kind::volume2:
       s += "preset = " + q(t.preset) + "\n";
-      if (t.extinction_scale != 1) s += "extinction_scale = " + num(t.extinction_scale) + "\n";
+      if (t.extinction_scale != 1) s += "extinction_scale = " + numf(t.extinction_scale) + "\n";
       s += std::string("relative = ") + (t.windows.at(0).relative ? "true" : "false") + "\n";
       if (t.windows.size() == 1) {
         s += "window = " + list({t.windows[0].lo, t.windows[0].hi}) + "\n";
@@ -284,7 +294,7 @@ std::string task_table_toml(const TaskConfig& t) {
     case TaskConfig::Kind::isosurface:
       s += (t.isovalues.size() == 1 ? "isovalue = " + num(t.isovalues[0]) : "isovalues = " + list(t.isovalues)) + "\n";
       s += std::string("relative = ") + (t.iso_relative ? "true" : "false") + "\n";
-      s += "colour = " + list({t.colour[0], t.colour[1], t.colour[2]}) + "\n";
+      s += "colour = [" + numf(t.colour[0]) + ", " + numf(t.colour[1]) + ", " + numf(t.colour[2]) + "]\n";
       break;
     case TaskConfig::Kind::slice:
       s += std::string("axis = \"") + char('x' + t.slice_axis) + "\"\n";
