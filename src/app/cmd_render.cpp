@@ -1,5 +1,9 @@
 // `panoptes render VOLUME... --rig SPEC --task TASK... --size WxH --out DB`: renders a volume, or a
-// time series of volumes, from every camera of a rig for every task, into a movie database.
+// time series of volumes, from every camera of a rig for every task, into a movie database. A replay
+// through the in-situ pipeline (issue 30): the options become a session configuration (the --task
+// shorthand is the TOML [[task]] table it stands for, insitu/task_plan.hpp) and every volume is one
+// snapshot of a one-rank insitu::Session, so rig, references, windows and frames are the ones
+// `panoptes run`, the C API and Python give for the same configuration.
 #include <glob.h>
 #include <unistd.h>
 
@@ -27,6 +31,9 @@
 #include "core/stop_request.hpp"
 #include "core/file_read.hpp"
 #include "core/memory.hpp"
+#include "insitu/resources.hpp"
+#include "insitu/session.hpp"
+#include "insitu/task_plan.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
 #include "video/writer_memory.hpp"
@@ -45,6 +52,8 @@ struct Args {
   double sample_distance = 0.5;
   bool adaptive = true;  // pays where images have more pixels than voxels across (docs/rendering.md, Round 4)
   double percentile = 0.999;
+  std::string reference = "snapshot";  // the session's default (before issue 30 render used a running maximum)
+  bool print_tasks = false;
   std::string spacing, origin, background = "0,0,0";
   bool no_outline = false;
   std::string title;
@@ -83,6 +92,7 @@ std::string recorded_command_line(const Args& a) {
   cl += " --sample-distance " + number_text(a.sample_distance);
   cl += a.adaptive ? " --adaptive" : " --no-adaptive";
   cl += " --percentile " + number_text(a.percentile);
+  cl += " --reference " + a.reference;
   if (!a.spacing.empty()) cl += " --spacing " + shell_word(a.spacing);
   if (!a.origin.empty()) cl += " --origin " + shell_word(a.origin);
   cl += " --background " + shell_word(a.background);
@@ -139,74 +149,6 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
   return files;
 }
 
-// A task given on the command line, with what the manifest records about it.
-struct CliTask {
-  render::TaskSpec spec;
-  bool relative = false;  // window resolved against the running reference each snapshot
-  store::TaskEntry entry;
-};
-
-// Syntax: volume:PRESET[:LO:HI] | iso:VALUE | slice:x|y|z:FRACTION[:PRESET[:LO:HI]].
-CliTask parse_task(const std::string& text, const render::GridGeometry& grid) {
-  std::vector<std::string> parts;
-  std::size_t b = 0;
-  while (true) {
-    const auto e = text.find(':', b);
-    parts.push_back(text.substr(b, e == std::string::npos ? std::string::npos : e - b));
-    if (e == std::string::npos) break;
-    b = e + 1;
-  }
-  auto number = [&](const std::string& s) {
-    try {
-      std::size_t used = 0;
-      const double v = std::stod(s, &used);
-      if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument("");
-      return v;
-    } catch (const std::exception&) {
-      throw Error("--task \"" + text + "\": \"" + s + "\" is not a number");
-    }
-  };
-  const std::string usage = "; expected volume:PRESET[:LO:HI], iso:VALUE or slice:x|y|z:FRACTION[:PRESET[:LO:HI]]";
-  CliTask t;
-  t.entry.name = text;
-  t.entry.fields = {"volume"};
-  if (parts[0] == "volume" && (parts.size() == 2 || parts.size() == 4)) {
-    const auto tf = render::TransferFunction::preset(parts[1]);
-    // Relative default: [0, ref] (|v| for the wave presets), [−ref, ref] for the diverging map.
-    render::ValueWindow w = render::ValueWindow::relative_to(parts[1] == "diverging" ? -1 : 0, 1);
-    t.relative = parts.size() == 2;
-    if (!t.relative) w = render::ValueWindow::absolute(number(parts[2]), number(parts[3])).resolve(0);
-    t.spec = render::TaskSpec::volume(0, tf, w);
-    t.entry.method = "volume";
-    t.entry.parameters = {{"preset", parts[1]}, {"window", t.relative ? "relative" : "absolute"}};
-    if (!t.relative) t.entry.parameters["range"] = {w.lo, w.hi};
-  } else if (parts[0] == "iso" && parts.size() == 2) {
-    const double v = number(parts[1]);
-    t.spec = render::TaskSpec::isosurface(0, float(v));
-    t.entry.method = "isosurface";
-    t.entry.parameters = {{"isovalue", v}};
-  } else if (parts[0] == "slice" && (parts.size() == 3 || parts.size() == 4 || parts.size() == 6)) {
-    const std::string axes = "xyz";
-    if (parts[1].size() != 1 || axes.find(parts[1][0]) == std::string::npos)
-      throw Error("--task \"" + text + "\": slice axis \"" + parts[1] + "\"; expected x, y or z");
-    const int axis = int(axes.find(parts[1][0]));
-    const double f = number(parts[2]);
-    if (!(f >= 0 && f <= 1)) throw Error("--task \"" + text + "\": slice position " + parts[2] + "; expected a fraction in [0, 1]");
-    const std::string preset = parts.size() >= 4 ? parts[3] : "diverging";
-    render::ValueWindow w = render::ValueWindow::relative_to(-1, 1);
-    t.relative = parts.size() < 6;
-    if (!t.relative) w = render::ValueWindow::absolute(number(parts[4]), number(parts[5])).resolve(0);
-    const double pos = grid.origin[axis] + f * (grid.dims[axis] - 1) * grid.spacing[axis];
-    t.spec = render::TaskSpec::slice(0, axis, pos, render::TransferFunction::preset(preset), w);
-    t.entry.method = "slice";
-    t.entry.parameters = {{"axis", parts[1]}, {"fraction", f}, {"position", pos}, {"preset", preset},
-                          {"window", t.relative ? "relative" : "absolute"}};
-  } else {
-    throw Error("--task \"" + text + "\"" + usage);
-  }
-  return t;
-}
-
 // A bar on a terminal; otherwise (logs, pipes) one line per tenth of the work.
 void progress(bool tty, long long done, long long total, double elapsed) {
   if (!tty) {
@@ -227,22 +169,59 @@ void progress(bool tty, long long done, long long total, double elapsed) {
   std::fflush(stderr);
 }
 
-void run(const Args& a, const std::string& command_line) {
+// The session configuration `render`'s options stand for (the grid comes from the first volume).
+insitu::SessionConfig session_config(const Args& a, const std::string& first_file, const std::string& command_line) {
   std::smatch m;
   static const std::regex size_re(R"((\d{1,5})x(\d{1,5}))");
   if (!std::regex_match(a.size, m, size_re))
     throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 920x896");
-  const int width = std::stoi(m[1]), height = std::stoi(m[2]);
-  if (width < 2 || height < 2 || width > 16384 || height > 16384)
-    throw Error("--size \"" + a.size + "\": expected 2..16384 pixels per side");
+  insitu::SessionConfig cfg;
+  cfg.width = std::stoi(m[1]);
+  cfg.height = std::stoi(m[2]);
+  if (cfg.width < 2 || cfg.height < 2 || cfg.width > insitu::kMaxImageSide || cfg.height > insitu::kMaxImageSide)
+    throw Error("--size \"" + a.size + "\": expected 2.." + std::to_string(insitu::kMaxImageSide) + " pixels per side");
+  const auto bg = parse_numbers(a.background, 3, "--background");
+  for (double c : bg)
+    if (!(c >= 0 && c <= 1)) throw Error("--background \"" + a.background + "\": expected three values in [0, 1]");
+  cfg.background = {float(bg[0]), float(bg[1]), float(bg[2])};
+  cfg.outline = !a.no_outline;
+  cfg.output_dir = a.out;
+  cfg.mode = a.overwrite ? insitu::OutputMode::overwrite : insitu::OutputMode::create;
+  cfg.title = a.title.empty() ? "panoptes render " + first_file : a.title;
+  cfg.program = "panoptes render";
+  cfg.command_line = command_line;
+  cfg.rig = a.rig;
+  (void)camera::RigSpec::parse(a.rig);  // a bad --rig is reported before any volume is read
+  cfg.up_axis = a.up_axis;
+  cfg.projection = a.projection;
+  cfg.tasks = insitu::tasks_from_shorthand(a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks, "volume");
+  cfg.schedule.every_steps = 1;  // every volume is a snapshot
+  if (a.crf > 51) throw Error("--crf " + std::to_string(a.crf) + ": expected an x264 quality 0..51");
+  if (a.crf >= 0) cfg.video.crf = a.crf;
+  cfg.render.sample_distance = a.sample_distance;
+  cfg.render.adaptive = a.adaptive;
+  cfg.percentile = a.percentile;
+  cfg.running_max = a.reference == "running-max";
+  cfg.check_memory = !a.force;
+  cfg.validate();
+  return cfg;
+}
+
+void run(const Args& a, const std::string& command_line) {
+  if (a.print_tasks) {
+    for (const insitu::TaskConfig& t :
+         insitu::tasks_from_shorthand(a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks, "volume"))
+      std::printf("%s\n", insitu::task_table_toml(t).c_str());
+    return;
+  }
   const std::vector<std::string> files = expand_inputs(a.inputs);
   if (files.empty()) throw Error("no input volume given");
-  const MemoryLimit available = available_memory();
+  insitu::SessionConfig cfg = session_config(a, files[0], command_line);
   if (!a.force) {
     // Reading a volume holds its bytes and its float values at once: refuse before, not with bad_alloc.
     MemoryEstimate read;
     read.add("volume file", double(regular_file_size(files[0], UINT64_MAX, "volume file")) * 2);
-    check_memory(read, available, 1, "reading " + files[0], "pass --force");
+    check_memory(read, available_memory(), 1, "reading " + files[0], "pass --force");
   }
 
   // The first volume fixes the grid of the whole series.
@@ -257,102 +236,25 @@ void run(const Args& a, const std::string& command_line) {
     grid.origin = {o[0], o[1], o[2]};
   }
   grid.validate();
-  const auto bg = parse_numbers(a.background, 3, "--background");
-  for (double c : bg)
-    if (!(c >= 0 && c <= 1)) throw Error("--background \"" + a.background + "\": expected three values in [0, 1]");
-
-  std::vector<CliTask> tasks;
-  for (const std::string& t : (a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks))
-    tasks.push_back(parse_task(t, grid));
-
-  const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
-  camera::RigSpec rig_spec = camera::RigSpec::parse(a.rig);
-  rig_spec.up_axis = camera::parse_up_axis(a.up_axis);
-  const camera::Rig rig = camera::make_rig(rig_spec, domain);
-  const camera::NavigationGraph graph = camera::build_navigation_graph(rig);
-
-  store::Manifest man;
-  man.title = a.title.empty() ? "panoptes render " + files[0] : a.title;
-  man.provenance.program = "panoptes render";
-  man.provenance.version = "0.1.0";
-  man.provenance.command_line = command_line;
-  man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
-  man.domain.origin = grid.origin;
-  man.domain.spacing = grid.spacing;
-  man.domain.up_axis = a.up_axis;
-  man.image.width = width;
-  man.image.height = height;
-  if (a.crf >= 0) man.video.crf = a.crf;
-  man.rig.kind = rig.spec;
-  man.rig.parameters = {{"spec", rig.spec}, {"shells", rig.shell_count}};
-  // Additive (issue 14): players read the projection and the lattice shape from here; older readers ignore them.
-  const camera::Projection projection = camera::parse_projection(a.projection);
-  if (projection != camera::Projection::perspective) man.rig.parameters["projection"] = a.projection;
-  if (rig.is_lattice()) man.rig.parameters["lattice"] = rig.lattice;
-  if (rig.path) man.rig.parameters["path"] = true;
-  std::vector<camera::Camera> cams;
-  for (int c = 0; c < rig.size(); ++c) {
-    const camera::RigCamera& rc = rig.cameras[std::size_t(c)];
-    cams.push_back(rig.camera(c, width, height, projection));
-    store::CameraEntry e;
-    e.id = c;
-    e.position = rc.position;
-    e.look_at = rc.look_at;
-    e.up = rc.up;
-    e.fov_y_deg = cams.back().fov_y_degrees();
-    e.labels.patch = rc.patch;
-    e.labels.lat_deg = rc.latitude_deg;
-    e.labels.lon_deg = rc.longitude_deg;
-    e.labels.shell = rc.shell;
-    man.cameras.push_back(e);
-    const camera::Neighbours& n = graph.neighbours[std::size_t(c)];
-    man.graph.neighbours.push_back({n.left, n.right, n.up, n.down, n.in, n.out});
-  }
-  // Several isosurfaces form an "isovalue" axis, so the player can step the isovalue.
-  std::vector<double> isovalues;
-  for (const CliTask& t : tasks)
-    if (t.spec.kind == render::TaskKind::isosurface) isovalues.push_back(t.spec.isovalue);
-  if (isovalues.size() >= 2) man.axes.push_back({"isovalue", isovalues, ""});
-  int iso_index = 0;
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    tasks[i].entry.id = int(i);
-    if (man.find_task(tasks[i].entry.name) >= 0) throw Error("--task \"" + tasks[i].entry.name + "\" is given twice");
-    if (isovalues.size() >= 2 && tasks[i].spec.kind == render::TaskKind::isosurface)
-      tasks[i].entry.axes = {{"isovalue", iso_index++}};
-    man.tasks.push_back(tasks[i].entry);
-  }
-
-  const long long streams = checked_product(rig.size(), (long long)tasks.size(), "cameras x tasks (movies)", INT_MAX);
-  if (const long long files_limit = open_file_limit(); files_limit >= 0 && streams > files_limit - 64)
-    throw Error(std::to_string(rig.size()) + " cameras x " + std::to_string(tasks.size()) + " tasks = " +
-                std::to_string(streams) + " movies open at once, but the open-file limit (ulimit -n) is " +
-                std::to_string(files_limit) + "; use fewer cameras or tasks, or raise the limit");
   if (!a.force) {
-    const double px = double(width) * height, points = double(grid.dims[0]) * grid.dims[1] * grid.dims[2];
-    MemoryEstimate e;
-    e.add("volumes", points * 4 * (files.size() > 1 ? 2 : 1) + points);  // first + current, macro-cells
-    e.add("images", double(tasks.size()) * px * (20 + 8 * 3) + omp_get_max_threads() * video::live_encoder_bytes(px));
-    e.add("open movie writers", double(streams) * video::open_writer_bytes(px, man.video.gop));
-    e.add("rig and manifest", rig.size() * 1500.0);
-    check_memory(e, available, 1, "this render", "pass --force");
+    // The session's own estimate, worded for this command (it would say [resources] check_memory).
+    const double points = double(grid.dims[0]) * grid.dims[1] * grid.dims[2];
+    MemoryEstimate e = insitu::estimate_session_memory(cfg, points, insitu::rig_camera_count(cfg, grid), 1,
+                                                       omp_get_max_threads());
+    e.add("volumes read", points * 4 * (files.size() > 1 ? 2 : 1));
+    check_memory(e, available_memory(), 1, "this render", "pass --force");
+    cfg.check_memory = false;
   }
-  store::DatabaseWriter writer = store::DatabaseWriter::create(a.out, man, a.overwrite);
+
+  insitu::Session session(cfg, grid, insitu::LocalBlock::whole(grid));
   const bool tty = ::isatty(STDERR_FILENO) && !a.quiet;
-  const bool show_progress = !a.quiet;
-  const long long total = (long long)files.size() * rig.size() * (long long)tasks.size();
+  const long long total = (long long)files.size() * session.camera_count() * (long long)session.task_count();
   long long done = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  render::RenderOptions opt;
-  opt.sample_distance = a.sample_distance;
-  opt.adaptive = a.adaptive;
-  render::OutlineStyle outline;
-  outline.enabled = !a.no_outline && projection == camera::Projection::perspective;  // box edges curve in 360° frames
-  const render::Rgb background{float(bg[0]), float(bg[1]), float(bg[2])};
-  render::RunningMax reference;
-  std::vector<render::PartialImage> partials(tasks.size());
-  std::vector<render::TaskSpec> specs(tasks.size());
-  std::vector<Image> frames(std::size_t(8) * tasks.size());
-
+  if (!a.quiet)
+    session.set_frame_observer([&](int, int, int, const Image&) {
+      progress(tty, ++done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    });
   for (std::size_t f = 0; f < files.size(); ++f) {
     app::Volume vol = f == 0 ? std::move(first) : app::read_volume(files[f]);
     warn_if_not_finite(files[f], vol.values);
@@ -360,57 +262,21 @@ void run(const Args& a, const std::string& command_line) {
       throw FileError(files[f], "volume of " + std::to_string(vol.dims[0]) + "x" + std::to_string(vol.dims[1]) + "x" +
                                     std::to_string(vol.dims[2]) + " points; expected " + std::to_string(grid.dims[0]) + "x" +
                                     std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " like " + files[0]);
-    const render::FieldView view = render::FieldView::whole(grid, vol.values.data());
-    const std::vector<render::PreparedField> fields{render::PreparedField(view)};
-    // Relative windows follow a running maximum of a high percentile of |v| over the series: the
-    // window only widens, so colours stay comparable along each movie.
-    const double ref = reference.update(render::abs_percentile(view, a.percentile));
-    for (std::size_t i = 0; i < tasks.size(); ++i) {
-      specs[i] = tasks[i].spec;
-      if (tasks[i].relative) specs[i].reference = std::max(ref, 1e-30);
-    }
-    // Cameras in batches: render each camera (multi-threaded inside), then encode the batch's
-    // frames in parallel — each goes to its own stream, and one x264 encoder uses one thread.
-    const int batch = 8;
-    int c0 = 0;
-    for (; c0 < rig.size() && !stop_requested(); c0 += batch) {
-      const int c1 = std::min(rig.size(), c0 + batch);
-      for (int c = c0; c < c1; ++c) {
-        render::render_brick(cams[std::size_t(c)], fields, specs, partials, opt);
-        for (std::size_t i = 0; i < tasks.size(); ++i)
-          frames[std::size_t(c - c0) * tasks.size() + i] =
-              render::finish_image(partials[i], cams[std::size_t(c)], grid, background, outline);
-      }
-      const int n = (c1 - c0) * int(tasks.size());
-      std::exception_ptr error;
-#pragma omp parallel for schedule(dynamic, 1)
-      for (int j = 0; j < n; ++j) {
-        try {
-          writer.append(c0 + j / int(tasks.size()), j % int(tasks.size()), frames[std::size_t(j)]);
-        } catch (...) {
-#pragma omp critical(render_append_error)
-          if (!error) error = std::current_exception();
-        }
-      }
-      if (error) std::rethrow_exception(error);
-      done += n;
-      if (show_progress) progress(tty, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
-    if (c0 >= rig.size()) {  // a snapshot cut short by a signal is abandoned: the manifest keeps the last one
-      writer.set_time(int(f), double(f));
-      writer.checkpoint();
-    }
-    if (const int sig = stop_requested()) {
-      if (tty) std::fprintf(stderr, "\n");
-      throw Interrupted(sig, a.out + ": stopped by " + signal_name(sig) + "; " + std::to_string(writer.complete_frames()) +
-                                 " complete snapshot(s) kept, the database is marked interrupted");
-    }
+    // Snapshot f at time f; a stop request (SIGINT/SIGTERM) throws Interrupted before the next one and
+    // the database keeps the snapshots taken, marked interrupted.
+    session.snapshot(double(f), {{"volume", vol.values.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }
-  writer.finalize();
+  if (const int sig = stop_requested()) {
+    if (tty) std::fprintf(stderr, "\n");
+    throw Interrupted(sig, a.out + ": stopped by " + signal_name(sig) + "; " + std::to_string(session.snapshots()) +
+                               " complete snapshot(s) kept, the database is marked interrupted");
+  }
+  session.finalize();
   if (tty) std::fprintf(stderr, "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("wrote %s: %d cameras x %zu tasks = %lld streams, %zu frames of %dx%d, in %.1f s\n", a.out.c_str(), rig.size(),
-              tasks.size(), (long long)rig.size() * (long long)tasks.size(), files.size(), width, height, seconds);
+  std::printf("wrote %s: %d cameras x %d tasks = %lld streams, %zu frames of %dx%d, in %.1f s\n", a.out.c_str(),
+              session.camera_count(), session.task_count(), (long long)session.camera_count() * session.task_count(),
+              files.size(), cfg.width, cfg.height, seconds);
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
@@ -420,27 +286,38 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       "Render a volume (or a time series of volumes) from every camera of a rig for every task into a movie "
       "database. Inputs: NumPy .npy (3-D float32/float64; C order = shape (nz, ny, nx)) or VTK legacy "
       "STRUCTURED_POINTS .vtk (ASCII or BINARY); several files or a quoted glob make a time series.");
-  sub->add_option("VOLUME", args->inputs, "Volume file(s) or glob pattern(s), one frame each, in order")->required();
+  sub->add_option("VOLUME", args->inputs, "Volume file(s) or glob pattern(s), one frame each, in order (required)");
   sub->add_option("--rig", args->rig,
                   "Camera rig: yinyang[:NTxNP], latlon[:NLATxNLON[+poles]], fibonacci[:N], file:PATH; "
                   "optional @R1,R2,... shell radii in bounding-sphere radii; or cameras inside the volume: "
                   "lattice:NXxNYxNZ[@MARGIN] (lattice nodes, walk along world axes) or path:FILE (x y z per line)")
       ->capture_default_str();
   sub->add_option("--task", args->tasks,
-                  "Visualization task (repeatable): volume:PRESET[:LO:HI], iso:VALUE, slice:x|y|z:FRACTION[:PRESET[:LO:HI]]. "
-                  "Presets: p-wave, s-wave, diverging, grayscale, hot, rainbow. Without LO:HI the window follows the "
-                  "running maximum of the --percentile of |v| (default task: volume:hot)")
+                  "Visualization task (repeatable): volume:PRESET[:LO:HI], iso:VALUE, slice:x|y|z:FRACTION[:PRESET[:LO:HI]]; "
+                  "shorthand for the TOML [[task]] tables of `panoptes run` (--print-tasks shows them; several iso: "
+                  "form one isovalue sweep). Presets: p-wave, s-wave, diverging, grayscale, hot, rainbow. Without "
+                  "LO:HI the window is relative to the --reference (default task: volume:hot)")
       ->allow_extra_args(false);
   sub->add_option("--size", args->size, "Image size WIDTHxHEIGHT")->capture_default_str();
-  sub->add_option("--out", args->out, "Output database directory")->required();
+  sub->add_option("--out", args->out, "Output database directory (required)");
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in --out");
   sub->add_option("--sample-distance", args->sample_distance, "Ray sample distance in voxels")
       ->check(CLI::Range(0.01, 16.0))->capture_default_str();
   sub->add_flag("--adaptive,!--no-adaptive", args->adaptive,
                 "Adaptive image-space sampling: march every 4th pixel and interpolate where the image is smooth "
                 "(default: on; --no-adaptive marches every pixel)");
-  sub->add_option("--percentile", args->percentile, "Reference for relative windows: this quantile of |v|")
+  sub->add_option("--percentile", args->percentile,
+                  "Reference for relative windows: this quantile of |v| (sampled as in situ: a lattice of about "
+                  "65,536 points, at least 0.001 x the maximum)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub->add_option("--reference", args->reference,
+                  "Reference of relative windows: snapshot (each volume's own quantile, as `panoptes run`'s "
+                  "default) or running-max (the running maximum over the series: colours comparable along a movie, "
+                  "but decaying waves fade)")
+      ->check(CLI::IsMember({"snapshot", "running-max"}))
+      ->capture_default_str();
+  sub->add_flag("--print-tasks", args->print_tasks,
+                "Print the TOML [[task]] tables the --task options stand for (as `panoptes run` reads them) and exit");
   sub->add_option("--spacing", args->spacing, "Grid spacing sx,sy,sz (default: from the file, or 1,1,1)");
   sub->add_option("--origin", args->origin, "Grid origin x,y,z (default: from the file, or 0,0,0)");
   sub->add_option("--background", args->background, "Background colour r,g,b in [0, 1]")->capture_default_str();
@@ -461,6 +338,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_flag("-q,--quiet", args->quiet, "No progress output");
   sub->callback([args] {
     install_stop_handlers();
+    if (!args->print_tasks && args->inputs.empty()) throw Error("render: VOLUME is required (a volume file or a glob)");
+    if (!args->print_tasks && args->out.empty()) throw Error("render: --out is required (the database directory)");
     run(*args, recorded_command_line(*args));
   });
 });

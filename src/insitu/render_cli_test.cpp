@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "insitu/session.hpp"
+#include "panoptes.h"
 #include "render/synthetic_fields.hpp"
 #include "store/database.hpp"
 
@@ -164,6 +165,132 @@ window = [-1.0, 1.0]
     }
   std::printf("in situ vs panoptes render: %d frames, %d identical, worst PSNR %.1f dB, max difference %d/255\n",
               frames, identical, worst, max_diff);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 30: `panoptes render` is a replay through the Session, so the same volumes and the same tasks
+// given as --task shorthand and as [[task]] tables give the same manifest (task entries, axes,
+// per-frame references) and bit-identical frames, with RELATIVE windows (the reference decides every
+// pixel) on a grid above 65,536 points (where the session samples a lattice for its percentile).
+TEST(InsituRenderCli, RenderIsASessionReplayWithRelativeWindows) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_render_replay_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const render::GridGeometry grid{{48, 48, 48}, {0, 0, 0}, {1, 1, 1}};  // 110,592 points
+  const int snapshots = 2;
+  const std::string toml = R"(
+[image]
+width = 40
+height = 32
+[rig]
+spec = "fibonacci:3"
+up_axis = "z_up"
+[schedule]
+every_steps = 1
+[render]
+adaptive = true  # as panoptes render's default
+[[task]]
+name = "volume:hot"
+type = "volume"
+field = "volume"
+preset = "hot"
+[[task]]
+name = "iso"
+type = "isosurface"
+field = "volume"
+isovalues = [0.3, -0.2]
+axis_name = "isovalue"
+[[task]]
+name = "slice:z:0.5:rainbow"
+type = "slice"
+field = "volume"
+axis = "z"
+position = 0.5
+preset = "rainbow"
+)";
+  insitu::SessionConfig cfg = insitu::parse_session_config_text(toml, "render_replay_test");
+  cfg.output_dir = (dir / "session_db").string();
+  std::string files;
+  std::vector<std::vector<float>> volumes;
+  {
+    insitu::Session session(cfg, grid, insitu::LocalBlock::whole(grid));
+    for (int s = 0; s < snapshots; ++s) {
+      const double t = double(s);  // render's snapshot times are the volume indices
+      const std::vector<render::WaveFront> fronts{{grid.centre(), 8 + 5 * t, 3.0, 1.0},
+                                                  {grid.centre() + Vec3{6, -5, 3}, 5 + 3 * t, 2.5, -0.7}};
+      const std::vector<float> a = render::wave_field(grid, fronts);
+      const fs::path npy = dir / ("v_" + std::to_string(s) + ".npy");
+      write_npy(npy, a, grid.dims);
+      files += " " + npy.string();
+      session.snapshot(t, {{"volume", a.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+      volumes.push_back(a);
+    }
+    session.finalize();
+  }
+  // The C API (and so Fortran and Python, which call it) with the same TOML text.
+  const fs::path capi_db = dir / "capi_db";
+  {
+    const std::string text = "[output]\ndir = \"" + capi_db.string() + "\"\n" + toml;
+    panoptes_session* s = nullptr;
+    ASSERT_EQ(panoptes_create(text.c_str(), 0, PANOPTES_COMM_WORLD, &s), 0);
+    const int dims[3] = {grid.dims[0], grid.dims[1], grid.dims[2]}, zero[3] = {0, 0, 0};
+    const double origin[3] = {0, 0, 0}, spacing[3] = {1, 1, 1};
+    ASSERT_EQ(panoptes_set_grid(s, dims, origin, spacing), 0);
+    ASSERT_EQ(panoptes_set_block(s, zero, dims, zero, zero), 0);
+    const long long contiguous[3] = {0, 0, 0};
+    for (int f = 0; f < snapshots; ++f) {
+      ASSERT_EQ(panoptes_set_field(s, "volume", volumes[std::size_t(f)].data(), PANOPTES_FLOAT32, contiguous), 0);
+      ASSERT_EQ(panoptes_snapshot(s, double(f)), 0);
+    }
+    ASSERT_EQ(panoptes_finalize(s), 0);
+    panoptes_destroy(s);
+  }
+  const fs::path cli_db = dir / "cli_db";
+  const std::string cmd = std::string(PANOPTES_BINARY) + " render" + files +
+                          " --rig fibonacci:3 --size 40x32 -q --task volume:hot --task iso:0.3 --task iso:-0.2"
+                          " --task slice:z:0.5:rainbow --out " + cli_db.string() + " > " + (dir / "render.log").string() +
+                          " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+
+  const store::Database a = store::Database::open(cfg.output_dir);
+  for (const fs::path& other : {cli_db, capi_db}) {
+  SCOPED_TRACE(other.string());
+  const store::Database b = store::Database::open(other);
+  const store::Manifest& ma = a.manifest();
+  const store::Manifest& mb = b.manifest();
+  ASSERT_EQ(ma.tasks.size(), 4u);
+  EXPECT_EQ(ma.tasks, mb.tasks);
+  EXPECT_EQ(ma.axes, mb.axes);
+  ASSERT_EQ(ma.fields.size(), 1u);
+  EXPECT_EQ(ma.fields, mb.fields);  // per-frame references, bit for bit
+  EXPECT_EQ(ma.fields[0].references, mb.fields.at(0).references);
+  ASSERT_EQ(ma.fields[0].references.size(), std::size_t(snapshots));
+  EXPECT_NE(ma.fields[0].references[0], ma.fields[0].references[1]);  // the reference does move
+  EXPECT_EQ(ma.cameras.size(), mb.cameras.size());
+  EXPECT_EQ(ma.domain.up_axis, mb.domain.up_axis);
+  ASSERT_EQ(a.frame_count(), snapshots);
+  ASSERT_EQ(b.frame_count(), snapshots);
+  int differing = 0, lit = 0;
+  for (int c = 0; c < a.camera_count(); ++c)
+    for (int t = 0; t < a.task_count(); ++t) {
+      auto ra = a.stream(c, t);
+      auto rb = b.stream(c, t);
+      for (int f = 0; f < snapshots; ++f) {
+        const Image ia = ra->read_rgba(f), ib = rb->read_rgba(f);
+        differing += ia.pixels != ib.pixels;
+        int brightest = 0;
+        for (std::size_t i = 0; i < ia.pixels.size(); ++i)
+          if (i % 4 != 3) brightest = std::max(brightest, int(ia.pixels[i]));
+        lit += brightest > 64;
+      }
+    }
+  EXPECT_EQ(differing, 0) << "frames differ from the Session's";
+    EXPECT_GE(lit, a.camera_count() * a.task_count() * snapshots * 3 / 4) << "too many (nearly) empty frames";
+  }
   fs::remove_all(dir);
 }
 

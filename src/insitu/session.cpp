@@ -24,6 +24,7 @@
 #include "insitu/halo.hpp"
 #include "insitu/output.hpp"
 #include "insitu/resources.hpp"
+#include "insitu/task_plan.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
 
@@ -59,25 +60,6 @@ using halo::Box;
 using halo::BlockInfo;
 using halo::intersect;
 
-// One rendered task: the renderer's spec plus how its window / isovalue follow the reference.
-struct Task {
-  render::TaskSpec spec;
-  bool relative = false, relative2 = false, iso_relative = false;
-  double iso_fraction = 0;
-  store::TaskEntry entry;
-};
-
-// The transfer function as data (control points), so players draw its colour legend without knowing
-// the renderer's presets (issue 34).
-nlohmann::json transfer_json(const render::TransferFunction& tf) {
-  // The presets are floats: 0.9f would read 0.8999999761581421 in the manifest.
-  const auto v = [](float x) { return std::round(double(x) * 1e6) / 1e6; };
-  nlohmann::json colour = nlohmann::json::array(), extinction = nlohmann::json::array();
-  for (const auto& p : tf.colour) colour.push_back({v(p.x), v(p.colour.r), v(p.colour.g), v(p.colour.b)});
-  for (const auto& p : tf.opacity) extinction.push_back({v(p.x), v(p.extinction)});
-  return {{"colour", std::move(colour)}, {"extinction", std::move(extinction)}, {"absolute_value", tf.absolute_value}};
-}
-
 std::string fmt(double v) {
   std::ostringstream s;
   s << v;
@@ -103,8 +85,7 @@ struct Session::Impl {
   std::vector<BlockInfo> blocks;  // per rank
   halo::Exchange exchange;        // reads the trusted points, fetches the others
   std::vector<std::string> field_names;
-  std::vector<Task> tasks;
-  std::vector<store::ParameterAxis> axes_;
+  TaskPlan plan;  // the tasks, their windows' references, axes and manifest entries
   std::vector<render::TaskSpec> specs;  // per snapshot, references resolved
   camera::Rig rig;
   std::vector<camera::Camera> cameras;
@@ -158,7 +139,6 @@ struct Session::Impl {
   bool repeated(double time) const {
     return resumed && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
   }
-  void build_tasks();
   void check_resources();
   store::Manifest make_manifest() const;
   void load_fields(const std::vector<FieldInput>& fields);
@@ -206,7 +186,8 @@ void Session::Impl::init() {
   for (int r = 0; r < size; ++r)
     for (int s = 0; s < size; ++s) exchange.needed = exchange.needed || halo::fetches(blocks, r, s);
 
-  build_tasks();
+  plan = TaskPlan(cfg.tasks, grid);
+  field_names = plan.field_names();
   check_resources();
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
   camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
@@ -251,12 +232,12 @@ void Session::Impl::init() {
   }
   stage("database created");
   const int slots = size;
-  partials.assign(std::size_t(slots), std::vector<render::PartialImage>(tasks.size()));
+  partials.assign(std::size_t(slots), std::vector<render::PartialImage>(plan.size()));
   send_buf.resize(std::size_t(slots));
-  received.assign(std::size_t(size), std::vector<render::PartialImage>(tasks.size()));
-  composited.resize(tasks.size());
-  parts.resize(tasks.size());
-  batch.assign(kEncodeBatch, std::vector<Image>(tasks.size()));
+  received.assign(std::size_t(size), std::vector<render::PartialImage>(plan.size()));
+  composited.resize(plan.size());
+  parts.resize(plan.size());
+  batch.assign(kEncodeBatch, std::vector<Image>(plan.size()));
   batch_camera.assign(kEncodeBatch, 0);
 }
 
@@ -266,7 +247,7 @@ void Session::Impl::check_resources() {
   std::string refusal;
   try {
     const long long cameras = rig_camera_count(cfg, grid);
-    check_open_streams(cameras, int(tasks.size()), size);
+    check_open_streams(cameras, int(plan.size()), size);
     if (cfg.check_memory) {
       const double points = me().has_brick ? double(me().required.size()) : 0.0;
       int sharing = 1;
@@ -290,110 +271,6 @@ void Session::Impl::check_resources() {
   if (size > 1) MPI_Allreduce(MPI_IN_PLACE, &refused, 1, MPI_INT, MPI_MAX, comm);
 #endif
   if (refused) throw Error(refusal.empty() ? "another rank of this session refused to start (see its message)" : refusal);
-}
-
-void Session::Impl::build_tasks() {
-  auto field_index = [&](const std::string& name) {
-    auto it = std::find(field_names.begin(), field_names.end(), name);
-    if (it != field_names.end()) return int(it - field_names.begin());
-    field_names.push_back(name);
-    return int(field_names.size()) - 1;
-  };
-  std::vector<store::ParameterAxis> axes;
-  for (const TaskConfig& tc : cfg.tasks) {
-    const int f = field_index(tc.fields[0]);
-    const int f2 = tc.fields.size() > 1 ? field_index(tc.fields[1]) : -1;
-    auto window = [](const WindowConfig& w) {
-      return w.relative ? render::ValueWindow::relative_to(w.lo, w.hi) : render::ValueWindow::absolute(w.lo, w.hi);
-    };
-    std::size_t n = 1;
-    std::string axis_suffix;
-    std::vector<double> axis_values;
-    switch (tc.kind) {
-      case TaskConfig::Kind::volume:
-        n = tc.windows.size();
-        axis_suffix = "window";
-        for (const auto& w : tc.windows) axis_values.push_back(w.hi);
-        break;
-      case TaskConfig::Kind::volume2:
-        break;
-      case TaskConfig::Kind::isosurface:
-        n = tc.isovalues.size();
-        axis_suffix = "isovalue";
-        axis_values = tc.isovalues;
-        break;
-      case TaskConfig::Kind::slice:
-        n = tc.slice_positions.size();
-        axis_suffix = "position";
-        axis_values = tc.slice_positions;
-        break;
-    }
-    const std::string axis_name = tc.axis.empty() ? tc.name + " " + axis_suffix : tc.axis;
-    if (n > 1) axes.push_back({axis_name, axis_values, ""});
-    for (std::size_t i = 0; i < n; ++i) {
-      Task t;
-      t.entry.name = n > 1 ? tc.name + " " + fmt(axis_values[i]) : tc.name;
-      t.entry.fields = tc.fields;
-      if (n > 1) t.entry.axes = {{axis_name, int(i)}};
-      switch (tc.kind) {
-        case TaskConfig::Kind::volume: {
-          const WindowConfig& w = tc.windows[i];
-          t.spec = render::TaskSpec::volume(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale), window(w));
-          t.relative = w.relative;
-          t.entry.method = "volume";
-          t.entry.parameters = {{"preset", tc.preset}, {"window", {w.lo, w.hi}}, {"relative", w.relative},
-                                {"extinction_scale", tc.extinction_scale},
-                                {"transfer_function", transfer_json(t.spec.tf)}};
-          break;
-        }
-        case TaskConfig::Kind::volume2: {
-          const WindowConfig& w = tc.windows[0];
-          t.spec = render::TaskSpec::volume2(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale),
-                                             window(w), f2,
-                                             render::TransferFunction::preset(tc.preset2, tc.extinction_scale),
-                                             window(tc.window2));
-          t.relative = w.relative;
-          t.relative2 = tc.window2.relative;
-          t.entry.method = "volume";
-          t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
-                                {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
-                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale},
-                                {"relative2", tc.window2.relative},
-                                {"transfer_function", transfer_json(t.spec.tf)},
-                                {"transfer_function2", transfer_json(t.spec.tf2)}};
-          break;
-        }
-        case TaskConfig::Kind::isosurface:
-          t.spec = render::TaskSpec::isosurface(f, float(tc.isovalues[i]),
-                                                {tc.colour[0], tc.colour[1], tc.colour[2]});
-          t.iso_relative = tc.iso_relative;
-          t.iso_fraction = tc.isovalues[i];
-          t.entry.method = "isosurface";
-          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative},
-                                {"colour", {tc.colour[0], tc.colour[1], tc.colour[2]}}};
-          break;
-        case TaskConfig::Kind::slice: {
-          const WindowConfig& w = tc.windows[0];
-          const int a = tc.slice_axis;
-          const double pos = grid.origin[a] + tc.slice_positions[i] * (grid.dims[a] - 1) * grid.spacing[a];
-          t.spec = render::TaskSpec::slice(f, a, pos, render::TransferFunction::preset(tc.preset), window(w));
-          t.relative = w.relative;
-          t.entry.method = "slice";
-          t.entry.parameters = {{"axis", std::string(1, char('x' + a))}, {"fraction", tc.slice_positions[i]},
-                                {"position", pos}, {"preset", tc.preset}, {"window", {w.lo, w.hi}},
-                                {"relative", w.relative}, {"transfer_function", transfer_json(t.spec.tf)}};
-          break;
-        }
-      }
-      t.entry.id = int(tasks.size());
-      for (const Task& o : tasks)
-        if (o.entry.name == t.entry.name) throw Error("task \"" + t.entry.name + "\": the name is used twice");
-      tasks.push_back(std::move(t));
-    }
-  }
-  specs.resize(tasks.size());
-  axes_.clear();
-  axes_ = std::move(axes);
 }
 
 store::Manifest Session::Impl::make_manifest() const {
@@ -435,8 +312,8 @@ store::Manifest Session::Impl::make_manifest() const {
     const camera::Neighbours& n = graph.neighbours[std::size_t(c)];
     man.graph.neighbours.push_back({n.left, n.right, n.up, n.down, n.in, n.out});
   }
-  for (const Task& t : tasks) man.tasks.push_back(t.entry);
-  man.axes = axes_;
+  for (const PlannedTask& t : plan.tasks()) man.tasks.push_back(t.entry);
+  man.axes = plan.axes();
   man.time_units = cfg.time_units;
   for (const std::string& f : field_names) {
     const auto unit = cfg.field_units.find(f);
@@ -469,7 +346,7 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
     // Every camera renders every task in one march: the fields the volume tasks read together get
     // one interleaved corner copy (render::prepare_fields()).
     std::vector<render::TaskSpec> uses;
-    for (const Task& t : tasks) uses.push_back(t.spec);
+    for (const PlannedTask& t : plan.tasks()) uses.push_back(t.spec);
     prepared = render::prepare_fields(views, uses);
   }
 }
@@ -488,8 +365,12 @@ double Session::Impl::global_percentile(int f) {
   for (int k = first(b.owned.lo[2]); k < b.owned.hi[2]; k += s)
     for (int j = first(b.owned.lo[1]); j < b.owned.hi[1]; j += s)
       for (int i = first(b.owned.lo[0]); i < b.owned.hi[0]; i += s)
-        mine.push_back(std::fabs(
-            buf[std::size_t((std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] + (i - req.lo[0]))]));
+      {
+        // NaN and infinite values (rendered as empty) are no reference: an all-NaN volume gave a NaN window.
+        const float v = std::fabs(buf[std::size_t((std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0] +
+                                                  (i - req.lo[0]))]);
+        if (std::isfinite(v)) mine.push_back(v);
+      }
   std::vector<float> all;
 #ifdef PANOPTES_HAVE_MPI
   if (size > 1) {
@@ -528,7 +409,7 @@ double Session::Impl::window_reference(int f) {
     for (int j = b.owned.lo[1]; j < b.owned.hi[1]; ++j) {
       const std::size_t row = std::size_t((std::int64_t(k - req.lo[2]) * rd[1] + (j - req.lo[1])) * rd[0]);
       for (int i = b.owned.lo[0]; i < b.owned.hi[0]; ++i)
-        peak = std::max(peak, std::fabs(buf[row + std::size_t(i - req.lo[0])]));
+        if (const float v = std::fabs(buf[row + std::size_t(i - req.lo[0])]); std::isfinite(v)) peak = std::max(peak, v);
     }
 #ifdef PANOPTES_HAVE_MPI
   if (size > 1) MPI_Allreduce(MPI_IN_PLACE, &peak, 1, MPI_FLOAT, MPI_MAX, comm);
@@ -569,7 +450,7 @@ const char* unpack(const char* in, const char* end, int width, int height, rende
 
 void Session::Impl::render_snapshot(int frame) {
   const int C = rig.size();
-  const int K = int(tasks.size());
+  const int K = int(plan.size());
   const bool brick = me().has_brick;
   const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
   render::OutlineStyle outline;
@@ -661,7 +542,7 @@ void Session::Impl::render_snapshot(int frame) {
 void Session::Impl::encode_batch() {
   if (batch_n == 0) return;
   const auto t0 = Clock::now();
-  const int K = int(tasks.size());
+  const int K = int(plan.size());
   store::DatabaseWriter& w = *writer;
   // Frames of several cameras in one parallel loop: appends to different streams may run
   // concurrently, and batch_n × K frames share the threads evenly where K alone would not.
@@ -794,14 +675,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
     ref[f] = std::max(m.cfg.running_max ? m.references[f].update(q) : q, 1e-30);
   }
   m.last_references = ref;
-  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
-    const Task& t = m.tasks[i];
-    render::TaskSpec& s = m.specs[i];
-    s = t.spec;
-    if (t.relative) s.reference = ref[std::size_t(t.spec.field)];
-    if (t.relative2 && t.spec.field2 >= 0) s.reference2 = ref[std::size_t(t.spec.field2)];
-    if (t.iso_relative) s.isovalue = float(t.iso_fraction * ref[std::size_t(t.spec.field)]);
-  }
+  m.plan.resolve(ref, m.specs);
   m.time.copy += since(t0);
   m.render_snapshot(m.snapshots);
   ++m.snapshots;
@@ -842,7 +716,7 @@ void Session::set_frame_observer(FrameObserver observer) { impl_->observer = std
 int Session::rank() const { return impl_->rank; }
 int Session::ranks() const { return impl_->size; }
 int Session::camera_count() const { return impl_->rig.size(); }
-int Session::task_count() const { return int(impl_->tasks.size()); }
+int Session::task_count() const { return int(impl_->plan.size()); }
 int Session::snapshots() const { return impl_->snapshots; }
 const std::vector<std::string>& Session::field_names() const { return impl_->field_names; }
 const std::string& Session::output_dir() const { return impl_->cfg.output_dir; }

@@ -26,6 +26,6 @@ expect_error 'panoptes: error: --sample-distance: "abc" is not a number (e.g. 0.
 expect_error 'panoptes: error: --frames: "1.5" is not an integer (e.g. 3) (see `panoptes synth-db --help`)' \
   "$panoptes" synth-db "$tmp/db" --frames 1.5
 /usr/bin/python3 -c "import numpy as np; np.save('$tmp/v.npy', np.ones((4, 4, 4), 'f4'))"
-expect_error "panoptes: error: $tmp/db: cannot create the database: manifest: video settings: crf 99 is outside 0..51" \
+expect_error "panoptes: error: --crf 99: expected an x264 quality 0..51" \
   "$panoptes" render "$tmp/v.npy" --rig fibonacci:2 --size 32x32 --crf 99 --out "$tmp/db"
 echo "help: ok"

@@ -1,0 +1,311 @@
+#include "insitu/task_plan.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace panoptes::insitu {
+
+namespace {
+
+// The transfer function as data (control points), so players draw its colour legend without knowing
+// the renderer's presets (issue 34).
+nlohmann::json transfer_json(const render::TransferFunction& tf) {
+  // The presets are floats: 0.9f would read 0.8999999761581421 in the manifest.
+  const auto v = [](float x) { return std::round(double(x) * 1e6) / 1e6; };
+  nlohmann::json colour = nlohmann::json::array(), extinction = nlohmann::json::array();
+  for (const auto& p : tf.colour) colour.push_back({v(p.x), v(p.colour.r), v(p.colour.g), v(p.colour.b)});
+  for (const auto& p : tf.opacity) extinction.push_back({v(p.x), v(p.extinction)});
+  return {{"colour", std::move(colour)}, {"extinction", std::move(extinction)}, {"absolute_value", tf.absolute_value}};
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+render::ValueWindow window_of(const WindowConfig& w) {
+  return w.relative ? render::ValueWindow::relative_to(w.lo, w.hi) : render::ValueWindow::absolute(w.lo, w.hi);
+}
+
+}  // namespace
+
+TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeometry& grid) {
+  auto field_index = [&](const std::string& name) {
+    auto it = std::find(field_names_.begin(), field_names_.end(), name);
+    if (it != field_names_.end()) return int(it - field_names_.begin());
+    field_names_.push_back(name);
+    return int(field_names_.size()) - 1;
+  };
+  for (const TaskConfig& tc : configs) {
+    const int f = field_index(tc.fields.at(0));
+    const int f2 = tc.fields.size() > 1 ? field_index(tc.fields[1]) : -1;
+    std::size_t n = 1;
+    std::string axis_suffix;
+    std::vector<double> axis_values;
+    switch (tc.kind) {
+      case TaskConfig::Kind::volume:
+        n = tc.windows.size();
+        axis_suffix = "window";
+        for (const auto& w : tc.windows) axis_values.push_back(w.hi);
+        break;
+      case TaskConfig::Kind::volume2:
+        break;
+      case TaskConfig::Kind::isosurface:
+        n = tc.isovalues.size();
+        axis_suffix = "isovalue";
+        axis_values = tc.isovalues;
+        break;
+      case TaskConfig::Kind::slice:
+        n = tc.slice_positions.size();
+        axis_suffix = "position";
+        axis_values = tc.slice_positions;
+        break;
+    }
+    const std::string axis_name = tc.axis.empty() ? tc.name + " " + axis_suffix : tc.axis;
+    if (n > 1) axes_.push_back({axis_name, axis_values, ""});
+    for (std::size_t i = 0; i < n; ++i) {
+      PlannedTask t;
+      t.entry.name = n > 1 ? tc.name + " " + fmt(axis_values[i]) : tc.name;
+      t.entry.fields = tc.fields;
+      if (n > 1) t.entry.axes = {{axis_name, int(i)}};
+      switch (tc.kind) {
+        case TaskConfig::Kind::volume: {
+          const WindowConfig& w = tc.windows[i];
+          t.spec = render::TaskSpec::volume(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale), window_of(w));
+          t.relative = w.relative;
+          t.entry.method = "volume";
+          t.entry.parameters = {{"preset", tc.preset}, {"window", {w.lo, w.hi}}, {"relative", w.relative},
+                                {"extinction_scale", tc.extinction_scale},
+                                {"transfer_function", transfer_json(t.spec.tf)}};
+          break;
+        }
+        case TaskConfig::Kind::volume2: {
+          const WindowConfig& w = tc.windows[0];
+          t.spec = render::TaskSpec::volume2(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale),
+                                             window_of(w), f2,
+                                             render::TransferFunction::preset(tc.preset2, tc.extinction_scale),
+                                             window_of(tc.window2));
+          t.relative = w.relative;
+          t.relative2 = tc.window2.relative;
+          t.entry.method = "volume";
+          t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
+                                {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
+                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale},
+                                {"relative2", tc.window2.relative},
+                                {"transfer_function", transfer_json(t.spec.tf)},
+                                {"transfer_function2", transfer_json(t.spec.tf2)}};
+          break;
+        }
+        case TaskConfig::Kind::isosurface:
+          t.spec = render::TaskSpec::isosurface(f, float(tc.isovalues[i]), {tc.colour[0], tc.colour[1], tc.colour[2]});
+          t.iso_relative = tc.iso_relative;
+          t.iso_fraction = tc.isovalues[i];
+          t.entry.method = "isosurface";
+          t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative},
+                                {"colour", {tc.colour[0], tc.colour[1], tc.colour[2]}}};
+          break;
+        case TaskConfig::Kind::slice: {
+          const WindowConfig& w = tc.windows[0];
+          const int a = tc.slice_axis;
+          const double pos = grid.origin[a] + tc.slice_positions[i] * (grid.dims[a] - 1) * grid.spacing[a];
+          t.spec = render::TaskSpec::slice(f, a, pos, render::TransferFunction::preset(tc.preset), window_of(w));
+          t.relative = w.relative;
+          t.entry.method = "slice";
+          t.entry.parameters = {{"axis", std::string(1, char('x' + a))}, {"fraction", tc.slice_positions[i]},
+                                {"position", pos}, {"preset", tc.preset}, {"window", {w.lo, w.hi}},
+                                {"relative", w.relative}, {"transfer_function", transfer_json(t.spec.tf)}};
+          break;
+        }
+      }
+      t.entry.id = int(tasks_.size());
+      for (const PlannedTask& o : tasks_)
+        if (o.entry.name == t.entry.name) throw Error("task \"" + t.entry.name + "\": the name is used twice");
+      tasks_.push_back(std::move(t));
+    }
+  }
+}
+
+void TaskPlan::resolve(const std::vector<double>& ref, std::vector<render::TaskSpec>& specs) const {
+  specs.resize(tasks_.size());
+  for (std::size_t i = 0; i < tasks_.size(); ++i) {
+    const PlannedTask& t = tasks_[i];
+    render::TaskSpec& s = specs[i];
+    s = t.spec;
+    if (t.relative) s.reference = ref[std::size_t(t.spec.field)];
+    if (t.relative2 && t.spec.field2 >= 0) s.reference2 = ref[std::size_t(t.spec.field2)];
+    if (t.iso_relative) s.isovalue = float(t.iso_fraction * ref[std::size_t(t.spec.field)]);
+  }
+}
+
+TaskConfig parse_task_shorthand(const std::string& text, const std::string& field) {
+  std::vector<std::string> parts;
+  std::size_t b = 0;
+  while (true) {
+    const auto e = text.find(':', b);
+    parts.push_back(text.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  const std::string usage = "; expected volume:PRESET[:LO:HI], iso:VALUE or slice:x|y|z:FRACTION[:PRESET[:LO:HI]]";
+  auto number = [&](const std::string& s) {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(s, &used);
+      if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument("");
+      return v;
+    } catch (const std::exception&) {
+      throw Error("--task \"" + text + "\": \"" + s + "\" is not a number");
+    }
+  };
+  auto preset = [&](const std::string& p) {
+    const auto names = render::TransferFunction::preset_names();
+    if (std::find(names.begin(), names.end(), p) != names.end()) return p;
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw Error("--task \"" + text + "\": unknown preset \"" + p + "\" (expected one of: " + list + ")");
+  };
+  auto absolute = [&](const std::string& lo, const std::string& hi) {
+    const WindowConfig w{number(lo), number(hi), false};
+    if (!(w.lo < w.hi)) throw Error("--task \"" + text + "\": window " + lo + ":" + hi + "; expected LO < HI");
+    return w;
+  };
+  TaskConfig t;
+  t.name = text;
+  t.fields = {field};
+  if (parts[0] == "volume" && (parts.size() == 2 || parts.size() == 4)) {
+    t.kind = TaskConfig::Kind::volume;
+    t.preset = preset(parts[1]);
+    // Relative default: [0, ref] (|v| for the wave presets), [-ref, ref] for the diverging map.
+    t.windows = {parts.size() == 4 ? absolute(parts[2], parts[3])
+                                   : WindowConfig{t.preset == "diverging" ? -1.0 : 0.0, 1.0, true}};
+  } else if (parts[0] == "iso" && parts.size() == 2) {
+    t.kind = TaskConfig::Kind::isosurface;
+    t.isovalues = {number(parts[1])};
+  } else if (parts[0] == "slice" && (parts.size() == 3 || parts.size() == 4 || parts.size() == 6)) {
+    t.kind = TaskConfig::Kind::slice;
+    const std::string axes = "xyz";
+    if (parts[1].size() != 1 || axes.find(parts[1][0]) == std::string::npos)
+      throw Error("--task \"" + text + "\": slice axis \"" + parts[1] + "\"; expected x, y or z");
+    t.slice_axis = int(axes.find(parts[1][0]));
+    const double f = number(parts[2]);
+    if (!(f >= 0 && f <= 1)) throw Error("--task \"" + text + "\": slice position " + parts[2] + "; expected a fraction in [0, 1]");
+    t.slice_positions = {f};
+    t.preset = parts.size() >= 4 ? preset(parts[3]) : "diverging";
+    t.windows = {parts.size() == 6 ? absolute(parts[4], parts[5]) : WindowConfig{-1, 1, true}};
+  } else {
+    throw Error("--task \"" + text + "\"" + usage);
+  }
+  return t;
+}
+
+std::vector<TaskConfig> tasks_from_shorthand(const std::vector<std::string>& texts, const std::string& field) {
+  std::vector<TaskConfig> tasks;
+  int isos = 0;
+  for (const std::string& text : texts) {
+    for (const TaskConfig& t : tasks)
+      if (t.name == text) throw Error("--task \"" + text + "\" is given twice");
+    TaskConfig t = parse_task_shorthand(text, field);
+    isos += t.kind == TaskConfig::Kind::isosurface;
+    tasks.push_back(std::move(t));
+  }
+  if (isos < 2) return tasks;
+  // Several isosurfaces form one sweep on an "isovalue" axis, so the player can step the isovalue.
+  std::vector<TaskConfig> merged;
+  std::size_t sweep = SIZE_MAX;  // an index: merged grows, a pointer into it would dangle
+  for (TaskConfig& t : tasks) {
+    if (t.kind != TaskConfig::Kind::isosurface) {
+      merged.push_back(std::move(t));
+      continue;
+    }
+    if (sweep == SIZE_MAX) {
+      t.name = "iso";
+      t.axis = "isovalue";
+      merged.push_back(std::move(t));
+      sweep = merged.size() - 1;
+      continue;
+    }
+    for (double v : merged[sweep].isovalues)
+      if (v == t.isovalues[0]) throw Error("--task \"" + t.name + "\": the isovalue is given twice");
+    merged[sweep].isovalues.push_back(t.isovalues[0]);
+  }
+  for (const TaskConfig& t : merged)
+    if (t.kind != TaskConfig::Kind::isosurface && t.name == "iso")
+      throw Error("--task names: \"iso\" is the isovalue sweep's name");
+  return merged;
+}
+
+std::string task_table_toml(const TaskConfig& t) {
+  auto q = [](const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) out += c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c);
+    return out + "\"";
+  };
+  auto num = [](double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    std::string text = s.str();
+    if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+    return text;
+  };
+  // Floats (colours, extinction scales) in their shortest form: 0.85, not 0.85000002384185791.
+  auto numf = [](float v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    std::string text(buf, r.ptr);
+    if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+    return text;
+  };
+  auto list = [&](const std::vector<double>& v) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + num(v[i]);
+    return s + "]";
+  };
+  std::string s = "[[task]]\nname = " + q(t.name) + "\n";
+  const char* type[] = {"volume", "volume2", "isosurface", "slice"};
+  s += "type = " + q(type[int(t.kind)]) + "\n";
+  if (t.fields.size() == 1) s += "field = " + q(t.fields[0]) + "\n";
+  else s += "fields = [" + q(t.fields.at(0)) + ", " + q(t.fields.at(1)) + "]\n";
+  if (!t.axis.empty() && t.kind != TaskConfig::Kind::volume2) s += "axis_name = " + q(t.axis) + "\n";
+  switch (t.kind) {
+    case TaskConfig::Kind::volume:
+    case TaskConfig::Kind::volume2:
+      s += "preset = " + q(t.preset) + "\n";
+      if (t.extinction_scale != 1) s += "extinction_scale = " + numf(t.extinction_scale) + "\n";
+      s += std::string("relative = ") + (t.windows.at(0).relative ? "true" : "false") + "\n";
+      if (t.windows.size() == 1) {
+        s += "window = " + list({t.windows[0].lo, t.windows[0].hi}) + "\n";
+      } else {
+        s += "windows = [";
+        for (std::size_t i = 0; i < t.windows.size(); ++i)
+          s += (i ? ", " : "") + list({t.windows[i].lo, t.windows[i].hi});
+        s += "]\n";
+      }
+      if (t.kind == TaskConfig::Kind::volume2)
+        s += "preset2 = " + q(t.preset2) + "\nwindow2 = " + list({t.window2.lo, t.window2.hi}) + "\n";
+      break;
+    case TaskConfig::Kind::isosurface:
+      s += (t.isovalues.size() == 1 ? "isovalue = " + num(t.isovalues[0]) : "isovalues = " + list(t.isovalues)) + "\n";
+      s += std::string("relative = ") + (t.iso_relative ? "true" : "false") + "\n";
+      s += "colour = [" + numf(t.colour[0]) + ", " + numf(t.colour[1]) + ", " + numf(t.colour[2]) + "]\n";
+      break;
+    case TaskConfig::Kind::slice:
+      s += std::string("axis = \"") + char('x' + t.slice_axis) + "\"\n";
+      s += (t.slice_positions.size() == 1 ? "position = " + num(t.slice_positions[0])
+                                          : "positions = " + list(t.slice_positions)) + "\n";
+      s += "preset = " + q(t.preset) + "\n";
+      s += std::string("relative = ") + (t.windows.at(0).relative ? "true" : "false") + "\n";
+      s += "window = " + list({t.windows.at(0).lo, t.windows.at(0).hi}) + "\n";
+      break;
+  }
+  return s;
+}
+
+}  // namespace panoptes::insitu

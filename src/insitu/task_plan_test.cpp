@@ -1,0 +1,70 @@
+// The task plan (issue 30): render's --task shorthand means the [[task]] tables it prints, and the
+// plan built from either is the same (entries, axes, specs resolved against a reference).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "insitu/task_plan.hpp"
+
+using namespace panoptes;
+
+namespace {
+
+const render::GridGeometry kGrid{{20, 16, 12}, {-1, 0, 2}, {0.5, 1, 2}};
+
+TEST(TaskPlan, ShorthandMeansTheTomlTablesItPrints) {
+  const std::vector<std::string> texts{"volume:hot", "volume:diverging", "volume:p-wave:0:0.8", "iso:0.3",
+                                       "slice:y:0.25:rainbow:-2:3", "iso:-0.2", "slice:z:1"};
+  const std::vector<insitu::TaskConfig> tasks = insitu::tasks_from_shorthand(texts, "v");
+  ASSERT_EQ(tasks.size(), 6u);  // the two iso: form one sweep
+  std::string toml = "[schedule]\nevery_steps = 1\n";
+  for (const auto& t : tasks) toml += insitu::task_table_toml(t) + "\n";
+  const insitu::SessionConfig cfg = insitu::parse_session_config_text(toml, "printed tasks");
+  const insitu::TaskPlan a(tasks, kGrid), b(cfg.tasks, kGrid);
+  ASSERT_EQ(a.size(), 7u);
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.tasks()[i].entry, b.tasks()[i].entry) << i;
+  EXPECT_EQ(a.axes(), b.axes());
+  ASSERT_EQ(a.axes().size(), 1u);
+  EXPECT_EQ(a.axes()[0].name, "isovalue");
+  EXPECT_EQ(a.axes()[0].values, (std::vector<double>{0.3, -0.2}));
+  EXPECT_EQ(a.tasks()[3].entry.name, "iso 0.3");
+  EXPECT_EQ(a.field_names(), std::vector<std::string>{"v"});
+
+  // Relative windows follow the reference; absolute ones do not.
+  std::vector<render::TaskSpec> specs;
+  a.resolve({2.5}, specs);
+  ASSERT_EQ(specs.size(), a.size());
+  EXPECT_EQ(specs[0].reference, 2.5);  // volume:hot, relative [0, 1]
+  EXPECT_EQ(specs[0].window.lo, 0.0);
+  EXPECT_EQ(specs[1].window.lo, -1.0);  // diverging: [-ref, ref]
+  EXPECT_FALSE(a.tasks()[2].relative);  // LO:HI is absolute
+  EXPECT_FALSE(a.tasks()[5].relative);
+  EXPECT_TRUE(a.tasks()[6].relative);
+  // Slice positions are fractions of the grid's domain.
+  EXPECT_DOUBLE_EQ(specs[5].slice_position, 0 + 0.25 * 15 * 1.0);
+  EXPECT_DOUBLE_EQ(specs[6].slice_position, 2 + 1.0 * 11 * 2.0);
+}
+
+TEST(TaskPlan, ShorthandErrorsNameTheOption) {
+  auto message = [](const std::string& text) {
+    try {
+      insitu::tasks_from_shorthand({text}, "v");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("volume:nope").find("--task \"volume:nope\": unknown preset"), std::string::npos);
+  EXPECT_NE(message("volume:hot:1:0").find("expected LO < HI"), std::string::npos);
+  EXPECT_NE(message("slice:w:0.5").find("slice axis \"w\""), std::string::npos);
+  EXPECT_NE(message("slice:x:1.5").find("expected a fraction"), std::string::npos);
+  EXPECT_NE(message("iso:abc").find("\"abc\" is not a number"), std::string::npos);
+  EXPECT_NE(message("cube:1").find("expected volume:PRESET"), std::string::npos);
+  EXPECT_THROW(insitu::tasks_from_shorthand({"iso:1", "iso:1"}, "v"), Error);
+  EXPECT_THROW(insitu::tasks_from_shorthand({"volume:hot", "volume:hot"}, "v"), Error);
+}
+
+}  // namespace
