@@ -29,6 +29,7 @@
 #include "core/memory.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
+#include "core/version.hpp"
 #include "video/writer_memory.hpp"
 
 namespace {
@@ -274,7 +275,7 @@ void run(const Args& a, const std::string& command_line) {
   store::Manifest man;
   man.title = a.title.empty() ? "panoptes render " + files[0] : a.title;
   man.provenance.program = "panoptes render";
-  man.provenance.version = "0.1.0";
+  man.provenance.version = panoptes::kVersion;
   man.provenance.command_line = command_line;
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
   man.domain.origin = grid.origin;
