@@ -19,7 +19,7 @@ got=$("$panoptes" --version)
 [ "$got" = "panoptes $v" ] || fail "'panoptes --version' says '$got'; CMakeLists.txt says $v"
 
 "$panoptes" synth-db "$tmp/db" --cameras 2 --tasks 1 --frames 2 --size 64x64 --gop 2 >/dev/null
-grep -q "\"version\": \"$v\"" "$tmp/db/panoptes.json" || fail "panoptes.json (manifest) writer version is not $v:
+grep -qE "\"version\": ?\"$v\"" "$tmp/db/panoptes.json" || fail "panoptes.json (manifest) writer version is not $v:
 $(grep -n '"version"' "$tmp/db/panoptes.json")"
 
 got=$(/usr/bin/python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['version'])" "$root/web/package.json")
