@@ -210,7 +210,7 @@ void BM_DenseSnapshot(benchmark::State& state) {
   std::string seis_text;
   insitu::SessionConfig cfg = insitu::parse_combined_config(read_file(path), path, kSeismicSections, seis_text);
   cfg.output_dir = (std::filesystem::temp_directory_path() / ("paper_snapshot_bench_" + std::to_string(::getpid()))).string();
-  cfg.overwrite = true;
+  cfg.mode = insitu::OutputMode::overwrite;
   cfg.up = {0, 0, -1};  // as panoptes run: depth is +z
   cfg.validate();
   insitu::SessionStats st;
@@ -441,7 +441,7 @@ void BM_DemoAdaptive(benchmark::State& state) {
   const auto& g = rc.solver.grid;
   const GridGeometry grid{{g.nx, g.ny, g.nz}, {0, 0, 0}, {g.h, g.h, g.h}};
   cfg.output_dir = (std::filesystem::temp_directory_path() / ("demo_adaptive_bench_" + std::to_string(::getpid()))).string();
-  cfg.overwrite = true;
+  cfg.mode = insitu::OutputMode::overwrite;
   double cpu[2] = {0, 0}, render[2] = {0, 0};
   for (auto _ : state)
     for (int on = 0; on < 2; ++on) {

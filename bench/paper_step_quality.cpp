@@ -339,7 +339,7 @@ int cmd_session(const std::vector<Scene>& scenes) {
   std::string seis_text;
   insitu::SessionConfig cfg = insitu::parse_combined_config(read_text(kPaper), kPaper, kSeismicSections, seis_text);
   cfg.output_dir = (std::filesystem::temp_directory_path() / "paper_step_quality_session").string();
-  cfg.overwrite = true;
+  cfg.mode = insitu::OutputMode::overwrite;
   cfg.up = {0, 0, -1};  // as panoptes run: depth is +z
   cfg.validate();
   std::printf("| scene | wall s | CPU-s | render s | composite s | encode s | copy s |\n");

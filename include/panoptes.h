@@ -96,6 +96,8 @@ int panoptes_finalize(panoptes_session* s);
 void panoptes_destroy(panoptes_session* s);
 /** The message of the last error of this thread ("" if none). */
 const char* panoptes_last_error(void);
+/** The library's version, "major.minor.patch" (static storage; never NULL). */
+const char* panoptes_version(void);
 /** Where failing calls print their message, process-wide: PANOPTES_ERRORS_ALL (default), _RANK0 or _NONE.
  * The environment variable PANOPTES_ERRORS=all|rank0|none sets the default before the first call. */
 void panoptes_set_error_output(int mode);

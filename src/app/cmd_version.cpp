@@ -6,12 +6,13 @@ extern "C" {
 }
 
 #include "app/command.hpp"
+#include "core/version.hpp"
 
 namespace {
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto* sub = root.add_subcommand("version", "Print the Panoptes version and the versions of its libraries");
   sub->callback([] {
-    std::printf("panoptes 0.1.0\nlibavcodec %s\n", AV_STRINGIFY(LIBAVCODEC_VERSION));
+    std::printf("panoptes %s\nlibavcodec %s\n", panoptes::kVersion, AV_STRINGIFY(LIBAVCODEC_VERSION));
   });
 });
 }  // namespace

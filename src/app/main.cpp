@@ -9,6 +9,7 @@
 #include "app/command.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/version.hpp"
 
 namespace panoptes::app {
 namespace {
@@ -110,7 +111,7 @@ int main(int argc, char** argv) {
       "Panoptes: in-situ visualization from very many cameras, kept as compressed movies, explored "
       "interactively afterwards.",
       "panoptes"};
-  root.set_version_flag("--version", "panoptes 0.1.0");
+  root.set_version_flag("--version", std::string("panoptes ") + panoptes::kVersion);
   root.require_subcommand(1);
   panoptes::app::add_registered_commands(root);
   panoptes::app::explain_number_options(root);

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/version.hpp"
 #include "insitu/session.hpp"
 
 using namespace panoptes;
@@ -369,6 +370,8 @@ void panoptes_destroy(panoptes_session* s) {
 }
 
 const char* panoptes_last_error(void) { return g_error.c_str(); }
+
+const char* panoptes_version(void) { return panoptes::kVersion; }
 
 void panoptes_set_error_output(int mode) {
   if (mode == PANOPTES_ERRORS_ALL || mode == PANOPTES_ERRORS_RANK0 || mode == PANOPTES_ERRORS_NONE) g_error_mode = mode;

@@ -18,6 +18,7 @@
 #include "cinema/stream_workers.hpp"
 #include "core/error.hpp"
 #include "store/database.hpp"
+#include "core/version.hpp"
 
 namespace panoptes::cinema {
 namespace fs = std::filesystem;
@@ -246,7 +247,7 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   m.title = o.title.empty() ? "Cinema database " + fs::absolute(cdb).lexically_normal().filename().string() : o.title;
   if (m.title == "Cinema database ") m.title = "Cinema database";
   m.provenance.program = "panoptes import-cinema";
-  m.provenance.version = "0.1.0";
+  m.provenance.version = panoptes::kVersion;
   m.provenance.command_line = o.command_line;
   m.provenance.extra["cinema_spec"] = t.spec;
   m.provenance.extra["cinema_source"] = fs::absolute(cdb).lexically_normal().string();

@@ -27,6 +27,7 @@
 #include "insitu/task_plan.hpp"
 #include "render/renderer.hpp"
 #include "store/database.hpp"
+#include "core/version.hpp"
 
 namespace panoptes::insitu {
 
@@ -277,7 +278,7 @@ store::Manifest Session::Impl::make_manifest() const {
   store::Manifest man;
   man.title = cfg.title;
   man.provenance.program = cfg.program;
-  man.provenance.version = "0.1.0";
+  man.provenance.version = panoptes::kVersion;
   man.provenance.command_line = cfg.command_line;
   man.provenance.extra["mpi_ranks"] = std::to_string(size);
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};

@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include "core/error.hpp"
+#include "core/version.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;
@@ -21,6 +22,7 @@ PYBIND11_MODULE(_panoptes, m) {
       PyErr_SetString(error.ptr(), e.what());
     }
   });
+  m.attr("__version__") = panoptes::kVersion;  // CMake project(VERSION), core/version.hpp
   panoptes::python::bind_database(m);
   panoptes::python::bind_player(m);
   panoptes::python::bind_session(m);

@@ -3,6 +3,7 @@
 // before issue 10, side by side for tests and for the reference renderer.
 #include "core/vec3.hpp"
 #include "render/field_view.hpp"
+#include "render/field_access.hpp"
 #include "render/renderer.hpp"
 
 namespace panoptes::render {
@@ -16,3 +17,15 @@ void shade_isosurface_hit(const FieldView& v, const double p[3], const Vec3& dir
                           float rgba[4]);
 
 }  // namespace panoptes::render
+
+namespace panoptes::render::march {
+
+/// The renderer's hit shading on the march's view of a field (what shade_isosurface_hit() with
+/// renderer = true computes): the six gradient interpolations as one 8-lane gather evaluation.
+void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
+               const float colour[3], float* a);
+/// The pre-issue-10 hit shading (six scalar interpolations, std::pow): the reference renderer's.
+void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
+                      const Vec3& dir, const float colour[3], float* a);
+
+}  // namespace panoptes::render::march

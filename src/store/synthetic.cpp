@@ -14,6 +14,7 @@
 
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
+#include "core/version.hpp"
 #include "core/frame_stamp.hpp"
 #include "store/database.hpp"
 
@@ -66,7 +67,7 @@ Manifest synthetic_manifest(const SyntheticOptions& options) {
   Manifest m;
   m.title = o.title;
   m.provenance.program = "panoptes synth-db";
-  m.provenance.version = "0.1.0";
+  m.provenance.version = panoptes::kVersion;
   m.provenance.command_line = o.command_line;
   m.domain.dims = {64, 64, 64};
   m.domain.origin = {-1, -1, -1};

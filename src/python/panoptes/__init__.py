@@ -16,10 +16,9 @@
 
 Errors raise panoptes.Error (panoptes.FileError for files) with the messages the command line prints.
 """
-from ._panoptes import Error, FileError
+from ._panoptes import Error, FileError, __version__  # CMake project(VERSION), one place
 from .database import Cameras, Database, open
 from .player import Player
 from .session import Session
 
 __all__ = ["open", "Database", "Cameras", "Player", "Session", "Error", "FileError"]
-__version__ = "0.1.0"

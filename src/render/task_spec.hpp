@@ -1,0 +1,53 @@
+#pragma once
+// What one image of a march shows: the task kinds and their parameters (TaskSpec), apart from the
+// renderer's interface. The march compiles a task list into its own plan (march_plan.hpp); a new
+// kind starts here (docs/extending.md).
+#include <string>
+#include <string_view>
+
+#include "render/transfer_function.hpp"
+
+namespace panoptes::render {
+
+/// What one image shows.
+enum class TaskKind {
+  volume,      ///< emission–absorption volume rendering of one field, or two fields mixed per sample
+  isosurface,  ///< the first crossing of one isovalue, lit (headlight, Lambert + specular)
+  slice,       ///< an axis-aligned plane coloured by a colour map
+};
+
+/// One visualization task (one image per camera). Fields are indices into the `fields` span of
+/// render_brick(). Windows may be relative; `reference` / `reference2` resolve them (see
+/// ValueWindow). Build with the named constructors.
+struct TaskSpec {
+  TaskKind kind = TaskKind::volume;
+  int field = 0;
+  TransferFunction tf;  ///< volume: colour + extinction; slice: colour map
+  ValueWindow window;
+  double reference = 1;
+  int field2 = -1;  ///< volume only: second field, composited with the first at every sample
+  TransferFunction tf2;
+  ValueWindow window2;
+  double reference2 = 1;
+  float isovalue = 0;
+  Rgb surface_colour{0.85f, 0.85f, 0.85f};
+  int slice_axis = 2;         ///< 0 = x, 1 = y, 2 = z
+  double slice_position = 0;  ///< world coordinate of the plane along slice_axis
+  float slice_opacity = 1;
+
+  static TaskSpec volume(int field, TransferFunction tf, ValueWindow window, double reference = 1);
+  /// Two fields in one image (the paper's p-wave orange + s-wave green): per sample the extinctions
+  /// add and the colours mix in proportion to them.
+  static TaskSpec volume2(int field, TransferFunction tf, ValueWindow window, int field2, TransferFunction tf2,
+                          ValueWindow window2, double reference = 1, double reference2 = 1);
+  static TaskSpec isosurface(int field, float isovalue, Rgb colour = {0.85f, 0.85f, 0.85f});
+  static TaskSpec slice(int field, int axis, double position, TransferFunction colour_map, ValueWindow window,
+                        double reference = 1);
+};
+
+/// The kind's word in task descriptions and manifests: "volume", "isosurface", "slice".
+const char* to_string(TaskKind kind);
+/// Parses the words of to_string(); throws panoptes::Error naming the text and the accepted words.
+TaskKind parse_task_kind(std::string_view text);
+
+}  // namespace panoptes::render
