@@ -5,7 +5,8 @@
  * Typical use (every call is collective over the MPI communicator):
  *   panoptes_session* s;
  *   panoptes_create("viz.toml", 1, PANOPTES_COMM_WORLD, &s);    // config file (or TOML text, 0)
- *   panoptes_set_grid(s, dims, origin, spacing);                // the global grid of points
+ *   panoptes_set_grid(s, dims, origin, spacing);                // the global grid of points (or
+ *                                                               // _rectilinear, _spherical, _yinyang)
  *   panoptes_set_block(s, offset, extent, ghost_lo, ghost_hi);  // this rank's owned points + STORED ghosts
  *   panoptes_set_halo(s, valid_lo, valid_hi, 0);                // optional: ghosts kept up to date, face-only
  *   for (step...) {
@@ -52,6 +53,29 @@ typedef struct panoptes_session panoptes_session;
 int panoptes_create(const char* config, int config_is_file, int fortran_comm, panoptes_session** out);
 /** The global grid: dims[3] points (x, y, z), origin[3] and spacing[3] in world units. */
 int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origin[3], const double spacing[3]);
+/** Grids that are not uniform boxes (docs/instrumenting.md, "Grids"): the session resamples them onto a
+ * uniform grid over the domain's bounding box before rendering. Arrays are indexed like a uniform grid's
+ * (first axis fastest, dims[3] points, blocks and ghosts as panoptes_set_block says).
+ * Rectilinear: x[dims[0]], y[dims[1]], z[dims[2]], strictly increasing coordinates. */
+int panoptes_set_grid_rectilinear(panoptes_session* s, const int dims[3], const double* x, const double* y, const double* z);
+/** A spherical shell (or sector): radii r[dims[0]] >= 0, colatitudes theta[dims[1]] in [0, pi] from +z and
+ * longitudes phi[dims[2]] (radians), each strictly increasing; point (i, j, k) is at
+ * (r sin(theta) cos(phi), r sin(theta) sin(phi), r cos(theta)). Longitudes that close the circle wrap around;
+ * colatitudes within 1.5 spacings of a pole cover its cap. Points outside the shell take the outside value. */
+int panoptes_set_grid_spherical(panoptes_session* s, const int dims[3], const double* r, const double* theta,
+                                const double* phi);
+/** A Yin-Yang grid: two patches (0 = Yin, 1 = Yang) with the coordinates of panoptes_set_grid_spherical, each
+ * covering at least theta in [pi/4, 3pi/4] and phi in [-3pi/4, 3pi/4] within (0, pi) x (-pi, pi); Yang's frame is
+ * Yin's rotated by (x, y, z) -> (-x, z, y). Select a rank's patch with panoptes_set_patch. */
+int panoptes_set_grid_yinyang(panoptes_session* s, const int dims[3], const double* r, const double* theta,
+                              const double* phi);
+/** Yin-Yang: the patch (0 = Yin, 1 = Yang) that the following panoptes_set_block and panoptes_set_field* calls
+ * describe. A rank may describe a block of each patch (select, set block and fields, select the other, ...). */
+int panoptes_set_patch(panoptes_session* s, int patch);
+/** Non-uniform grids: points along the longest axis of the uniform grid the fields are resampled onto
+ * (0 = the source's largest dimension, the default) and the value of points outside the grid's domain (a
+ * shell's core and outside; default 0, which the absolute-value presets show transparent). */
+int panoptes_set_resample(panoptes_session* s, int longest_axis_points, double outside_value);
 /** This rank's owned points (0-based global offset, extent) and the ghost layers its arrays store
  * below/above them per axis. Owned boxes of all ranks must partition the grid. */
 int panoptes_set_block(panoptes_session* s, const int offset[3], const int extent[3], const int ghost_lo[3],

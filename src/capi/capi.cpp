@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -13,6 +14,8 @@
 
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "grid/grid_description.hpp"
+#include "insitu/grid_adapter.hpp"
 #include "insitu/session.hpp"
 
 using namespace panoptes;
@@ -25,6 +28,18 @@ struct panoptes_session {
   std::optional<insitu::LocalBlock> block;
   std::map<std::string, insitu::FieldInput> fields;
   std::unique_ptr<insitu::Session> session;
+  // A non-uniform grid (panoptes_set_grid_rectilinear / _spherical / _yinyang): the blocks and fields
+  // of the patch not selected by panoptes_set_patch wait in `other_patches`; the adapter resamples
+  // them onto the uniform grid the session renders.
+  std::optional<grid::GridDescription> source;
+  insitu::ResampleOptions resample;
+  int patch = 0;
+  struct PatchState {
+    std::optional<insitu::LocalBlock> block;
+    std::map<std::string, insitu::FieldInput> fields;
+  };
+  std::map<int, PatchState> other_patches;
+  std::unique_ptr<insitu::GridAdapter> adapter;
   bool finalized = false;  // the overhead report is printed by the first panoptes_finalize only
 };
 
@@ -110,28 +125,86 @@ void need(bool ok, const std::string& what) {
   if (!ok) throw UsageError(what);
 }
 
+// Every patch's state, the selected one included, in patch order (non-uniform grids).
+std::map<int, panoptes_session::PatchState> all_patches(const panoptes_session* s) {
+  std::map<int, panoptes_session::PatchState> all = s->other_patches;
+  all[s->patch] = {s->block, s->fields};
+  return all;
+}
+
+std::vector<insitu::GridBlock> grid_blocks(const panoptes_session* s) {
+  std::vector<insitu::GridBlock> v;
+  for (const auto& [patch, st] : all_patches(s))
+    if (st.block) v.push_back({patch, st.block->offset, st.block->extent, st.block->ghost_lo, st.block->ghost_hi});
+  return v;
+}
+
 insitu::Session& session_of(panoptes_session* s) {
   need(s, "null session");
   if (s->session) return *s->session;
-  need(s->grid.has_value(), "panoptes_set_grid must be called before the first snapshot");
-  need(s->block.has_value(), "panoptes_set_block must be called before the first snapshot");
+  need(s->grid.has_value() || s->source.has_value(),
+       "panoptes_set_grid (or _rectilinear, _spherical, _yinyang) must be called before the first snapshot");
+  need(s->block.has_value() || (s->source && !grid_blocks(s).empty()),
+       "panoptes_set_block must be called before the first snapshot");
 #ifdef PANOPTES_HAVE_MPI
   int init = 0;
   MPI_Initialized(&init);
   if (init) {
     MPI_Comm comm = s->fortran_comm == PANOPTES_COMM_WORLD ? MPI_COMM_WORLD : MPI_Comm_f2c(s->fortran_comm);
-    s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, comm);
+    if (s->source) {
+      s->config.source_grid = s->source->summary();
+      s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample, comm);
+      s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block(), comm);
+    } else {
+      s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, comm);
+    }
     return *s->session;
   }
 #endif
-  s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block);
+  if (s->source) {
+    s->config.source_grid = s->source->summary();
+    s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample);
+    s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block());
+  } else {
+    s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block);
+  }
   return *s->session;
 }
 
 std::vector<insitu::FieldInput> inputs(const panoptes_session* s) {
   std::vector<insitu::FieldInput> v;
-  for (const auto& [name, f] : s->fields) v.push_back(f);
-  return v;
+  if (!s->adapter) {
+    for (const auto& [name, f] : s->fields) v.push_back(f);
+    return v;
+  }
+  // One input per field and block, blocks in patch order (as grid_blocks() gave them to the adapter).
+  for (const auto& [patch, st] : all_patches(s))
+    if (st.block)
+      for (const auto& [name, f] : st.fields) v.push_back(f);
+  return s->adapter->adapt(v);
+}
+
+// The three non-uniform grid calls: coordinates per axis, validated.
+int set_source_grid(panoptes_session* s, const char* call, grid::GridKind kind, const int dims[3], const double* a,
+                    const double* b, const double* c) {
+  return guarded(s, [&] {
+    need(s && dims && a && b && c, std::string(call) + ": null argument");
+    need(!s->session, std::string(call) + ": the grid cannot change after the first snapshot");
+    for (int d = 0; d < 3; ++d)
+      need(dims[d] >= 2 && dims[d] <= 65535, std::string(call) + ": dims[" + std::to_string(d) + "] = " +
+                                                 std::to_string(dims[d]) + "; expected 2 to 65535 points");
+    std::vector<double> x(a, a + dims[0]), y(b, b + dims[1]), z(c, c + dims[2]);
+    grid::GridDescription g = kind == grid::GridKind::rectilinear ? grid::GridDescription::rectilinear(x, y, z)
+                              : kind == grid::GridKind::spherical ? grid::GridDescription::spherical(x, y, z)
+                                                                  : grid::GridDescription::yinyang(x, y, z);
+    try {
+      g.validate();
+    } catch (const std::exception& e) {
+      throw UsageError(std::string(call) + ": " + e.what());
+    }
+    s->source = std::move(g);
+    s->grid.reset();
+  });
 }
 
 std::string shape_text(const std::array<long long, 3>& v) {
@@ -227,6 +300,52 @@ int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origi
       throw UsageError(std::string("panoptes_set_grid: ") + e.what());
     }
     s->grid = g;
+    s->source.reset();
+  });
+}
+
+int panoptes_set_grid_rectilinear(panoptes_session* s, const int dims[3], const double* x, const double* y,
+                                  const double* z) {
+  return set_source_grid(s, "panoptes_set_grid_rectilinear", grid::GridKind::rectilinear, dims, x, y, z);
+}
+
+int panoptes_set_grid_spherical(panoptes_session* s, const int dims[3], const double* r, const double* theta,
+                                const double* phi) {
+  return set_source_grid(s, "panoptes_set_grid_spherical", grid::GridKind::spherical, dims, r, theta, phi);
+}
+
+int panoptes_set_grid_yinyang(panoptes_session* s, const int dims[3], const double* r, const double* theta,
+                              const double* phi) {
+  return set_source_grid(s, "panoptes_set_grid_yinyang", grid::GridKind::yinyang, dims, r, theta, phi);
+}
+
+int panoptes_set_patch(panoptes_session* s, int patch) {
+  return guarded(s, [&] {
+    need(s, "panoptes_set_patch: null session");
+    need(!s->session, "panoptes_set_patch: the blocks cannot change after the first snapshot");
+    need(s->source && s->source->kind == grid::GridKind::yinyang,
+         "panoptes_set_patch: only a Yin-Yang grid has patches (call panoptes_set_grid_yinyang first)");
+    need(patch == 0 || patch == 1,
+         "panoptes_set_patch: patch " + std::to_string(patch) + "; expected 0 (Yin) or 1 (Yang)");
+    if (patch == s->patch) return;
+    s->other_patches[s->patch] = {s->block, s->fields};
+    panoptes_session::PatchState next = s->other_patches[patch];
+    s->other_patches.erase(patch);
+    s->block = next.block;
+    s->fields = next.fields;
+    s->patch = patch;
+  });
+}
+
+int panoptes_set_resample(panoptes_session* s, int longest_axis_points, double outside_value) {
+  return guarded(s, [&] {
+    need(s, "panoptes_set_resample: null session");
+    need(!s->session, "panoptes_set_resample: the resampling cannot change after the first snapshot");
+    need(longest_axis_points == 0 || (longest_axis_points >= 2 && longest_axis_points <= 4096),
+         "panoptes_set_resample: " + std::to_string(longest_axis_points) +
+             " points; expected 2 to 4096 along the longest axis (0 = the source's largest dimension)");
+    need(std::isfinite(outside_value), "panoptes_set_resample: the outside value is not finite");
+    s->resample = {longest_axis_points, float(outside_value)};
   });
 }
 

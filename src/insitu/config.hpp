@@ -86,6 +86,7 @@ struct SessionConfig {
   std::string rig = "yinyang";        ///< camera::RigSpec string
   std::array<double, 3> up{0, 0, 0};  ///< requested up vector of the rig's cameras (world); 0 = the sky
   std::string up_axis;                ///< which way is up in the domain: "z_up" / "z_down"; "" = z_up
+  std::string source_grid;            ///< set by the grid stage: the simulation's non-uniform grid (manifest domain.grid)
   /// "perspective" or "equirectangular" (360° x 180° frames; the domain outline is not drawn then).
   std::string projection = "perspective";
   double playback_fps = 0;            ///< preferred playback rate for players (0 = the video's fps)

@@ -286,6 +286,7 @@ store::Manifest Session::Impl::make_manifest() const {
   man.domain.spacing = grid.spacing;
   man.domain.units = cfg.units;
   man.domain.up_axis = cfg.up_axis;
+  man.domain.grid = cfg.source_grid;
   man.playback_fps = cfg.playback_fps;
   man.image.width = cfg.width;
   man.image.height = cfg.height;

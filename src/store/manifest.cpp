@@ -327,6 +327,7 @@ json manifest_json(const Manifest& m, const CameraTableRef* table) {
                  {"spacing", vec3_json(m.domain.spacing)},
                  {"units", m.domain.units}};
   if (!m.domain.up_axis.empty()) j["domain"]["up_axis"] = m.domain.up_axis;
+  if (!m.domain.grid.empty()) j["domain"]["grid"] = m.domain.grid;
   if (m.playback_fps > 0) j["playback_fps"] = m.playback_fps;
   if (m.frame_checks.recorded())
     j["frame_checks"] = {{"scheme", m.frame_checks.scheme}, {"database_id", m.frame_checks.database_id}};
@@ -443,6 +444,7 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
     if (const json* s = r.optional(*d, "spacing", "domain")) m.domain.spacing = r.vec3(*s, "domain.spacing");
     m.domain.units = r.opt_str(*d, "units", "domain");
     m.domain.up_axis = r.opt_str(*d, "up_axis", "domain");
+    m.domain.grid = r.opt_str(*d, "grid", "domain");
   }
   if (const json* v = r.optional(j, "playback_fps", "")) m.playback_fps = r.num(*v, "playback_fps");
   if (const json* fc = r.optional(j, "frame_checks", "")) {

@@ -58,6 +58,10 @@ struct Domain {
   /// Which way is up (towards the sky): "z_up", "z_down" (z is depth, as in seismology), or empty for
   /// databases written before it was recorded, which the player treats as z_up.
   std::string up_axis;
+  /// The simulation's own grid when it is not the uniform one the images were rendered from (issue 33:
+  /// resampled by the grid stage), as grid::GridDescription::summary() gives it, e.g.
+  /// "spherical 24x64x128, r in [0.35, 1]"; its first word is the kind. Empty = the uniform grid above.
+  std::string grid;
   bool operator==(const Domain&) const = default;
   /// Unit vector towards the sky: (0, 0, −1) for "z_down", else (0, 0, 1).
   Vec3 sky() const { return up_axis == "z_down" ? Vec3{0, 0, -1} : Vec3{0, 0, 1}; }
