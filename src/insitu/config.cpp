@@ -257,7 +257,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
       }
   }
   if (const auto* im = table(c, root, "image")) {
-    only_keys(c, *im, "image", {"width", "height", "background", "outline"});
+    only_keys(c, *im, "image", {"width", "height", "background", "outline", "compass"});
     s.width = int_in(c, *im, "width", "image.", s.width, INT_MIN, INT_MAX);
     s.height = int_in(c, *im, "height", "image.", s.height, INT_MIN, INT_MAX);
     if (s.width < 2 || s.height < 2 || s.width > kMaxImageSide || s.height > kMaxImageSide)
@@ -265,6 +265,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
                                        " pixels; expected 2.." + std::to_string(kMaxImageSide) + " each");
     if (const auto* bg = im->get("background")) s.background = colour(c, *bg, "image.background");
     s.outline = boolean(c, *im, "outline", "image.", true);
+    s.compass = boolean(c, *im, "compass", "image.", true);
   }
   if (const auto* r = table(c, root, "rig")) {
     only_keys(c, *r, "rig", {"spec", "up", "up_axis", "projection"});
@@ -409,7 +410,8 @@ const char* config_keys_help() {
             the restarted run (time <= the last written time) are skipped, the movies go on; rig, tasks,
             grid, image and video settings must be the ones it was written with);
             overwrite = true | false is the old spelling of mode = "overwrite" | "create"
-[image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box)
+[image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box);
+            compass = true (360-degree frames: horizon, a tick every 45 degrees, N/E/S/W)
 [rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,
             optional @R1,R2,... shell radii in bounding-sphere radii; default 130 Yin-Yang cameras at 3 R);
             up_axis = "z_up" | "z_down" (which way is the sky: poles, latitudes, the cameras' up and the
@@ -418,7 +420,7 @@ const char* config_keys_help() {
             spec = "lattice:NXxNYxNZ[@MARGIN]" | "path:FILE" put the cameras inside the volume (lattice nodes
             at cell centres of the domain shrunk by MARGIN at each face; world-axis navigation);
             projection = "perspective" | "equirectangular" (360 x 180 degree frames, e.g. 1920 x 960, for
-            looking around in the player; the domain outline is not drawn)
+            looking around in the player; the domain outline is drawn as arcs)
 [schedule]  every_steps = 10 | every_time = DT (exactly one); max_snapshots = 0 (unlimited)
 [video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4);
             playback_fps = 0 (the player's preferred rate; 0 = fps)

@@ -87,7 +87,7 @@ struct SessionConfig {
   std::array<double, 3> up{0, 0, 0};  ///< requested up vector of the rig's cameras (world); 0 = the sky
   std::string up_axis;                ///< which way is up in the domain: "z_up" / "z_down"; "" = z_up
   std::string source_grid;            ///< set by the grid stage: the simulation's non-uniform grid (manifest domain.grid)
-  /// "perspective" or "equirectangular" (360° x 180° frames; the domain outline is not drawn then).
+  /// "perspective" or "equirectangular" (360° x 180° frames; the domain outline is drawn as arcs).
   std::string projection = "perspective";
   double playback_fps = 0;            ///< preferred playback rate for players (0 = the video's fps)
   int width = 920, height = 896;
@@ -97,6 +97,7 @@ struct SessionConfig {
   render::RenderOptions render;
   std::array<float, 3> background{0, 0, 0};
   bool outline = true;
+  bool compass = true;                ///< 360° frames: horizon, ticks and N/E/S/W (render::OutlineStyle)
   double percentile = 0.999;          ///< quantile of |v| used as reference of relative windows
   /// Reference of relative windows: this snapshot's quantile (false), or its running maximum over
   /// snapshots (true: colours comparable across frames, but decaying waves fade out).

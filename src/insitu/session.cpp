@@ -17,6 +17,7 @@
 #include <omp.h>
 
 #include "camera/navigation.hpp"
+#include "camera/orientation.hpp"
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
@@ -456,8 +457,11 @@ void Session::Impl::render_snapshot(int frame) {
   const bool brick = me().has_brick;
   const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
   render::OutlineStyle outline;
-  // Straight box edges are curves in a 360° frame: finish_image draws straight segments, so no outline.
-  outline.enabled = cfg.outline && cfg.projection == "perspective";
+  // In a 360° frame the box edges are arcs, and the horizon and compass show where to turn (issue 32).
+  outline.enabled = cfg.outline || (cfg.compass && cfg.projection == "equirectangular");
+  outline.box = cfg.outline;
+  outline.compass = cfg.compass;
+  outline.sky = camera::SkyFrame::of(cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis));
   for (int r0 = 0; r0 < C; r0 += size) {
     // Render every camera of this round, sending each partial set to its owner at once.
 #ifdef PANOPTES_HAVE_MPI

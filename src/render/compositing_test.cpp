@@ -580,3 +580,76 @@ TEST(Compositing, FinishImageKeepsTheOutlineOnlyForTheSameCameraDomainAndWidth) 
     }
   }
 }
+
+// A camera inside the domain with a 360° frame (issue 32): all twelve box edges are drawn as the arcs
+// they project to, also across the frame's left/right seam; the compass adds the horizon of its sky
+// frame, ticks and N/E/S/W letters above the cardinal directions and nothing far from the horizon; a
+// perspective frame is unchanged by it.
+TEST(Compositing, EquirectangularFramesShowTheBoxAsArcsAndACompass) {
+  const GridGeometry g{{21, 17, 13}, {-10, -8, -6}, {1, 1, 1}};  // the box [-10, 10] x [-8, 8] x [-6, 6]
+  const camera::SkyFrame ned = camera::SkyFrame::of(camera::UpAxis::z_down);  // north +x, east +y, sky -z
+  const int w = 360, h = 180;                                                  // 1 pixel per degree
+  const Vec3 eye{2, 1, 0.5};
+  const camera::Camera cam(eye, eye + ned.north, ned.sky, 90, w, h, camera::Projection::equirectangular);
+  PartialImage p;
+  p.reset(w, h, {0, 0, 0, 0});
+  OutlineStyle box_only, with_compass, compass_only;
+  box_only.compass = false;
+  with_compass.sky = compass_only.sky = ned;
+  compass_only.box = false;
+  const Image a = finish_image(p, cam, g, {0, 0, 0}, box_only), b = finish_image(p, cam, g, {0, 0, 0}, with_compass);
+  const Image c = finish_image(p, cam, g, {0, 0, 0}, compass_only);
+  auto lit_near = [&](const Image& img, double px, double py, int r) {
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const int x = ((int(std::floor(px)) + dx) % w + w) % w, y = int(std::floor(py)) + dy;
+        if (y >= 0 && y < h && img.at(x, y)[0] > 0) return true;
+      }
+    return false;
+  };
+  const Vec3 lo = g.domain_lo(), hi = g.domain_hi();
+  for (int e = 0; e < 12; ++e) {
+    const int ax = e / 4, b1 = (ax + 1) % 3, b2 = (ax + 2) % 3;
+    Vec3 s = lo, t = lo;
+    s[b1] = t[b1] = (e & 1) ? hi[b1] : lo[b1];
+    s[b2] = t[b2] = (e & 2) ? hi[b2] : lo[b2];
+    t[ax] = hi[ax];
+    for (const double f : {0.0, 0.2, 0.5, 0.8, 1.0}) {
+      double px, py;
+      ASSERT_TRUE(cam.project(s + (t - s) * f, px, py));
+      EXPECT_TRUE(lit_near(a, px, py, 1)) << "edge " << e << " at " << f << ": pixel " << px << ", " << py;
+      EXPECT_FALSE(lit_near(c, px, py, 0) && std::abs(py - h / 2) > 12) << "box edge drawn with box = false";
+    }
+  }
+  // The edge x = −10 (south), z = 0.5 ± ... crosses the seam behind the camera: both sides of the frame show it.
+  double sx, sy;
+  ASSERT_TRUE(cam.project({-10, 1, -6}, sx, sy));
+  EXPECT_TRUE(a.at(0, int(sy))[0] > 0 || a.at(0, int(sy) + 1)[0] > 0 || a.at(0, int(sy) - 1)[0] > 0);
+  EXPECT_TRUE(a.at(w - 1, int(sy))[0] > 0 || a.at(w - 1, int(sy) + 1)[0] > 0 || a.at(w - 1, int(sy) - 1)[0] > 0);
+  // The compass's pixels: within 12 degrees above and 4 below the horizon (row 90), on it in almost
+  // every column, and letters above north (column 180), east (270), south (0) and west (90).
+  int horizon_columns = 0;
+  for (int x = 0; x < w; ++x) horizon_columns += c.at(x, 89)[0] > 0 || c.at(x, 90)[0] > 0;
+  EXPECT_GE(horizon_columns, w - 2);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (c.at(x, y)[0] > 0) {
+        ASSERT_TRUE(y >= 90 - 12 && y <= 90 + 4) << "compass pixel at " << x << ", " << y;
+      }
+  for (const int col : {180, 270, 0, 90}) {
+    int letter = 0;
+    for (int y = 90 - 11; y <= 90 - 4; ++y)
+      for (int dx = -3; dx <= 3; ++dx) letter += c.at((col + dx + w) % w, y)[0] > 0;
+    EXPECT_GE(letter, 10) << "no letter above column " << col;
+  }
+  int between = 0;  // above the horizon half-way between two letters: only the 45-degree tick or nothing
+  for (int y = 90 - 11; y <= 90 - 4; ++y) between += c.at(180 + 22, y)[0] > 0;
+  EXPECT_EQ(between, 0);
+  // With the box too, every box pixel is still there (the compass only adds coverage).
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) ASSERT_GE(b.pixels[i], a.pixels[i]) << "pixel byte " << i;
+  // Perspective frames have no compass.
+  const camera::Camera persp(eye, eye + ned.north, ned.sky, 60, 96, 64);
+  PartialImage q;
+  q.reset(96, 64, {0, 0, 0, 0});
+  EXPECT_EQ(finish_image(q, persp, g, {0, 0, 0}, box_only).pixels, finish_image(q, persp, g, {0, 0, 0}, with_compass).pixels);
+}

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <numeric>
 
 #if defined(__AVX2__) && defined(__FMA__)
@@ -154,6 +155,8 @@ struct OutlineCoverage {
     double fov = 0, width = 0;
     int w = 0, h = 0;
     camera::Projection projection = camera::Projection::perspective;
+    bool box = true, compass = false;  // the compass: equirectangular frames only
+    Vec3 north, east, sky;    // the compass's frame (zero without one)
     bool operator==(const Key&) const = default;
   };
   std::vector<float> front, back;                  // w×h coverage in [0, 1], zero where untouched
@@ -176,7 +179,7 @@ struct OutlineCoverage {
 // Anti-aliased segment coverage into a w×h float buffer (max of coverages); records every pixel the
 // buffer turns non-zero in `touched` (each at most once per buffer).
 void draw_segment(std::vector<float>& buf, std::vector<std::uint32_t>& touched, int w, int h, double ax, double ay,
-                  double bx, double by, double width) {
+                  double bx, double by, double width, float strength = 1.0f) {
   const double half = 0.5 * width;
   const double x0 = std::min(ax, bx) - half - 1, x1 = std::max(ax, bx) + half + 1;
   const double y0 = std::min(ay, by) - half - 1, y1 = std::max(ay, by) + half + 1;
@@ -197,7 +200,7 @@ void draw_segment(std::vector<float>& buf, std::vector<std::uint32_t>& touched, 
       double t = len2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / len2 : 0;
       t = std::clamp(t, 0.0, 1.0);
       const double ex = px - (ax + t * dx), ey = py - (ay + t * dy);
-      const double cov = std::clamp(half + 0.5 - std::sqrt(ex * ex + ey * ey), 0.0, 1.0);
+      const double cov = strength * std::clamp(half + 0.5 - std::sqrt(ex * ex + ey * ey), 0.0, 1.0);
       const std::size_t i = std::size_t(steep ? m : n) * w + (steep ? n : m);
       float& b = buf[i];
       if (b == 0.0f && float(cov) > 0.0f) touched.push_back(std::uint32_t(i));
@@ -216,16 +219,99 @@ bool project_segment(const camera::Camera& cam, Vec3 a, Vec3 b, double& ax, doub
   return cam.project(a, ax, ay) && cam.project(b, bx, by);
 }
 
+// The segment a–b of world space in an equirectangular frame: the arc of the great circle through the
+// camera it projects to. Halved until a piece spans at most 4 pixels (or 14 halvings: a piece through a
+// pole); a piece whose ends lie more than half the width apart crosses the left/right seam and is drawn
+// twice, once leaving each side of the frame.
+void draw_arc(std::vector<float>& buf, std::vector<std::uint32_t>& touched, const camera::Camera& cam, const Vec3& a,
+              double ax, double ay, const Vec3& b, double bx, double by, double width, float strength, int depth = 0) {
+  const int w = cam.width(), h = cam.height();
+  double dx = bx - ax;
+  const bool wraps = std::abs(dx) > 0.5 * w;
+  if (wraps) dx -= std::copysign(double(w), dx);
+  if (depth >= 14 || dx * dx + (by - ay) * (by - ay) <= 16) {
+    if (!wraps) {
+      draw_segment(buf, touched, w, h, ax, ay, bx, by, width, strength);
+    } else {
+      draw_segment(buf, touched, w, h, ax, ay, ax + dx, by, width, strength);
+      draw_segment(buf, touched, w, h, bx - dx, ay, bx, by, width, strength);
+    }
+    return;
+  }
+  const Vec3 m = (a + b) * 0.5;
+  double mx, my;
+  if (!cam.project(m, mx, my)) return;  // the camera lies on the segment: nothing to see of it
+  draw_arc(buf, touched, cam, a, ax, ay, m, mx, my, width, strength, depth + 1);
+  draw_arc(buf, touched, cam, m, mx, my, b, bx, by, width, strength, depth + 1);
+}
+
+// draw_arc() of the world segment a–b.
+void draw_world_arc(std::vector<float>& buf, std::vector<std::uint32_t>& touched, const camera::Camera& cam,
+                    const Vec3& a, const Vec3& b, double width, float strength) {
+  double ax, ay, bx, by;
+  if (cam.project(a, ax, ay) && cam.project(b, bx, by))
+    draw_arc(buf, touched, cam, a, ax, ay, b, bx, by, width, strength);
+}
+
+// A 5×7 bitmap letter (rows top to bottom, bit 4 = leftmost column) centred at column cx with its bottom
+// row ending at row by, each bitmap cell `scale` pixels square; columns wrap around the 360° frame.
+void draw_glyph(std::vector<float>& buf, std::vector<std::uint32_t>& touched, int w, int h, char letter, double cx,
+                double by, int scale, float strength) {
+  static constexpr std::array<std::array<std::uint8_t, 7>, 4> kGlyphs{{
+      {0b10001, 0b11001, 0b11001, 0b10101, 0b10011, 0b10011, 0b10001},  // N
+      {0b11111, 0b10000, 0b10000, 0b11110, 0b10000, 0b10000, 0b11111},  // E
+      {0b01111, 0b10000, 0b10000, 0b01110, 0b00001, 0b00001, 0b11110},  // S
+      {0b10001, 0b10001, 0b10001, 0b10101, 0b10101, 0b10101, 0b01010},  // W
+  }};
+  const std::size_t g = letter == 'N' ? 0 : letter == 'E' ? 1 : letter == 'S' ? 2 : 3;
+  const int x0 = int(std::lround(cx - 2.5 * scale)), y0 = int(std::lround(by)) - 7 * scale;
+  for (int r = 0; r < 7 * scale; ++r) {
+    const int y = y0 + r;
+    if (y < 0 || y >= h) continue;
+    for (int c = 0; c < 5 * scale; ++c) {
+      if (!(kGlyphs[g][std::size_t(r / scale)] >> (4 - c / scale) & 1)) continue;
+      const int x = ((x0 + c) % w + w) % w;
+      const std::size_t i = std::size_t(y) * w + x;
+      if (buf[i] == 0.0f) touched.push_back(std::uint32_t(i));
+      buf[i] = std::max(buf[i], strength);
+    }
+  }
+}
+
+// The compass of an equirectangular frame into `buf`: the horizon of `sky` (eight 45° arcs, faint), a
+// tick across it every 45° (the cardinal ones longer) and N/E/S/W above the cardinal ticks. Sizes
+// follow the frame's height, so a mark covers the same angle at every resolution.
+void draw_compass(std::vector<float>& buf, std::vector<std::uint32_t>& touched, const camera::Camera& cam,
+                  const camera::SkyFrame& sky, double width) {
+  const int w = cam.width(), h = cam.height();
+  const Vec3 c = cam.position();
+  const double deg = std::numbers::pi / 180;
+  auto dir = [&](double azimuth_deg, double elevation_deg) {  // azimuth from north towards east
+    const double az = azimuth_deg * deg, el = elevation_deg * deg;
+    return (sky.north * std::cos(az) + sky.east * std::sin(az)) * std::cos(el) + sky.sky * std::sin(el);
+  };
+  for (int k = 0; k < 8; ++k) draw_world_arc(buf, touched, cam, c + dir(45.0 * k, 0), c + dir(45.0 * (k + 1), 0), width, 0.35f);
+  const int scale = std::max(1, int(std::lround(h / 240.0)));
+  for (int k = 0; k < 8; ++k) {
+    const bool cardinal = k % 2 == 0;
+    const double len = cardinal ? 2.5 : 1.2;  // degrees above and below the horizon
+    draw_world_arc(buf, touched, cam, c + dir(45.0 * k, -len), c + dir(45.0 * k, len), width, cardinal ? 0.7f : 0.5f);
+    double px, py;
+    if (!cardinal || !cam.project(c + dir(45.0 * k, len + 1.0), px, py)) continue;
+    draw_glyph(buf, touched, w, h, "NESW"[k / 2], px, py, scale, 0.8f);
+  }
+}
+
 // Redraws `cover` for the camera, the domain box lo–hi and the line width that `key` names.
 void draw_outline(const camera::Camera& cam, const Vec3& lo, const Vec3& hi, double width,
-                  const OutlineCoverage::Key& key, OutlineCoverage& cover) {
+                  const OutlineCoverage::Key& key, const camera::SkyFrame& sky, OutlineCoverage& cover) {
   const int w = cam.width(), h = cam.height();
   const Vec3 c = cam.position();
   cover.clear();
   cover.prepare(std::size_t(w) * h);
   // Face (axis a, side s) is turned towards the camera when the camera is beyond its plane.
   auto facing = [&](int a, int s) { return s ? c[a] > hi[a] : c[a] < lo[a]; };
-  for (int a = 0; a < 3; ++a) {
+  for (int a = 0; a < (key.box ? 3 : 0); ++a) {
     const int b = (a + 1) % 3, d = (a + 2) % 3;
     for (int sb = 0; sb < 2; ++sb)
       for (int sd = 0; sd < 2; ++sd) {
@@ -233,12 +319,17 @@ void draw_outline(const camera::Camera& cam, const Vec3& lo, const Vec3& hi, dou
         p[b] = q[b] = sb ? hi[b] : lo[b];
         p[d] = q[d] = sd ? hi[d] : lo[d];
         q[a] = hi[a];
+        const bool is_front = facing(b, sb) || facing(d, sd);
+        if (cam.projection() == camera::Projection::equirectangular) {
+          draw_world_arc(is_front ? cover.front : cover.back, cover.touched, cam, p, q, width, 1.0f);
+          continue;
+        }
         double ax, ay, bx, by;
         if (!project_segment(cam, p, q, ax, ay, bx, by)) continue;
-        const bool is_front = facing(b, sb) || facing(d, sd);
         draw_segment(is_front ? cover.front : cover.back, cover.touched, w, h, ax, ay, bx, by, width);
       }
   }
+  if (key.compass) draw_compass(cover.back, cover.touched, cam, sky, width);
   cover.key = key;
   cover.drawn = true;
 }
@@ -307,9 +398,12 @@ void finish_image_into(const PartialImage& comp, const camera::Camera& cam, cons
 
   thread_local OutlineCoverage cover;
   const Vec3 lo = g.domain_lo(), hi = g.domain_hi();
+  const bool compass = outline.compass && cam.projection() == camera::Projection::equirectangular;
   const OutlineCoverage::Key key{cam.position(), cam.forward(), cam.right(), cam.up(), lo, hi,
-                                 cam.fov_y_degrees(), outline.width, w, h, cam.projection()};
-  if (!cover.drawn || !(cover.key == key)) draw_outline(cam, lo, hi, outline.width, key, cover);
+                                 cam.fov_y_degrees(), outline.width, w, h, cam.projection(), outline.box, compass,
+                                 compass ? outline.sky.north : Vec3{}, compass ? outline.sky.east : Vec3{},
+                                 compass ? outline.sky.sky : Vec3{}};
+  if (!cover.drawn || !(cover.key == key)) draw_outline(cam, lo, hi, outline.width, key, outline.sky, cover);
   // The touched pixels again, with the outline behind and in front of the volume. A pixel touched
   // by both buffers is listed twice and computed twice to the same value.
   for (const std::uint32_t i : cover.touched) {

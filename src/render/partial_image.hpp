@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "camera/camera.hpp"
+#include "camera/orientation.hpp"
 #include "core/image.hpp"
 #include "render/field_view.hpp"
 #include "render/transfer_function.hpp"
@@ -83,6 +84,12 @@ struct OutlineStyle {
   bool enabled = true;
   Rgb colour{0.75f, 0.75f, 0.75f};
   float width = 1.5f;  ///< line width in pixels (anti-aliased)
+  bool box = true;     ///< the domain box's edges (false: the compass alone)
+  /// 360° (equirectangular) frames only: the horizon of `sky` (the great circle normal to its sky), a
+  /// tick every 45° of azimuth on it and N/E/S/W letters above the cardinal ones, faint and behind
+  /// the data like the box edges seen from inside (where a camera inside the domain sees them all).
+  bool compass = true;
+  camera::SkyFrame sky{};  ///< whose north, east and sky the marks follow (default: z up, north = +y)
 };
 
 /// The final RGBA8 image (alpha 255): `composited` over the background colour, with the outline of
@@ -90,7 +97,9 @@ struct OutlineStyle {
 /// surface, so an edge is either where rays ENTER the volume (an edge of a face turned towards the
 /// camera: drawn over the volume) or where they LEAVE it (both adjacent faces turned away: drawn
 /// behind the volume and attenuated by its full opacity). `composited` may cover only part of the
-/// image (its rect). Throws panoptes::Error when its size differs from the camera's.
+/// image (its rect). In an equirectangular frame the edges are the arcs they project to (wrapping at
+/// the frame's left/right seam), with the compass marks of `outline` if it asks for them.
+/// Throws panoptes::Error when its size differs from the camera's.
 Image finish_image(const PartialImage& composited, const camera::Camera& cam, const GridGeometry& grid,
                    Rgb background = {0, 0, 0}, const OutlineStyle& outline = {});
 /// finish_image() into `out`, reusing its pixels when it already has the camera's size and 4
