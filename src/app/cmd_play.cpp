@@ -72,7 +72,7 @@ void run_play(const PlayArgs& a) {
     }
     return;
   }
-  if (a.db.empty()) throw panoptes::Error("play: a database directory is required (panoptes play DB)");
+  if (a.db.empty()) throw panoptes::Error("play: db is required (a database directory); run panoptes play --help for more information");
   if (!std::filesystem::exists(std::filesystem::path(a.db) / "panoptes.json"))
     throw panoptes::FileError(a.db, std::filesystem::exists(a.db)
                                         ? "not a Panoptes database (no panoptes.json inside)"
