@@ -23,6 +23,7 @@ struct ExportArgs {
   int crf = -1;
   bool paused = false;
   std::string view_size = "1280x720";
+  double speed = 0;  // 0 = automatic (the players' short-run rule)
 };
 
 void run_export(const ExportArgs& a) {
@@ -36,6 +37,7 @@ void run_export(const ExportArgs& a) {
   o.engine.task = panoptes::app::resolve_task_option(a.db, a.task);
   o.engine.frame = a.frame;
   o.engine.start_playing = !a.paused;
+  o.speed = a.speed;  // 0: the short-run rule, as the window starts
   o.script = player::read_script(a.script);
   if (a.duration > 0) o.duration = a.duration;
   // The writer is created at the first frame, when the frame size is known; the output settings follow
@@ -91,6 +93,10 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--camera", args->camera, "Start camera id")->check(CLI::NonNegativeNumber);
   sub->add_option("--task", args->task, "Start task: its id or its name (e.g. p+s)");
   sub->add_option("--frame", args->frame, "Start frame")->check(CLI::NonNegativeNumber);
+  sub->add_option("--speed", args->speed,
+                  "Playback speed factor (0.25 .. 8) of the database's playback rate (default: x1, slowed down as "
+                  "the players do so that a run of few frames lasts at least 4 s)")
+      ->check(CLI::Range(0.25, 8.0));
   sub->add_flag("--paused", args->paused, "Start paused (the script's Space starts playback)");
   sub->add_option("--view-size", args->view_size,
                   "360-degree databases: size of the perspective view cut out of each frame (the script's look=)")

@@ -8,7 +8,10 @@
 #include "app/command.hpp"
 #include "app/task_option.hpp"
 #include "core/error.hpp"
+#include "player/controls.hpp"
 #include "player/headless.hpp"
+#include "player/keys_json.hpp"
+#include "store/database.hpp"
 #ifdef PANOPTES_HAVE_UI
 #include "ui/window_app.hpp"
 #endif
@@ -18,11 +21,12 @@ namespace {
 struct PlayArgs {
   std::string db;
   bool headless = false;
-  std::string script, frames_out, stats;
+  std::string script, frames_out, stats, trace;
+  bool keys_json = false;
   double duration = 0;
   int camera = 0, frame = 0;
   std::string task = "0";  // an index or a name
-  double speed = 0;  // 0 = automatic (window) / x1 (headless)
+  double speed = 0;  // 0 = automatic: the short-run rule (player/playback_rule.hpp)
   bool paused = false, no_loop = false;
   double cache_mb = 0;
   bool no_prefetch = false;
@@ -35,10 +39,22 @@ struct PlayArgs {
 };
 
 std::string key_table() {
+  namespace player = panoptes::player;
   std::string text = "Keys (window; the same names are used in scripts as key=NAME):\n";
-  for (const auto& b : panoptes::player::key_bindings()) {
-    char line[160];
+  for (const auto& b : player::key_bindings()) {
+    char line[200];
     std::snprintf(line, sizeof line, "  %-13s %s\n", std::string(b.key).c_str(), std::string(b.description).c_str());
+    text += line;
+  }
+  text += "In 360-degree databases (panorama, lattice) + / - / 0 change the field of view; inside a lattice or\n"
+          "along a path the keys act as follows:\n";
+  for (const auto& b : player::key_bindings()) {
+    const auto mode = player::ViewMode::lattice;
+    if (player::operation(b.action, mode) == player::operation(b.action, player::ViewMode::panorama)) continue;
+    char line[200];
+    const std::string_view d = player::description(b, mode);
+    std::snprintf(line, sizeof line, "  %-13s %s\n", std::string(b.key).c_str(),
+                  d.empty() ? "nothing" : std::string(d).c_str());
     text += line;
   }
   return text;
@@ -46,6 +62,17 @@ std::string key_table() {
 
 void run_play(const PlayArgs& a) {
   namespace player = panoptes::player;
+  if (a.keys_json) {
+    // The key table as the browser receives it (docs/web.md); with a database, its view mode too.
+    if (a.db.empty()) {
+      std::printf("%s\n", player::keys_json().dump(2).c_str());
+    } else {
+      const auto db = panoptes::store::Database::open(a.db);
+      std::printf("%s\n", player::keys_json(&db.manifest()).dump(2).c_str());
+    }
+    return;
+  }
+  if (a.db.empty()) throw panoptes::Error("play: db is required (a database directory); run panoptes play --help for more information");
   if (!std::filesystem::exists(std::filesystem::path(a.db) / "panoptes.json"))
     throw panoptes::FileError(a.db, std::filesystem::exists(a.db)
                                         ? "not a Panoptes database (no panoptes.json inside)"
@@ -65,13 +92,8 @@ void run_play(const PlayArgs& a) {
     if (a.duration > 0) o.duration = a.duration;
     if (!a.frames_out.empty()) o.frames_out = a.frames_out;
     if (!a.stats.empty()) o.stats_out = a.stats;
-    // The speed option is a script command at t=0 so the run stays one code path.
-    if (a.speed > 0 && a.speed != 1) {
-      player::ScriptCommand c;
-      c.kind = player::ScriptCommand::Kind::speed;
-      c.speed = a.speed;
-      o.script.insert(o.script.begin(), c);
-    }
+    if (!a.trace.empty()) o.trace_out = a.trace;
+    o.speed = a.speed;  // 0: the short-run rule, as the window starts
     const auto r = player::run_headless(a.db, o);
     const auto lat = [&] {
       std::vector<double> v;
@@ -99,6 +121,7 @@ void run_play(const PlayArgs& a) {
   w.loop = !a.no_loop;
   w.cache_bytes = std::size_t(a.cache_mb * 1024 * 1024);
   w.script = a.script;
+  w.trace = a.trace;
   w.max_frames = a.max_frames;
   w.screenshot_on_exit = a.screenshot_on_exit;
   w.output_dir = a.output_dir;
@@ -119,9 +142,16 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       "timed key presses without a window (--headless)");
   sub->footer(key_table() +
               "\nScript lines (headless and --script): `t=SECONDS key=NAME`, `t=S seek=FRAME`, `t=S camera=ID`,\n"
-              "`t=S task=ID|NAME`, `t=S axis=NAME:DELTA`, `t=S snap=X,Y,Z`, `t=S speed=F`, `t=S play|pause|end`;\n"
+              "`t=S task=ID|NAME`, `t=S axis=NAME:DELTA`, `t=S snap=X,Y,Z`, `t=S look=YAW,PITCH,FOV`, `t=S walk=DIR`,\n"
+              "`t=S speed=F`, `t=S play|pause|end`;\n"
               "'#' starts a comment. See docs/player.md.");
-  sub->add_option("db", args->db, "Database directory (holds panoptes.json)")->required();
+  sub->add_option("db", args->db, "Database directory (holds panoptes.json)");
+  sub->add_flag("--keys-json", args->keys_json,
+                "Print the key table as JSON (the document the web player reads, docs/web.md) and exit; with DB "
+                "also the database's view mode");
+  sub->add_option("--trace", args->trace,
+                  "With --script: write the camera, task, frame and look after each script command as JSON lines "
+                  "(window and headless; docs/web.md)");
   sub->add_flag("--headless", args->headless, "Run without a window: play the script on a virtual clock");
   sub->add_option("--script", args->script, "Script of timed commands (headless; in the window: injected keys)")
       ->check(CLI::ExistingFile);
@@ -135,8 +165,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--task", args->task, "Start task: its id or its name (e.g. p+s)");
   sub->add_option("--frame", args->frame, "Start frame")->check(CLI::NonNegativeNumber);
   sub->add_option("--speed", args->speed,
-                  "Playback speed factor (0.25 .. 8) of the database's playback rate (default: x1, in the window "
-                  "slowed down so that a run of few frames lasts at least 4 s)")
+                  "Playback speed factor (0.25 .. 8) of the database's playback rate (default: x1, slowed down "
+                  "so that a run of few frames lasts at least 4 s, as in every front end)")
       ->check(CLI::Range(0.25, 8.0));
   sub->add_flag("--paused", args->paused, "Start paused");
   sub->add_flag("--no-loop", args->no_loop, "Stop at the end instead of looping");

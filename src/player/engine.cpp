@@ -1,4 +1,5 @@
 #include "player/engine.hpp"
+#include "player/playback_rule.hpp"
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -24,7 +25,6 @@ double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-constexpr double kMinSpeed = 0.25, kMaxSpeed = 8.0;
 
 }  // namespace
 
@@ -640,7 +640,7 @@ void Engine::set_speed(double speed) {
   Impl& m = *impl_;
   if (!std::isfinite(speed)) return;
   m.tick();
-  m.speed_factor = std::clamp(speed, kMinSpeed, kMaxSpeed);
+  m.speed_factor = std::clamp(speed, kSpeedMin, kSpeedMax);
 }
 bool Engine::loop() const { return impl_->looping; }
 void Engine::set_loop(bool loop) { impl_->looping = loop; }
@@ -662,19 +662,19 @@ bool Engine::apply(Action action) {
     case Action::toggle_loop: set_loop(!m.looping); return true;
     case Action::faster: {
       const double before = m.speed_factor;
-      set_speed(m.speed_factor * 2);
+      set_speed(m.speed_factor * kFasterFactor);
       return m.speed_factor != before;
     }
     case Action::slower: {
       const double before = m.speed_factor;
-      set_speed(m.speed_factor / 2);
+      set_speed(m.speed_factor / kFasterFactor);
       return m.speed_factor != before;
     }
     case Action::speed_up:
     case Action::speed_down:
     case Action::speed_reset: {
       const double before = m.speed_factor;
-      set_speed(action == Action::speed_reset ? 1.0 : action == Action::speed_up ? m.speed_factor * 1.1 : m.speed_factor / 1.1);
+      set_speed(action == Action::speed_reset ? 1.0 : action == Action::speed_up ? m.speed_factor * kFineSpeedFactor : m.speed_factor / kFineSpeedFactor);
       return m.speed_factor != before;
     }
     case Action::reverse: set_direction(-m.dir); return true;

@@ -11,6 +11,8 @@
 #include "core/error.hpp"
 #include "core/file_read.hpp"
 #include "core/png.hpp"
+#include "player/controls.hpp"
+#include "player/playback_rule.hpp"
 
 namespace panoptes::player {
 namespace {
@@ -46,6 +48,8 @@ int parse_int(const std::string& text, const std::string& where) {
 
 constexpr const char* kWalkNames[] = {"forward", "back", "left", "right", "up", "down"};
 
+}  // namespace
+
 std::string describe(const ScriptCommand& c) {
   using K = ScriptCommand::Kind;
   switch (c.kind) {
@@ -73,33 +77,6 @@ std::string describe(const ScriptCommand& c) {
   return "?";
 }
 
-// Applies one command; false if it could not apply (no such edge, unknown task name, ...).
-bool apply(Engine& engine, const ScriptCommand& c, Look& look) {
-  using K = ScriptCommand::Kind;
-  switch (c.kind) {
-    case K::look: look = clamped(c.look); return true;
-    case K::walk: return walk_keeping_view(engine, look, c.walk);
-    case K::key: return engine.apply(c.action);
-    case K::seek: engine.seek(c.value); return c.value >= 0 && c.value < engine.frame_count();
-    case K::camera: return engine.jump_to_camera(c.value);
-    case K::task: {
-      const int t = c.value >= 0 ? c.value : engine.manifest().find_task(c.name);
-      return t >= 0 && engine.set_task(t);
-    }
-    case K::axis: {
-      const int a = engine.manifest().find_axis(c.name);
-      return a >= 0 && engine.step_axis(a, c.value);
-    }
-    case K::snap: return engine.snap_to_direction(c.direction);
-    case K::speed: engine.set_speed(c.speed); return true;
-    case K::play: engine.set_playing(true); return true;
-    case K::pause: engine.set_playing(false); return true;
-    case K::end: return true;
-  }
-  return false;
-}
-
-}  // namespace
 
 std::vector<ScriptCommand> parse_script(const std::string& text, const std::string& source) {
   std::vector<ScriptCommand> out;
@@ -251,6 +228,8 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
   Engine engine(dir, eo);
   check_script(options.script, engine.manifest());
   const double fps = engine.fps();
+  engine.set_speed(options.speed > 0 ? options.speed
+                                     : starting_speed(engine.frame_count(), fps, engine.manifest().playback_fps));
 
   double duration = 0;
   if (options.duration) {
@@ -276,7 +255,10 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
   }
 
   HeadlessResult result;
-  Look look = clamped(options.look);
+  Controls controls(engine, options.look);
+  std::optional<TraceWriter> trace;
+  if (options.trace_out) trace.emplace(*options.trace_out);
+  int step = 0;
   nlohmann::json displayed = nlohmann::json::array(), commands = nlohmann::json::array();
   std::size_t next_command = 0;
   for (long k = 0; k < ticks; ++k) {
@@ -290,7 +272,12 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
     while (next_command < options.script.size() && options.script[next_command].t <= t + 1e-9) {
       const ScriptCommand& c = options.script[next_command++];
       if (c.kind == ScriptCommand::Kind::end) ended = true;
-      const bool applied = apply(engine, c, look);
+      const bool applied = controls.run(c);
+      if (c.kind != ScriptCommand::Kind::end) {
+        const TraceStep ts{step++, c.line, describe(c), engine.selection(), controls.look()};
+        if (trace) trace->write(ts);
+        result.trace.push_back(ts);
+      }
       commands.push_back({{"t", c.t}, {"line", c.line}, {"command", describe(c)}, {"applied", applied}, {"tick", k}});
     }
     if (ended) break;
@@ -298,15 +285,15 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
     df.index = int(k);
     df.t = t;
     df.shown = engine.current_frame();
-    df.look = look;
+    df.look = controls.look();
     const auto& s = df.shown.selection;
     result.shown.push_back(s);
-    result.looks.push_back(look);
+    result.looks.push_back(df.look);
     ++result.frames_displayed;
     if (df.shown.status != FrameStatus::ok) ++result.placeholders;
     displayed.push_back({{"index", k}, {"t", t}, {"camera", s.camera}, {"task", s.task}, {"frame", s.frame},
                          {"status", std::string(to_string(df.shown.status))}, {"cache_hit", df.shown.cache_hit},
-                         {"look", {look.yaw_deg, look.pitch_deg, look.fov_deg}}});
+                         {"look", {df.look.yaw_deg, df.look.pitch_deg, df.look.fov_deg}}});
     if (options.frames_out) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%06ld.png", k);

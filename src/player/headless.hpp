@@ -29,6 +29,7 @@
 #include "player/engine.hpp"
 #include "player/keys.hpp"
 #include "player/look.hpp"
+#include "player/trace.hpp"
 
 namespace panoptes::player {
 
@@ -50,6 +51,9 @@ struct ScriptCommand {
   Walk walk = Walk::forward;     ///< kind == walk
   int line = 0;                  ///< 1-based line number in the script
 };
+
+/// The command as a script line would write it (without the time), e.g. "key=Up", "walk=forward".
+std::string describe(const ScriptCommand& command);
 
 /// Checks a parsed script against a database: camera ids, task ids and names, axis names and seek
 /// frames must exist (a typo must not be silently ignored). Throws Error naming the line, the value and
@@ -86,6 +90,10 @@ struct HeadlessOptions {
   /// the prefetch threads one frame period of time (makes cache hits on switches reproducible).
   bool wait_prefetch_each_tick = true;
   Look look;  ///< initial view (look= commands change it)
+  /// Starting playback speed; 0 = the short-run rule every front end uses (starting_speed()).
+  double speed = 1;
+  /// Writes the trace (the state after each script command, trace.hpp) as JSON lines if set.
+  std::optional<std::filesystem::path> trace_out;
 };
 
 /// Summary of a headless run.
@@ -95,11 +103,12 @@ struct HeadlessResult {
   Statistics statistics;
   std::vector<Selection> shown;  ///< selection of every displayed frame, in order
   std::vector<Look> looks;       ///< the view of every displayed frame, in order
+  std::vector<TraceStep> trace;  ///< the state after every script command but `end`, in order
 };
 
 /// Runs a script through an Engine over the database in dir. Display ticks are at t = k / fps
 /// (k = 0, 1, ...); at tick k the playback clock advances to t, then every command with time ≤ t
-/// is applied in order, then the frame is taken (so `t=1 seek=10` shows frame 10 at t = 1). Throws FileError/Error for a bad database or an unwritable output.
+/// is applied in order through Controls (the key dispatch every front end shares), then the frame is taken (so `t=1 seek=10` shows frame 10 at t = 1). Throws FileError/Error for a bad database or an unwritable output.
 HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOptions& options);
 
 }  // namespace panoptes::player

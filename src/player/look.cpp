@@ -13,8 +13,8 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 }
 
 Look clamped(Look l) {
-  l.pitch_deg = std::clamp(l.pitch_deg, -89.0, 89.0);
-  l.fov_deg = std::clamp(l.fov_deg, 20.0, 120.0);
+  l.pitch_deg = std::clamp(l.pitch_deg, -kPitchMaxDeg, kPitchMaxDeg);
+  l.fov_deg = std::clamp(l.fov_deg, kFovMinDeg, kFovMaxDeg);
   l.yaw_deg = std::remainder(l.yaw_deg, 360.0);
   if (l.yaw_deg == -180.0) l.yaw_deg = 180.0;
   return l;
@@ -95,7 +95,7 @@ int walk_target(const store::Manifest& m, int camera, const Look& look, Walk wal
   }
   const store::Neighbours& n = m.graph.neighbours[std::size_t(camera)];
   int best = -1;
-  double best_cos = 0.5;  // cos 60°: never walk sideways when nothing lies ahead
+  double best_cos = kWalkMinCos;  // never walk sideways when nothing lies ahead
   for (int id : {n.left, n.right, n.up, n.down, n.in, n.out}) {
     if (id < 0 || id >= m.camera_count() || id == camera) continue;
     const Vec3 step = m.cameras[std::size_t(id)].position - here.position;

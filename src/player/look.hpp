@@ -20,6 +20,8 @@ struct Look {
   double yaw_deg = 0, pitch_deg = 0, fov_deg = 90;
   bool operator==(const Look&) const = default;
 };
+/// Range of the look (also published to the browser in keys.json).
+inline constexpr double kPitchMaxDeg = 89, kFovMinDeg = 20, kFovMaxDeg = 120;
 /// Range of the look: pitch within ±89°, field of view 20°..120°, yaw wrapped into (−180°, 180°].
 Look clamped(Look look);
 
@@ -45,6 +47,8 @@ std::array<int, 3> lattice_node(const std::array<int, 3>& shape, int camera);
 /// Walking moves relative to the view: forward/back along the view direction, left/right along its
 /// right vector, up/down along the camera's up (the sky for lattice cameras).
 enum class Walk { forward, back, left, right, up, down };
+/// A walk goes only to a neighbour whose direction is within 60° of the walk's (cos 60° = 0.5).
+inline constexpr double kWalkMinCos = 0.5;
 /// The neighbour of `camera` in the navigation graph (any of its six slots) whose displacement is best
 /// aligned with the walk's world direction (angle below 60°), or −1. Lattice graphs have their
 /// neighbours on the world axes, so facing roughly along an axis walks along it.

@@ -10,7 +10,9 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "player/controls.hpp"
 #include "player/engine.hpp"
+#include "player/keys.hpp"
 #include "store/database.hpp"
 #include "python/bindings.hpp"
 #include "python/frame_array.hpp"
@@ -57,9 +59,26 @@ class PyPlayer {
     o.cache_bytes = cache_mb << 20;
     o.time_source = clock_->source();
     engine_ = std::make_unique<player::Engine>(dir, o);
+    controls_ = std::make_unique<player::Controls>(*engine_);
   }
 
   player::Engine& engine() { return *engine_; }
+  player::Controls& controls() { return *controls_; }
+
+  /// A key of the players' key table ("Up", "Shift+Tab", "3"), dispatched as the window and headless
+  /// runs do (walks inside lattices, field of view in 360° streams). True when it changed something.
+  bool key(const std::string& name) {
+    const auto action = player::action_for_key(name);
+    if (!action) throw Error("key: unknown key \"" + name + "\" (the names of `panoptes play --help`)");
+    return controls_->apply(*action) == player::Controls::Result::done;
+  }
+
+  bool walk(const std::string& direction) {
+    static const char* names[] = {"forward", "back", "left", "right", "up", "down"};
+    for (int i = 0; i < 6; ++i)
+      if (direction == names[i]) return controls_->walk(player::Walk(i));
+    throw Error("walk: direction \"" + direction + "\"; expected forward, back, left, right, up or down");
+  }
 
   py::dict selection() const {
     const player::Selection s = engine_->selection();
@@ -113,6 +132,7 @@ class PyPlayer {
  private:
   std::unique_ptr<player::VirtualClock> clock_;  // outlives the engine, which reads it
   std::unique_ptr<player::Engine> engine_;
+  std::unique_ptr<player::Controls> controls_;  // after engine_: destroyed before it
 };
 
 }  // namespace
@@ -150,6 +170,15 @@ void bind_player(py::module_& m) {
       .def("snap_to_direction", [](PyPlayer& p, std::array<double, 3> d) {
              return p.engine().snap_to_direction({d[0], d[1], d[2]});
            }, py::arg("direction"))
+      .def("key", &PyPlayer::key, py::arg("name"))
+      .def("walk", &PyPlayer::walk, py::arg("direction"))
+      .def_property_readonly("mode", [](PyPlayer& p) { return std::string(player::to_string(p.controls().mode())); })
+      .def_property("look",
+                    [](PyPlayer& p) {
+                      const auto& l = p.controls().look();
+                      return py::make_tuple(l.yaw_deg, l.pitch_deg, l.fov_deg);
+                    },
+                    [](PyPlayer& p, std::array<double, 3> l) { p.controls().set_look({l[0], l[1], l[2]}); })
       .def("shown", &PyPlayer::shown)
       .def("statistics_json", [](PyPlayer& p) { return player::to_json(p.engine().statistics()).dump(); });
 }

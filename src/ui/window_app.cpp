@@ -22,7 +22,10 @@
 #include "core/error.hpp"
 #include "core/png.hpp"
 #include "player/engine.hpp"
+#include "player/controls.hpp"
 #include "player/headless.hpp"
+#include "player/playback_rule.hpp"
+#include "player/trace.hpp"
 #include "ui/drag_rotation.hpp"
 #include "ui/look_mesh.hpp"
 #include "ui/hud.hpp"
@@ -192,15 +195,16 @@ class WindowApp {
         options_(options),
         script_(std::move(script)),
         vclock_(vclock),
+        controls_(engine),
+        look_(controls_.mutable_look()),
         texture_(window.renderer()),
         hud_(engine.manifest()) {
     hud_.show_panel = options.show_hud;
     for (const auto& c : engine.manifest().cameras) shell_count_ = std::max(shell_count_, c.labels.shell + 1);
     hud_.show_help = options.show_help;
-    equirect_ = player::is_equirectangular(engine.manifest());
+    equirect_ = controls_.is_360();
     lattice_ = player::lattice_shape(engine.manifest());
-    const auto& params = engine.manifest().rig.parameters;
-    walkable_ = equirect_ && (lattice_[0] > 0 || (params.contains("path") && params["path"] == true));
+    if (!options.trace.empty()) trace_.emplace(options.trace);
   }
 
   WindowResult run();
@@ -225,19 +229,23 @@ class WindowApp {
   std::vector<player::ScriptCommand> script_;
   std::size_t next_command_ = 0;
   player::VirtualClock& vclock_;
+  player::Controls controls_;
+  player::Look& look_;  // controls_'s look: the drag and the wheel turn it
   YuvTexture texture_;
   Hud hud_;
   ViewTransform view_;
   DragRotation drag_;
   Recorder recorder_;
   int shell_count_ = 1;
-  // Look-around in 360° streams (issue 14): the view, and the mesh that draws it on the GPU.
-  bool equirect_ = false, walkable_ = false;
+  // Look-around in 360° streams (issue 14): the view (kept by the shared key dispatch, which walks and
+  // changes the field of view as every front end does), and the mesh that draws it on the GPU.
+  bool equirect_ = false;
   std::array<int, 3> lattice_{0, 0, 0};
-  player::Look look_;
+  std::optional<player::TraceWriter> trace_;
+  int trace_step_ = 0;
+  void write_trace(const player::ScriptCommand& c);
   std::vector<MeshVertex> mesh_;
   std::vector<SDL_Vertex> sdl_mesh_;
-  bool walk(player::Walk w);
 
   double t0_ = wall_seconds();
   bool quit_ = false;
@@ -262,33 +270,37 @@ class WindowApp {
 void WindowApp::run_due_script_commands() {
   using Kind = player::ScriptCommand::Kind;
   const double t = now();
+  // As headless runs do: the clock's frame first, then the commands due, each traced after its effect.
+  if (next_command_ < script_.size() && script_[next_command_].t <= t) engine_.tick();
   while (next_command_ < script_.size() && script_[next_command_].t <= t) {
     const auto& c = script_[next_command_++];
-    switch (c.kind) {
-      case Kind::key:
-        // Through SDL's queue, so a scripted key takes exactly the path of a typed one.
-        if (auto e = key_event_for_name(c.key)) {
-          SDL_Event ev = *e;
-          ev.key.windowID = SDL_GetWindowID(window_.window());
-          ev.key.timestamp = SDL_GetTicks();
-          SDL_PushEvent(&ev);
-        } else {
-          do_action(c.action);  // a key name SDL has no key for: apply its action directly
-        }
-        break;
-      case Kind::seek: engine_.seek(c.value); break;
-      case Kind::camera: engine_.jump_to_camera(c.value); break;
-      case Kind::task: engine_.set_task(c.value >= 0 ? c.value : engine_.manifest().find_task(c.name)); break;
-      case Kind::axis: engine_.step_axis(engine_.manifest().find_axis(c.name), c.value); break;
-      case Kind::snap: engine_.snap_to_direction(c.direction); break;
-      case Kind::speed: engine_.set_speed(c.speed); break;
-      case Kind::play: engine_.set_playing(true); break;
-      case Kind::pause: engine_.set_playing(false); break;
-      case Kind::end: quit_ = true; break;
-      case Kind::look: look_ = player::clamped(c.look); break;
-      case Kind::walk: walk(c.walk); break;
+    if (c.kind == Kind::end) {
+      quit_ = true;
+      continue;
     }
+    if (c.kind == Kind::key) {
+      // Through SDL's queue, so a scripted key takes exactly the path of a typed one; handled at once so
+      // the next command sees its effect.
+      if (auto e = key_event_for_name(c.key)) {
+        SDL_Event ev = *e;
+        ev.key.windowID = SDL_GetWindowID(window_.window());
+        ev.key.timestamp = SDL_GetTicks();
+        SDL_PushEvent(&ev);
+        SDL_Event q;
+        while (SDL_PollEvent(&q)) handle_event(q);
+      } else {
+        do_action(c.action);  // a key name SDL has no key for: apply its action directly
+      }
+    } else if (!controls_.run(c) && c.kind == Kind::walk) {
+      hud_.notify("no camera that way");
+    }
+    write_trace(c);
   }
+}
+
+void WindowApp::write_trace(const player::ScriptCommand& c) {
+  if (!trace_) return;
+  trace_->write({trace_step_++, c.line, player::describe(c), engine_.selection(), controls_.look()});
 }
 
 void WindowApp::zoom_by(double factor) {
@@ -302,30 +314,26 @@ void WindowApp::zoom_by(double factor) {
     view_.zoom_at(factor, out_w_ / 2.0, out_h_ / 2.0);
 }
 
-bool WindowApp::walk(player::Walk w) {
-  if (player::walk_keeping_view(engine_, look_, w)) return true;
-  hud_.notify("no camera that way");
-  return false;
-}
-
 void WindowApp::do_action(player::Action action) {
   using player::Action;
-  if (walkable_) {
-    // Inside a lattice (or along a path) the arrows and PgUp/PgDn walk relative to the view.
-    switch (action) {
-      case Action::camera_up: walk(player::Walk::forward); return;
-      case Action::camera_down: walk(player::Walk::back); return;
-      case Action::camera_left: walk(player::Walk::left); return;
-      case Action::camera_right: walk(player::Walk::right); return;
-      case Action::axis_up: walk(player::Walk::up); return;
-      case Action::axis_down: walk(player::Walk::down); return;
-      default: break;
+  // One dispatch for every front end (player/controls.hpp): walks, field of view and engine commands.
+  switch (controls_.apply(action)) {
+    case player::Controls::Result::done:
+      if (action == Action::speed_up || action == Action::speed_down || action == Action::speed_reset ||
+          action == Action::faster || action == Action::slower) {
+        char text[64];
+        std::snprintf(text, sizeof text, "speed x%.2f (%.1f frames/s)", engine_.speed(), engine_.speed() * engine_.fps());
+        hud_.notify(text);
+      }
+      return;
+    case player::Controls::Result::refused: {
+      const player::Operation op = player::operation(action, controls_.mode());
+      if (op == player::Operation::engine) explain_refused(action);
+      if (player::is_walk(op)) hud_.notify("no camera that way");
+      if (op == player::Operation::none) hud_.notify("this key does nothing inside a lattice or along a path");
+      return;  // a field of view at its limit needs no words
     }
-  }
-  if (equirect_ && (action == Action::zoom_in || action == Action::zoom_out || action == Action::zoom_reset)) {
-    look_.fov_deg = action == Action::zoom_reset ? 90 : look_.fov_deg / (action == Action::zoom_in ? 1.25 : 0.8);
-    look_ = player::clamped(look_);
-    return;
+    case player::Controls::Result::front_end: break;
   }
   switch (action) {
     case Action::zoom_in: zoom_by(1.25); break;
@@ -337,17 +345,7 @@ void WindowApp::do_action(player::Action action) {
     case Action::help: hud_.show_help = !hud_.show_help; break;
     case Action::toggle_hud: hud_.show_panel = !hud_.show_panel; break;
     case Action::quit: quit_ = true; break;
-    case Action::none: break;
-    default:
-      if (!engine_.apply(action)) {
-        explain_refused(action);
-      } else if (action == Action::speed_up || action == Action::speed_down || action == Action::speed_reset ||
-                 action == Action::faster || action == Action::slower) {
-        char text[64];
-        std::snprintf(text, sizeof text, "speed x%.2f (%.1f frames/s)", engine_.speed(), engine_.speed() * engine_.fps());
-        hud_.notify(text);
-      }
-      break;
+    default: break;
   }
 }
 
@@ -712,14 +710,10 @@ WindowResult run_window(const std::filesystem::path& db, const WindowOptions& op
   if (options.virtual_time) eo.time_source = vclock.source();
   player::Engine engine(db, eo);
   player::check_script(script, engine.manifest());
-  // A database without a preferred playback rate whose whole run would flash by in under ~4 s at its
-  // video rate (e.g. 24 snapshots at 30 fps) starts slower, so the eye can follow the waves.
-  double speed = options.speed > 0 ? options.speed : 1.0;
-  if (options.speed <= 0 && engine.manifest().playback_fps <= 0 && engine.frame_count() > 1) {
-    constexpr double kShortestRun = 4.0;  // seconds
-    speed = std::clamp(engine.frame_count() / (engine.fps() * kShortestRun), 0.25, 1.0);
-  }
-  engine.set_speed(speed);
+  // The short-run rule every front end shares (player/playback_rule.hpp).
+  engine.set_speed(options.speed > 0 ? options.speed
+                                     : player::starting_speed(engine.frame_count(), engine.fps(),
+                                                              engine.manifest().playback_fps));
 
   const auto& m = engine.manifest();
   SdlWindowOptions wo;

@@ -38,6 +38,8 @@ struct WindowOptions {
   /// A script of timed key presses in the player's script format (e.g. `t=0.5 key=Right`), injected as
   /// if typed: for demos and the window test. Empty = none.
   std::filesystem::path script;
+  /// Writes the trace of the script (the state after each command, player/trace.hpp) here. Empty = none.
+  std::filesystem::path trace;
   /// Close the window by itself after this many presented frames (0 = run until the user closes it).
   int max_frames = 0;
   /// When closing, save the window's final rendered image (frame + HUD) as PNG here. Empty = none.

@@ -1,5 +1,7 @@
 #include "web/server.hpp"
 
+#include "player/keys_json.hpp"
+
 #include <httplib.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -290,6 +292,12 @@ struct Server::Impl {
       const auto d = database(true);
       o.frames_backed = frames_backed(*d);
       res.set_content(database_json(*d, o).dump(), "application/json");
+    });
+    // The players' key table as data (docs/web.md), with this database's view mode.
+    http.Get("/api/keys.json", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_header("Cache-Control", "no-cache");
+      const auto d = database(true);
+      res.set_content(player::keys_json(&d->manifest()).dump(), "application/json");
     });
     http.Get(R"(/api/index/(\d{1,9})/(\d{1,9})\.json)", [this](const httplib::Request& req, httplib::Response& res) {
       const auto d = database(false);

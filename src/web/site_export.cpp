@@ -1,5 +1,7 @@
 #include "web/site_export.hpp"
 
+#include "player/keys_json.hpp"
+
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -216,6 +218,7 @@ SiteExport export_site(const fs::path& database, const fs::path& out_arg, const 
     staging.copy_in(entry.path(), entry.path().lexically_relative(player_dir).generic_string());
   }
   staging.write_text("api/database.json", database_json(db).dump());
+  staging.write_text("api/keys.json", player::keys_json(&db.manifest()).dump());
 
   SiteExport summary;
   summary.streams = db.stream_count();

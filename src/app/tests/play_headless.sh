@@ -16,7 +16,7 @@ t=0.4 key=Tab
 t=0.5 seek=3
 t=0.8 key=Left
 SCRIPT
-"$panoptes" play db --headless --script s.txt --frames-out frames --stats stats.json > out.txt
+"$panoptes" play db --headless --script s.txt --speed 1 --frames-out frames --stats stats.json > out.txt
 grep -q "played 25 frames (0 placeholders)" out.txt || { cat out.txt; echo "unexpected summary"; exit 1; }
 [ "$(ls frames | wc -l)" -eq 25 ] || { echo "expected 25 PNGs"; exit 1; }
 [ -s frames/frame_000000.png ] && [ -s frames/frame_000024.png ]
@@ -34,13 +34,13 @@ jq -e '.decode_time.count > 0 and .cache.hits >= 0' stats.json >/dev/null
 
 # A missing movie: placeholder while camera 1 is shown, playback continues.
 rm db/movies/c1/t0.mp4
-"$panoptes" play db --headless --script s.txt --stats stats2.json > out2.txt
+"$panoptes" play db --headless --script s.txt --speed 1 --stats stats2.json > out2.txt
 grep -q "played 25 frames (6 placeholders)" out2.txt || { cat out2.txt; echo "expected 6 placeholders"; exit 1; }
 [ "$(jq -r '.displayed[6].status' stats2.json)" = missing ]
 [ "$(jq -r '.displayed[13].frame' stats2.json)" = 13 ]
 
 # Prefetch off still shows the same frames.
-"$panoptes" play db --headless --script s.txt --stats stats3.json --no-prefetch >/dev/null
+"$panoptes" play db --headless --script s.txt --speed 1 --stats stats3.json --no-prefetch >/dev/null
 [ "$(jq -c '[.displayed[] | [.camera,.task,.frame]]' stats2.json)" = "$(jq -c '[.displayed[] | [.camera,.task,.frame]]' stats3.json)" ]
 [ "$(jq '.decodes.prefetch' stats3.json)" = 0 ]
 

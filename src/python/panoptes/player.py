@@ -30,6 +30,19 @@ class Player:
     playing = property(lambda self: self._p.playing)
     fps = property(lambda self: self._p.fps)
 
+    def key(self, name):
+        """Press a key of the players' key table ("Up", "Shift+Tab", "3"), with the meaning it has in the
+        window and headless runs (walks inside lattices, field of view in 360-degree streams)."""
+        return self._p.key(name)
+
+    def walk(self, direction):
+        """Walk relative to the view: forward, back, left, right, up or down."""
+        return self._p.walk(direction)
+
+    mode = property(lambda self: self._p.mode, doc="view mode: sphere, panorama or lattice")
+    look = property(lambda self: self._p.look, lambda self, v: setattr(self._p, "look", tuple(v)),
+                    doc="(yaw, pitch, fov) in degrees inside 360-degree streams")
+
     def navigate(self, direction):
         """Moves along the navigation graph: "left", "right", "up", "down", "in" or "out"."""
         return self._p.navigate(direction)

@@ -59,3 +59,29 @@ def test_tasks_by_name(synth_db):
         p.set_task(1.5)
     with pytest.raises(panoptes.Error, match=r'Player: the database has no task "nope"'):
         panoptes.Player(db, task="nope")
+
+
+def test_keys_give_the_headless_trace_on_a_lattice(tmp_path):
+    """Issue 30: Player.key() follows the same dispatch as `play --headless` (trace per script line)."""
+    import json
+    import subprocess
+    from conftest import panoptes_binary
+    db = tmp_path / "lattice"
+    subprocess.run([panoptes_binary(), "synth-db", str(db), "--lattice", "3x3x3", "--tasks", "3", "--frames", "4",
+                    "--size", "64x32"], check=True, stdout=subprocess.DEVNULL)
+    keys = ["Up", "Right", "Up", "Period", "2", "Tab", "End", "Left", "Z", "Comma"]
+    script = tmp_path / "s.txt"
+    script.write_text("".join(f"t={i / 10} key={k}\n" for i, k in enumerate(keys)))
+    trace = tmp_path / "trace.jsonl"
+    subprocess.run([panoptes_binary(), "play", str(db), "--headless", "--paused", "--camera", "13", "--script",
+                    str(script), "--trace", str(trace)], check=True, stdout=subprocess.DEVNULL)
+    expected = [(r["step"], r["camera"], r["task"], r["frame"]) for r in map(json.loads, trace.read_text().splitlines())]
+    p = panoptes.Player(db, camera=13)
+    got = []
+    for i, k in enumerate(keys):
+        p.key(k)
+        got.append((i, p.camera, p.task, p.frame_index))
+    assert got == expected
+    assert got[0][1] == 22  # Up from the centre camera goes up the graph, as in the window
+    with pytest.raises(Exception, match="unknown key"):
+        p.key("Nope")

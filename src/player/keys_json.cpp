@@ -1,0 +1,130 @@
+#include "player/keys_json.hpp"
+
+#include <cctype>
+#include <string>
+#include <vector>
+
+#include "player/controls.hpp"
+#include "player/keys.hpp"
+#include "player/playback_rule.hpp"
+
+namespace panoptes::player {
+namespace {
+
+/// The browser's view of a desktop key name: KeyboardEvent.key values, KeyboardEvent.code values (US
+/// layout) and, for keys whose `key` does not change with Shift, the Shift state they need.
+struct BrowserKey {
+  std::vector<std::string> keys, codes;
+  int shift = -1;  // -1: any, 0: without, 1: with
+};
+
+BrowserKey browser_key(std::string_view name) {
+  struct Named {
+    std::string_view desktop, key, code;
+  };
+  static constexpr Named kNamed[] = {
+      {"Space", " ", "Space"},          {"Left", "ArrowLeft", "ArrowLeft"}, {"Right", "ArrowRight", "ArrowRight"},
+      {"Up", "ArrowUp", "ArrowUp"},     {"Down", "ArrowDown", "ArrowDown"}, {"Period", ".", "Period"},
+      {"Comma", ",", "Comma"},          {"Shift+Period", ">", "Period"},    {"Shift+Comma", "<", "Comma"},
+      {"+", "+", "Equal"},              {"=", "=", "Equal"},                {"-", "-", "Minus"},
+      {"[", "[", "BracketLeft"},        {"]", "]", "BracketRight"},         {"/", "/", "Slash"},
+  };
+  BrowserKey k;
+  for (const auto& n : kNamed)
+    if (n.desktop == name) {
+      k.keys = {std::string(n.key)};
+      k.codes = {std::string(n.code)};
+      return k;
+    }
+  // Named keys that keep their `key` under Shift (Tab, PageUp, F1, ...): the Shift state decides.
+  bool shift = false;
+  if (name.starts_with("Shift+")) shift = true, name.remove_prefix(6);
+  if (name.size() == 1 && std::isalpha(static_cast<unsigned char>(name[0]))) {
+    const char lower = char(std::tolower(static_cast<unsigned char>(name[0])));
+    const char upper = char(std::toupper(static_cast<unsigned char>(name[0])));
+    k.keys = {std::string(1, lower), std::string(1, upper)};
+    k.codes = {std::string("Key") + upper};
+  } else if (name.size() == 1 && std::isdigit(static_cast<unsigned char>(name[0]))) {
+    k.keys = {std::string(name)};
+    k.codes = {std::string("Digit") + name[0]};
+  } else {
+    k.keys = {std::string(name)};
+    k.codes = {std::string(name)};
+  }
+  if (name.size() > 1) k.shift = shift ? 1 : 0;  // Tab vs Shift+Tab
+  return k;
+}
+
+}  // namespace
+
+nlohmann::json keys_json(const store::Manifest* manifest) {
+  using nlohmann::json;
+  json j;
+  j["version"] = kKeysJsonVersion;
+  if (manifest) j["mode"] = std::string(to_string(view_mode(*manifest)));
+  j["modes"] = {
+      {"sphere", "perspective frames (sphere, shells, Yin-Yang, ring, file rigs): the arrows and Z/X follow the "
+                 "navigation graph, + / - / 0 magnify"},
+      {"panorama", "360-degree frames without walking: the arrows and Z/X follow the navigation graph, a drag "
+                   "looks around, + / - / 0 and the wheel change the field of view"},
+      {"lattice", "360-degree frames of a lattice or path rig: the arrows and PageUp/PageDown walk relative to "
+                  "the view, a drag looks around, + / - / 0 and the wheel change the field of view"},
+  };
+  j["mode_rule"] =
+      "panorama when the rig's parameters record projection = \"equirectangular\"; lattice when they also record "
+      "lattice = [nx, ny, nz] with nx*ny*nz = the camera count, or path = true; else sphere";
+
+  json bindings = json::array();
+  json actions = json::object();
+  for (const KeyBinding& b : key_bindings()) {
+    const BrowserKey k = browser_key(b.key);
+    json row;
+    row["desktop"] = std::string(b.key);
+    row["keys"] = k.keys;
+    row["codes"] = k.codes;
+    if (k.shift >= 0) row["shift"] = k.shift == 1;
+    row["action"] = std::string(to_string(b.action));
+    row["front_end_only"] = !is_engine_action(b.action);
+    json modes = json::array(), descriptions = json::object();
+    for (ViewMode m : kViewModes) {
+      if (operation(b.action, m) == Operation::none) continue;
+      modes.push_back(std::string(to_string(m)));
+      descriptions[std::string(to_string(m))] = std::string(description(b, m));
+    }
+    row["modes"] = std::move(modes);
+    row["description"] = std::move(descriptions);
+    bindings.push_back(std::move(row));
+    json per_mode = json::object();
+    for (ViewMode m : kViewModes) {
+      const std::string_view op = operation_name(b.action, m);
+      per_mode[std::string(to_string(m))] = op.empty() ? json(nullptr) : json(std::string(op));
+    }
+    actions[std::string(to_string(b.action))] = std::move(per_mode);
+  }
+  j["bindings"] = std::move(bindings);
+  j["actions"] = std::move(actions);
+
+  j["walk"] = {
+      {"slots", {"left", "right", "up", "down", "in", "out"}},
+      {"min_cos", kWalkMinCos},
+      {"keep_view", true},
+      {"directions",
+       {{"walk_forward", "+view.forward"}, {"walk_back", "-view.forward"}, {"walk_right", "+view.right"},
+        {"walk_left", "-view.right"}, {"walk_up", "+camera.up"}, {"walk_down", "-camera.up"}}},
+  };
+  j["look"] = {
+      {"fov_deg", Look{}.fov_deg},         {"fov_min_deg", kFovMinDeg},       {"fov_max_deg", kFovMaxDeg},
+      {"pitch_max_deg", kPitchMaxDeg},     {"key_fov_factor", kKeyFovFactor}, {"wheel_fov_factor", kWheelFovFactor},
+  };
+  j["playback"] = {
+      {"speed_min", kSpeedMin},
+      {"speed_max", kSpeedMax},
+      {"faster_factor", kFasterFactor},
+      {"fine_factor", kFineSpeedFactor},
+      {"short_run", {{"shortest_run_s", kShortestRunSeconds}, {"speed_min", kShortRunSpeedMin}}},
+  };
+  j["numbering"] = {{"camera_first", 0}, {"frame_first", 0}, {"task_first", 1}};
+  return j;
+}
+
+}  // namespace panoptes::player
