@@ -32,6 +32,7 @@ struct PlayArgs {
   bool fullscreen = false, software = false, no_vsync = false;
   int max_frames = 0;
   std::string screenshot_on_exit, output_dir = ".";
+  std::string latency_log;
 };
 
 std::string key_table() {
@@ -102,6 +103,7 @@ void run_play(const PlayArgs& a) {
   w.max_frames = a.max_frames;
   w.screenshot_on_exit = a.screenshot_on_exit;
   w.output_dir = a.output_dir;
+  w.latency_log = a.latency_log;
   const auto r = panoptes::ui::run_window(a.db, w);
   if (!r.summary.empty()) std::printf("%s\n", r.summary.c_str());
 #else
@@ -155,6 +157,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--screenshot-on-exit", args->screenshot_on_exit, "Window: save the final window image as PNG");
   sub->add_option("--output-dir", args->output_dir, "Window: directory for screenshots (S) and recordings (R)");
+  sub->add_option("--latency-log", args->latency_log,
+                  "Window: write every key / click / wheel turn's latency to FILE, one line each (from the input's "
+                  "own X server timestamp to the presented frame, monotonic ms; what the HUD shows under details)");
   sub->callback([args] { run_play(*args); });
 });
 

@@ -26,6 +26,10 @@ struct HudInfo {
   double last_switch_ms = 0;
   bool last_switch_hit = false;   ///< the last switch was served from the cache (prefetched)
   double switch_p99_ms = 0;
+  bool have_input_latency = false;  ///< an input (key, click, wheel) has been shown on screen
+  double input_latency_ms = 0;      ///< the last one: its own timestamp → the frame presented
+  double input_latency_p99_ms = 0;
+  int inputs_measured = 0;
   std::int64_t cache_hits = 0, cache_misses = 0;
   std::size_t cache_bytes = 0, cache_capacity = 0;
   double zoom = 1;
