@@ -119,6 +119,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
                     cam.labels.patch.c_str(), signed_degrees(cam.labels.lat_deg).c_str(),
                     signed_degrees(cam.labels.lon_deg).c_str(), shell.c_str());
       if (!info.look_label.empty()) ImGui::TextUnformatted(info.look_label.c_str());
+      if (!info.world_label.empty()) ImGui::TextUnformatted(info.world_label.c_str());
       const std::string params = format_parameters(m, task);
       // Numbered from 1, as the digit keys select them.
       ImGui::Text("task %d of %d: %s%s%s", sel.task + 1, int(m.tasks.size()), task.name.c_str(),
@@ -159,8 +160,9 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::End();
 
     // Mini-map, bottom right above the slider.
-    // Scales with the window: ~16 % of its smaller side (about 3 % of the picture's area).
-    const float map = std::clamp(std::min(vw, vh) * 0.16f, 80.f, 320.f);
+    // Scales with the window: 16 % of its width (256 px on a 1600-px window, issue 32.2), but never more
+    // than 40 % of its height, so wide short windows keep room for the panel above it.
+    const float map = std::clamp(std::min(vw * 0.16f, vh * 0.4f), 80.f, 400.f);
     const float slider_h = ImGui::GetFrameHeightWithSpacing() + 2 * ImGui::GetStyle().WindowPadding.y;
     ImGui::SetNextWindowPos(ImVec2(vw - pad, vh - slider_h - pad), ImGuiCond_Always, ImVec2(1, 1));
     ImGui::SetNextWindowBgAlpha(0.35f);
@@ -168,7 +170,8 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       remember_window();
       if (!lattice_map_.empty()) {
         const Vec3& v = info.view_direction;
-        req.jump_camera = lattice_map_.draw(info.selection.camera, info.neighbours, z_down_ ? Vec3{v.y, v.x, -v.z} : v, map);
+        req.jump_camera =
+            lattice_map_.draw(info.selection.camera, info.neighbours, z_down_ ? Vec3{v.y, v.x, -v.z} : v, map, info.half_fov_deg);
       } else {
         req.jump_camera = minimap_.draw(info.selection.camera, info.neighbours, map);
       }

@@ -42,7 +42,9 @@ struct HudInfo {
   int shell_count = 1;            ///< camera shells of the rig (the shell is shown only if > 1)
   std::string position_label;     ///< lattice cameras: "lattice (i, j, k) of NxNyxNz" instead of lat/lon
   std::string look_label;         ///< 360° streams: where the viewer looks (empty otherwise)
+  std::string world_label;        ///< 360° streams: position in world units, compass heading, elevation
   Vec3 view_direction{0, 1, 0};   ///< world direction of the current view (lattice mini-map arrow)
+  double half_fov_deg = 0;        ///< half the horizontal field of view (mini-map view cone; 0 = none)
 };
 
 /// What the user did in the HUD this frame.

@@ -482,7 +482,12 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   // Inside a 360° stream the camera ahead is the likeliest walk: prefetch it first.
   if (equirect_) engine_.set_view_direction(h.view_direction);
   h.position_label = lattice_position_text(lattice_, shown.selection.camera);
-  if (equirect_) h.look_label = (lattice_[0] > 0 ? "" : "360 view   ") + look_text(look_);
+  if (equirect_) {
+    h.look_label = (lattice_[0] > 0 ? "" : "360 view   ") + look_text(look_);
+    h.half_fov_deg = std::atan(std::tan(look_.fov_deg * M_PI / 360) * double(out_w_) / std::max(1, out_h_)) * 180 / M_PI;
+    h.world_label = world_position_text(engine_.manifest().cameras[std::size_t(shown.selection.camera)].position,
+                                        h.view_direction, engine_.manifest().domain.up_axis == "z_down");
+  }
   if (!m.graph.empty()) {
     const auto& n = m.graph.neighbours[std::size_t(shown.selection.camera)];
     for (int id : {n.left, n.right, n.up, n.down, n.in, n.out})
