@@ -22,6 +22,7 @@
 #include "core/error.hpp"
 #include "core/png.hpp"
 #include "player/engine.hpp"
+#include "player/face_action.hpp"
 #include "player/headless.hpp"
 #include "ui/drag_rotation.hpp"
 #include "ui/look_mesh.hpp"
@@ -216,6 +217,7 @@ class WindowApp {
   std::vector<MeshVertex> mesh_;
   std::vector<SDL_Vertex> sdl_mesh_;
   bool walk(player::Walk w);
+  void face_the_action();
 
   double t0_ = wall_seconds();
   bool quit_ = false;
@@ -286,8 +288,26 @@ bool WindowApp::walk(player::Walk w) {
   return false;
 }
 
+// Turns the 360° view toward the strongest signal of the frame on screen (player/face_action.hpp).
+void WindowApp::face_the_action() {
+  if (!equirect_ || !shown_frame_) {
+    hud_.notify("C turns a 360-degree view toward the strongest signal; this database has fixed views");
+    return;
+  }
+  const auto& cam = engine_.manifest().cameras[std::size_t(engine_.selection().camera)];
+  const player::ViewBasis basis = player::camera_basis(cam);
+  const auto d = player::strongest_signal_direction(*shown_frame_, basis);
+  if (!d) {
+    hud_.notify("nothing stands out in this frame to turn to");
+    return;
+  }
+  look_ = player::look_towards(basis, *d, look_.fov_deg);
+  hud_.notify("facing the strongest signal: " + look_text(look_));
+}
+
 void WindowApp::do_action(player::Action action) {
   using player::Action;
+  if (action == Action::face_action) return face_the_action();
   if (walkable_) {
     // Inside a lattice (or along a path) the arrows and PgUp/PgDn walk relative to the view.
     switch (action) {
