@@ -120,6 +120,10 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       "Play a movie database: switch cameras and tasks while time plays (window), or run a script of "
       "timed key presses without a window (--headless)");
   sub->footer(key_table() +
+              "\nIn 360-degree databases (equirectangular frames) the keys act on the view: left drag looks around,\n"
+              "+ / - / 0 and the wheel set the field of view, C turns toward the strongest signal. On a lattice or\n"
+              "path rig the arrows walk forward / back / left / right relative to where you look and PageUp /\n"
+              "PageDown walk up / down (toward the sky / the ground); H in the window shows the keys as they act there.\n" +
               "\nScript lines (headless and --script): `t=SECONDS key=NAME`, `t=S seek=FRAME`, `t=S camera=ID`,\n"
               "`t=S task=ID|NAME`, `t=S axis=NAME:DELTA`, `t=S snap=X,Y,Z`, `t=S speed=F`, `t=S play|pause|end`;\n"
               "'#' starts a comment. See docs/player.md.");

@@ -11,6 +11,7 @@
 
 #include "player/keys.hpp"
 #include "player/legend.hpp"
+#include "player/look.hpp"
 
 namespace panoptes::ui {
 namespace {
@@ -41,7 +42,7 @@ std::string megabytes(std::size_t bytes) {
 
 }  // namespace
 
-Hud::Hud(const store::Manifest& manifest) {
+Hud::Hud(const store::Manifest& manifest) : help_mode_(help_mode(manifest)) {
   std::vector<Vec3> dirs;
   std::vector<int> shells;
   dirs.reserve(manifest.cameras.size());
@@ -267,9 +268,50 @@ void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
   ImGui::End();
 }
 
-std::vector<HelpRow> help_rows() {
+HelpMode help_mode(const store::Manifest& m) {
+  if (!player::is_equirectangular(m)) return HelpMode::rig;
+  const auto& params = m.rig.parameters;
+  const bool walkable = player::lattice_shape(m)[0] > 0 || (params.contains("path") && params["path"] == true);
+  return walkable ? HelpMode::walk : HelpMode::look;
+}
+
+namespace {
+// What a key does in a 360° database where the window reinterprets it (window_app.cpp); empty = as in
+// the key table.
+std::string_view description_in(HelpMode mode, player::Action a, std::string_view table) {
+  using player::Action;
+  if (mode == HelpMode::walk) {
+    switch (a) {
+      case Action::camera_up: return "walk forward, toward where you look";
+      case Action::camera_down: return "walk back";
+      case Action::camera_left: return "walk left (relative to the view)";
+      case Action::camera_right: return "walk right";
+      case Action::axis_up: return "walk up, toward the sky";
+      case Action::axis_down: return "walk down";
+      case Action::shell_in: return "step along the rig's 'in' link";
+      case Action::shell_out: return "step along the rig's 'out' link";
+      default: break;
+    }
+  }
+  if (mode != HelpMode::rig) {
+    switch (a) {
+      case Action::zoom_in: return "narrower field of view (also the mouse wheel)";
+      case Action::zoom_out: return "wider field of view";
+      case Action::zoom_reset: return "field of view 90 degrees";
+      default: break;
+    }
+  } else if (a == Action::face_action) {
+    return "(360-degree databases only) turn toward the strongest signal";
+  }
+  return table;
+}
+}  // namespace
+
+std::vector<HelpRow> help_rows(HelpMode mode) {
   std::vector<HelpRow> rows;
-  for (const auto& b : player::key_bindings()) {
+  for (const auto& kb : player::key_bindings()) {
+    player::KeyBinding b = kb;
+    b.description = description_in(mode, b.action, b.description);
     // The nine digit keys are one row, numbered as the HUD numbers tasks.
     if (b.action >= player::Action::task_1 && b.action <= player::Action::task_9) {
       if (b.action == player::Action::task_1) rows.push_back({"1 .. 9", "select task 1 .. 9 (numbered as in the HUD)"});
@@ -286,10 +328,17 @@ std::vector<HelpRow> help_rows() {
     }
     rows.push_back({std::string(b.key), std::string(b.description)});
   }
-  for (const auto& r : {HelpRow{"left drag", "rotate: snap to the camera nearest the dragged direction"},
-                        HelpRow{"wheel", "magnify around the cursor"}, HelpRow{"right drag", "pan the magnified frame"},
-                        HelpRow{"mini-map click", "jump to that camera"}})
-    rows.push_back(r);
+  if (mode == HelpMode::rig) {
+    for (const auto& r : {HelpRow{"left drag", "rotate: snap to the camera nearest the dragged direction"},
+                          HelpRow{"wheel", "magnify around the cursor"}, HelpRow{"right drag", "pan the magnified frame"},
+                          HelpRow{"mini-map click", "jump to that camera"}})
+      rows.push_back(r);
+  } else {
+    for (const auto& r : {HelpRow{"left drag", "look around (the scene follows the pointer)"},
+                          HelpRow{"wheel", "narrower / wider field of view"},
+                          HelpRow{"mini-map click", "jump to that camera"}})
+      rows.push_back(r);
+  }
   return rows;
 }
 
@@ -307,7 +356,7 @@ HelpLayout help_layout(int rows, float row_h, float pair_w, float avail_w, float
 }
 
 void Hud::draw_help(float vw, float vh) {
-  const std::vector<HelpRow> rows = help_rows();
+  const std::vector<HelpRow> rows = help_rows(help_mode_);
   const ImGuiStyle& style = ImGui::GetStyle();
   float key_w = 0, what_w = 0;
   for (const HelpRow& r : rows) {

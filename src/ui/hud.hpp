@@ -58,9 +58,17 @@ struct HudRequests {
 struct HelpRow {
   std::string key, what;
 };
+/// How the database at hand uses the view keys (issue 32.2: help describes the keys as they act there).
+enum class HelpMode {
+  rig,       ///< perspective frames from cameras around the data: arrows rotate, + / - magnify
+  look,      ///< 360° frames: drag looks around, + / - / wheel change the field of view
+  walk,      ///< 360° frames on a lattice or path: additionally the arrows and PgUp / PgDn walk
+};
+/// The mode of a manifest (as the window decides: equirectangular projection, lattice or path rig).
+HelpMode help_mode(const store::Manifest& manifest);
 /// The help overlay's lines: the shared key table (player/keys.hpp) with the digit keys on one line and
-/// keys of the same action sharing a line, then the mouse gestures.
-std::vector<HelpRow> help_rows();
+/// keys of the same action sharing a line, worded for `mode`, then the mouse gestures.
+std::vector<HelpRow> help_rows(HelpMode mode = HelpMode::rig);
 
 /// How the help overlay is laid out: key/description column pairs side by side and the text scale.
 struct HelpLayout {
@@ -104,6 +112,7 @@ class Hud {
  private:
   void draw_help(float viewport_w, float viewport_h);
   void draw_legend(const HudInfo& info, float viewport_w, float viewport_h);
+  HelpMode help_mode_ = HelpMode::rig;
   MiniMap minimap_;
   LatticeMap lattice_map_;
   bool z_down_ = false;  ///< replaces the sphere map for rigs inside the volume (lattice, path)
