@@ -334,6 +334,8 @@ std::vector<HelpRow> help_rows(HelpMode mode) {
                           HelpRow{"mini-map click", "jump to that camera"}})
       rows.push_back(r);
   } else {
+    if (mode == HelpMode::walk)
+      rows.push_back({"double-click", "step toward the clicked direction (Shift: step away from it)"});
     for (const auto& r : {HelpRow{"left drag", "look around (the scene follows the pointer)"},
                           HelpRow{"wheel", "narrower / wider field of view"},
                           HelpRow{"mini-map click", "jump to that camera"}})

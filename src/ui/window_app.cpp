@@ -23,6 +23,7 @@
 #include "core/png.hpp"
 #include "player/engine.hpp"
 #include "player/face_action.hpp"
+#include "player/step_toward.hpp"
 #include "player/headless.hpp"
 #include "ui/drag_rotation.hpp"
 #include "ui/look_mesh.hpp"
@@ -218,6 +219,7 @@ class WindowApp {
   std::vector<SDL_Vertex> sdl_mesh_;
   bool walk(player::Walk w);
   void face_the_action();
+  void step_toward_click(int x, int y, bool back);
 
   double t0_ = wall_seconds();
   bool quit_ = false;
@@ -303,6 +305,23 @@ void WindowApp::face_the_action() {
   }
   look_ = player::look_towards(basis, *d, look_.fov_deg);
   hud_.notify("facing the strongest signal: " + look_text(look_));
+}
+
+// Double-click in a walkable 360° database: one step toward the clicked direction (Shift: away from it),
+// keeping the world view direction, as a walk key does.
+void WindowApp::step_toward_click(int x, int y, bool back) {
+  const store::Manifest& m = engine_.manifest();
+  const int from = engine_.selection().camera;
+  const player::ViewBasis basis = player::camera_basis(m.cameras[std::size_t(from)]);
+  const Vec3 d = player::cutout_direction(basis, look_, x * px_x_, y * px_y_, out_w_, out_h_);
+  const int to = player::neighbour_toward(m, from, back ? -d : d);
+  if (to < 0 || !engine_.jump_to_camera(to)) {
+    hud_.notify(back ? "no camera behind that way" : "no camera that way");
+    return;
+  }
+  const Vec3 view = player::look_basis(basis, look_).forward;
+  look_ = player::look_towards(player::camera_basis(m.cameras[std::size_t(to)]), view, look_.fov_deg);
+  engine_.set_view_direction(view);
 }
 
 void WindowApp::do_action(player::Action action) {
@@ -394,6 +413,10 @@ void WindowApp::handle_event(const SDL_Event& e) {
     }
     case SDL_MOUSEBUTTONDOWN:
       if (hud_.covers(float(e.button.x), float(e.button.y))) break;
+      if (e.button.button == SDL_BUTTON_LEFT && e.button.clicks == 2 && walkable_) {
+        step_toward_click(e.button.x, e.button.y, (SDL_GetModState() & KMOD_SHIFT) != 0);
+        break;
+      }
       if (e.button.button == SDL_BUTTON_LEFT && equirect_) {
         left_down_ = true;
       } else if (e.button.button == SDL_BUTTON_LEFT) {
