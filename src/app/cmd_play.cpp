@@ -36,6 +36,7 @@ struct PlayArgs {
   bool fullscreen = false, software = false, no_vsync = false;
   int max_frames = 0;
   std::string screenshot_on_exit, output_dir = ".";
+  std::string latency_log;
 };
 
 std::string key_table() {
@@ -125,6 +126,7 @@ void run_play(const PlayArgs& a) {
   w.max_frames = a.max_frames;
   w.screenshot_on_exit = a.screenshot_on_exit;
   w.output_dir = a.output_dir;
+  w.latency_log = a.latency_log;
   const auto r = panoptes::ui::run_window(a.db, w);
   if (!r.summary.empty()) std::printf("%s\n", r.summary.c_str());
 #else
@@ -141,6 +143,10 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       "Play a movie database: switch cameras and tasks while time plays (window), or run a script of "
       "timed key presses without a window (--headless)");
   sub->footer(key_table() +
+              "\nIn 360-degree databases (equirectangular frames) the keys act on the view: left drag looks around,\n"
+              "+ / - / 0 and the wheel set the field of view, C turns toward the strongest signal. On a lattice or\n"
+              "path rig the arrows walk forward / back / left / right relative to where you look and PageUp /\n"
+              "PageDown walk up / down (toward the sky / the ground); H in the window shows the keys as they act there.\n" +
               "\nScript lines (headless and --script): `t=SECONDS key=NAME`, `t=S seek=FRAME`, `t=S camera=ID`,\n"
               "`t=S task=ID|NAME`, `t=S axis=NAME:DELTA`, `t=S snap=X,Y,Z`, `t=S look=YAW,PITCH,FOV`, `t=S walk=DIR`,\n"
               "`t=S speed=F`, `t=S play|pause|end`;\n"
@@ -185,6 +191,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--screenshot-on-exit", args->screenshot_on_exit, "Window: save the final window image as PNG");
   sub->add_option("--output-dir", args->output_dir, "Window: directory for screenshots (S) and recordings (R)");
+  sub->add_option("--latency-log", args->latency_log,
+                  "Window: write every key / click / wheel turn's latency to FILE, one line each (from the input's "
+                  "own X server timestamp to the presented frame, monotonic ms; what the HUD shows under details)");
   sub->callback([args] { run_play(*args); });
 });
 

@@ -51,6 +51,8 @@ constexpr std::array kBindings{
     KeyBinding{"I", Action::toggle_hud, "hide / show the HUD (status panel, mini-map, time slider)"},
     KeyBinding{"Escape", Action::quit, "quit"},
     KeyBinding{"Q", Action::quit, "quit"},
+    // Issue 32.2: orientation aids of 360° databases.
+    KeyBinding{"C", Action::face_action, "360° view: turn toward the strongest signal in the shown frame"},
 };
 
 }  // namespace
@@ -111,6 +113,7 @@ std::string_view to_string(Action action) {
     case Action::help: return "help";
     case Action::toggle_hud: return "toggle_hud";
     case Action::quit: return "quit";
+    case Action::face_action: return "face_action";
   }
   return "unknown";
 }
@@ -127,6 +130,7 @@ bool is_engine_action(Action action) {
     case Action::help:
     case Action::toggle_hud:
     case Action::quit:
+    case Action::face_action:
       return false;
     default:
       return true;

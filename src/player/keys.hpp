@@ -50,6 +50,8 @@ enum class Action {
   help,            ///< H or F1: help overlay
   toggle_hud,      ///< I: hide / show the HUD (status panel, mini-map, time slider)
   quit,            ///< Escape or Q
+  // added by issue 32.2 (front end only)
+  face_action,     ///< C: turn a 360° view toward the strongest signal in the shown frame
 };
 
 /// One row of the key table.

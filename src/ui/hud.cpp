@@ -11,6 +11,7 @@
 
 #include "player/keys.hpp"
 #include "player/legend.hpp"
+#include "player/look.hpp"
 
 namespace panoptes::ui {
 namespace {
@@ -62,7 +63,7 @@ std::vector<Vec3> minimap_directions(const store::Manifest& manifest) {
   return dirs;
 }
 
-Hud::Hud(const store::Manifest& manifest) {
+Hud::Hud(const store::Manifest& manifest) : help_mode_(help_mode(manifest)) {
   std::vector<Vec3> dirs = minimap_directions(manifest);
   std::vector<int> shells;
   for (const auto& c : manifest.cameras) shells.push_back(c.labels.shell);
@@ -133,6 +134,7 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
                     cam.labels.patch.c_str(), signed_degrees(cam.labels.lat_deg).c_str(),
                     signed_degrees(cam.labels.lon_deg).c_str(), shell.c_str());
       if (!info.look_label.empty()) ImGui::TextUnformatted(info.look_label.c_str());
+      if (!info.world_label.empty()) ImGui::TextUnformatted(info.world_label.c_str());
       const std::string params = format_parameters(m, task);
       // Numbered from 1, as the digit keys select them.
       ImGui::Text("task %d of %d: %s%s%s", sel.task + 1, int(m.tasks.size()), task.name.c_str(),
@@ -152,11 +154,15 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       }
       if (ImGui::TreeNodeEx("details", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
         ImGui::Text("display %.1f fps   zoom x%.2g", info.display_fps, info.zoom);
-        if (info.have_switch)
-          ImGui::Text("last switch %.2f ms (%s)  p99 %.2f ms", info.last_switch_ms,
-                      info.last_switch_hit ? "prefetched" : "decoded", info.switch_p99_ms);
+        // From the key press as the display server stamped it to the frame presented: what the user
+        // waited (the engine's own switch time leaves out the queueing and the drawing).
+        if (info.have_input_latency)
+          ImGui::Text("input -> screen %.1f ms  p99 %.1f ms (%d inputs)", info.input_latency_ms, info.input_latency_p99_ms,
+                      info.inputs_measured);
         else
-          ImGui::TextDisabled("last switch: none yet");
+          ImGui::TextDisabled("input -> screen: no input yet");
+        if (info.have_switch)
+          ImGui::Text("last switch: frame %s", info.last_switch_hit ? "prefetched" : "decoded on demand");
         const std::int64_t shown = info.cache_hits + info.cache_misses;
         ImGui::Text("cache %s / %s, hits %.0f%%", megabytes(info.cache_bytes).c_str(),
                     megabytes(info.cache_capacity).c_str(), shown ? 100.0 * double(info.cache_hits) / double(shown) : 0.0);
@@ -169,8 +175,9 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
     ImGui::End();
 
     // Mini-map, bottom right above the slider.
-    // Scales with the window: ~16 % of its smaller side (about 3 % of the picture's area).
-    const float map = std::clamp(std::min(vw, vh) * 0.16f, 80.f, 320.f);
+    // Scales with the window: 16 % of its width (256 px on a 1600-px window, issue 32.2), but never more
+    // than 40 % of its height, so wide short windows keep room for the panel above it.
+    const float map = std::clamp(std::min(vw * 0.16f, vh * 0.4f), 80.f, 400.f);
     const float slider_h = ImGui::GetFrameHeightWithSpacing() + 2 * ImGui::GetStyle().WindowPadding.y;
     ImGui::SetNextWindowPos(ImVec2(vw - pad, vh - slider_h - pad), ImGuiCond_Always, ImVec2(1, 1));
     ImGui::SetNextWindowBgAlpha(0.35f);
@@ -178,7 +185,8 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       remember_window();
       if (!lattice_map_.empty()) {
         const Vec3& v = info.view_direction;
-        req.jump_camera = lattice_map_.draw(info.selection.camera, info.neighbours, z_down_ ? Vec3{v.y, v.x, -v.z} : v, map);
+        req.jump_camera =
+            lattice_map_.draw(info.selection.camera, info.neighbours, z_down_ ? Vec3{v.y, v.x, -v.z} : v, map, info.half_fov_deg);
       } else {
         req.jump_camera = minimap_.draw(info.selection.camera, info.neighbours, map);
       }
@@ -274,9 +282,50 @@ void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
   ImGui::End();
 }
 
-std::vector<HelpRow> help_rows() {
+HelpMode help_mode(const store::Manifest& m) {
+  if (!player::is_equirectangular(m)) return HelpMode::rig;
+  const auto& params = m.rig.parameters;
+  const bool walkable = player::lattice_shape(m)[0] > 0 || (params.contains("path") && params["path"] == true);
+  return walkable ? HelpMode::walk : HelpMode::look;
+}
+
+namespace {
+// What a key does in a 360° database where the window reinterprets it (window_app.cpp); empty = as in
+// the key table.
+std::string_view description_in(HelpMode mode, player::Action a, std::string_view table) {
+  using player::Action;
+  if (mode == HelpMode::walk) {
+    switch (a) {
+      case Action::camera_up: return "walk forward, toward where you look";
+      case Action::camera_down: return "walk back";
+      case Action::camera_left: return "walk left (relative to the view)";
+      case Action::camera_right: return "walk right";
+      case Action::axis_up: return "walk up, toward the sky";
+      case Action::axis_down: return "walk down";
+      case Action::shell_in: return "step along the rig's 'in' link";
+      case Action::shell_out: return "step along the rig's 'out' link";
+      default: break;
+    }
+  }
+  if (mode != HelpMode::rig) {
+    switch (a) {
+      case Action::zoom_in: return "narrower field of view (also the mouse wheel)";
+      case Action::zoom_out: return "wider field of view";
+      case Action::zoom_reset: return "field of view 90 degrees";
+      default: break;
+    }
+  } else if (a == Action::face_action) {
+    return "(360-degree databases only) turn toward the strongest signal";
+  }
+  return table;
+}
+}  // namespace
+
+std::vector<HelpRow> help_rows(HelpMode mode) {
   std::vector<HelpRow> rows;
-  for (const auto& b : player::key_bindings()) {
+  for (const auto& kb : player::key_bindings()) {
+    player::KeyBinding b = kb;
+    b.description = description_in(mode, b.action, b.description);
     // The nine digit keys are one row, numbered as the HUD numbers tasks.
     if (b.action >= player::Action::task_1 && b.action <= player::Action::task_9) {
       if (b.action == player::Action::task_1) rows.push_back({"1 .. 9", "select task 1 .. 9 (numbered as in the HUD)"});
@@ -293,10 +342,19 @@ std::vector<HelpRow> help_rows() {
     }
     rows.push_back({std::string(b.key), std::string(b.description)});
   }
-  for (const auto& r : {HelpRow{"left drag", "rotate: snap to the camera nearest the dragged direction"},
-                        HelpRow{"wheel", "magnify around the cursor"}, HelpRow{"right drag", "pan the magnified frame"},
-                        HelpRow{"mini-map click", "jump to that camera"}})
-    rows.push_back(r);
+  if (mode == HelpMode::rig) {
+    for (const auto& r : {HelpRow{"left drag", "rotate: snap to the camera nearest the dragged direction"},
+                          HelpRow{"wheel", "magnify around the cursor"}, HelpRow{"right drag", "pan the magnified frame"},
+                          HelpRow{"mini-map click", "jump to that camera"}})
+      rows.push_back(r);
+  } else {
+    if (mode == HelpMode::walk)
+      rows.push_back({"double-click", "step toward the clicked direction (Shift: step away from it)"});
+    for (const auto& r : {HelpRow{"left drag", "look around (the scene follows the pointer)"},
+                          HelpRow{"wheel", "narrower / wider field of view"},
+                          HelpRow{"mini-map click", "jump to that camera"}})
+      rows.push_back(r);
+  }
   return rows;
 }
 
@@ -314,7 +372,7 @@ HelpLayout help_layout(int rows, float row_h, float pair_w, float avail_w, float
 }
 
 void Hud::draw_help(float vw, float vh) {
-  const std::vector<HelpRow> rows = help_rows();
+  const std::vector<HelpRow> rows = help_rows(help_mode_);
   const ImGuiStyle& style = ImGui::GetStyle();
   float key_w = 0, what_w = 0;
   for (const HelpRow& r : rows) {

@@ -26,6 +26,10 @@ struct HudInfo {
   double last_switch_ms = 0;
   bool last_switch_hit = false;   ///< the last switch was served from the cache (prefetched)
   double switch_p99_ms = 0;
+  bool have_input_latency = false;  ///< an input (key, click, wheel) has been shown on screen
+  double input_latency_ms = 0;      ///< the last one: its own timestamp → the frame presented
+  double input_latency_p99_ms = 0;
+  int inputs_measured = 0;
   std::int64_t cache_hits = 0, cache_misses = 0;
   std::size_t cache_bytes = 0, cache_capacity = 0;
   double zoom = 1;
@@ -38,7 +42,9 @@ struct HudInfo {
   int shell_count = 1;            ///< camera shells of the rig (the shell is shown only if > 1)
   std::string position_label;     ///< lattice cameras: "lattice (i, j, k) of NxNyxNz" instead of lat/lon
   std::string look_label;         ///< 360° streams: where the viewer looks (empty otherwise)
+  std::string world_label;        ///< 360° streams: position in world units, compass heading, elevation
   Vec3 view_direction{0, 1, 0};   ///< world direction of the current view (lattice mini-map arrow)
+  double half_fov_deg = 0;        ///< half the horizontal field of view (mini-map view cone; 0 = none)
 };
 
 /// What the user did in the HUD this frame.
@@ -52,9 +58,17 @@ struct HudRequests {
 struct HelpRow {
   std::string key, what;
 };
+/// How the database at hand uses the view keys (issue 32.2: help describes the keys as they act there).
+enum class HelpMode {
+  rig,       ///< perspective frames from cameras around the data: arrows rotate, + / - magnify
+  look,      ///< 360° frames: drag looks around, + / - / wheel change the field of view
+  walk,      ///< 360° frames on a lattice or path: additionally the arrows and PgUp / PgDn walk
+};
+/// The mode of a manifest (as the window decides: equirectangular projection, lattice or path rig).
+HelpMode help_mode(const store::Manifest& manifest);
 /// The help overlay's lines: the shared key table (player/keys.hpp) with the digit keys on one line and
-/// keys of the same action sharing a line, then the mouse gestures.
-std::vector<HelpRow> help_rows();
+/// keys of the same action sharing a line, worded for `mode`, then the mouse gestures.
+std::vector<HelpRow> help_rows(HelpMode mode = HelpMode::rig);
 
 /// How the help overlay is laid out: key/description column pairs side by side and the text scale.
 struct HelpLayout {
@@ -104,6 +118,7 @@ class Hud {
  private:
   void draw_help(float viewport_w, float viewport_h);
   void draw_legend(const HudInfo& info, float viewport_w, float viewport_h);
+  HelpMode help_mode_ = HelpMode::rig;
   MiniMap minimap_;
   LatticeMap lattice_map_;
   bool z_down_ = false;  ///< replaces the sphere map for rigs inside the volume (lattice, path)

@@ -57,5 +57,26 @@ TEST(HudHelp, LayoutFitsByColumnsThenByTextSizeButNotBelowTheBitmapFont) {
   EXPECT_FLOAT_EQ(l.scale, 1);
 }
 
+// Issue 32.2: in a lattice 360° database the help says the arrows walk and + / - change the field of
+// view, and no longer mentions rotating or magnifying; the rig help keeps its wording.
+TEST(HudHelp, WordedForTheDatabaseAtHand) {
+  const auto text = [](HelpMode mode) {
+    std::string all;
+    for (const auto& r : help_rows(mode)) all += r.key + ": " + r.what + "\n";
+    return all;
+  };
+  const std::string walk = text(HelpMode::walk), rig = text(HelpMode::rig), look = text(HelpMode::look);
+  EXPECT_NE(walk.find("Up: walk forward"), std::string::npos) << walk;
+  EXPECT_NE(walk.find("PageUp: walk up"), std::string::npos) << walk;
+  EXPECT_NE(walk.find("field of view"), std::string::npos);
+  EXPECT_EQ(walk.find("rotate"), std::string::npos) << walk;
+  EXPECT_EQ(walk.find("magnif"), std::string::npos) << walk;
+  EXPECT_NE(look.find("look around"), std::string::npos);
+  EXPECT_NE(look.find("rotate: camera"), std::string::npos) << "a 360° sphere rig still rotates with the arrows";
+  EXPECT_NE(rig.find("Up: rotate"), std::string::npos);
+  EXPECT_NE(rig.find("magnify"), std::string::npos);
+  EXPECT_EQ(rig.find("walk"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace panoptes::ui

@@ -24,4 +24,16 @@ TEST(HudText, DegreesNeverReadMinusZero) {
 }
 
 }  // namespace
+// The HUD says where the viewer stands in world units and which way it faces on a compass, in the
+// domain's sky frame (z_down: north = +x, east = +y, sky = -z).
+TEST(HudText, WorldPositionAndHeading) {
+  EXPECT_EQ(world_position_text({1, 2, 3}, {0, 1, 0}, false), "at (1, 2, 3)   heading 000 N   elevation 0");
+  EXPECT_EQ(world_position_text({0, 0, 0}, {1, 0, 0}, false), "at (0, 0, 0)   heading 090 E   elevation 0");
+  EXPECT_EQ(world_position_text({0, 0, 0}, {-1, -1, 0}, false), "at (0, 0, 0)   heading 225 SW   elevation 0");
+  EXPECT_EQ(world_position_text({120, 40, -35}, {1, 1, -std::sqrt(2.0) * std::tan(10 * M_PI / 180)}, true),
+            "at (120, 40, -35)   heading 045 NE   elevation +10");
+  EXPECT_EQ(world_position_text({0, 0, 0}, {0, 0, 1}, false), "at (0, 0, 0)   looking up");
+  EXPECT_EQ(world_position_text({0, 0, 0}, {0, 0, 1}, true), "at (0, 0, 0)   looking down");
+}
+
 }  // namespace panoptes::ui

@@ -28,7 +28,7 @@ MapPoint LatticeMap::project(const Vec3& p) const {
   return project_to_map((p - centre_) * scale_, kAzimuth, kElevation);
 }
 
-int LatticeMap::draw(int current, const std::vector<int>& neighbours, const Vec3& view, float size) {
+int LatticeMap::draw(int current, const std::vector<int>& neighbours, const Vec3& view, float size, double half_fov_deg) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
   ImGui::InvisibleButton("##latticemap", ImVec2(size, size));
@@ -51,6 +51,16 @@ int LatticeMap::draw(int current, const std::vector<int>& neighbours, const Vec3
       v[a] = hi_[a];
       dl->AddLine(to_screen(u), to_screen(v), IM_COL32(90, 110, 140, 255), 1.0f);
     }
+  // Orientation marks at the south-west bottom corner: north (+y) and the sky (+z), a third of the box.
+  {
+    const double len = 0.3 / scale_;
+    const ImVec2 o = to_screen(lo_);
+    const ImVec2 n = to_screen(lo_ + Vec3{0, len, 0}), up = to_screen(lo_ + Vec3{0, 0, len});
+    dl->AddLine(o, n, IM_COL32(235, 90, 80, 255), 2.0f);
+    dl->AddText(ImVec2(n.x + 2, n.y - 7), IM_COL32(235, 90, 80, 255), "N");
+    dl->AddLine(o, up, IM_COL32(120, 180, 255, 255), 2.0f);
+    dl->AddText(ImVec2(up.x + 3, up.y - 10), IM_COL32(120, 180, 255, 255), "sky");
+  }
   // Cameras back to front, so nearer dots cover farther ones.
   std::vector<int> order(positions_.size());
   std::iota(order.begin(), order.end(), 0);
@@ -70,9 +80,21 @@ int LatticeMap::draw(int current, const std::vector<int>& neighbours, const Vec3
   if (current >= 0 && current < int(positions_.size())) {
     const Vec3& p = positions_[std::size_t(current)];
     const ImVec2 s = to_screen(p);
-    // The view direction as a short arrow (a quarter of the box's half diagonal).
-    const ImVec2 e = to_screen(p + normalize(view) * (0.25 / scale_));
-    dl->AddLine(s, e, IM_COL32(255, 210, 40, 255), 2.0f);
+    // The view: a cone as wide as the field of view (turned about the sky axis), a third of the box's
+    // half diagonal long, and its axis.
+    const Vec3 f = normalize(view);
+    const double len = 0.35 / scale_;
+    Vec3 side = cross(f, Vec3{0, 0, 1});
+    if (half_fov_deg > 0 && norm(side) > 1e-6) {
+      side = normalize(side);
+      const double a = half_fov_deg * M_PI / 180;
+      const ImVec2 l = to_screen(p + (f * std::cos(a) - side * std::sin(a)) * len);
+      const ImVec2 r = to_screen(p + (f * std::cos(a) + side * std::sin(a)) * len);
+      dl->AddTriangleFilled(s, l, r, IM_COL32(255, 210, 40, 70));
+      dl->AddLine(s, l, IM_COL32(255, 210, 40, 200), 1.0f);
+      dl->AddLine(s, r, IM_COL32(255, 210, 40, 200), 1.0f);
+    }
+    dl->AddLine(s, to_screen(p + f * len), IM_COL32(255, 210, 40, 255), 2.0f);
     dl->AddCircleFilled(s, 4.5f, IM_COL32(255, 210, 40, 255), 12);
   }
   if (hit >= 0) {

@@ -17,8 +17,9 @@ class LatticeMap {
   /// Screen point (x right, y down, in units of the box's half diagonal) and depth of a sky-frame point.
   MapPoint project(const Vec3& p) const;
   /// Draws a `size` x `size` pixel map at the ImGui cursor; `view` is the current view direction (sky
-  /// frame). Returns the camera clicked this frame, or -1.
-  int draw(int current, const std::vector<int>& neighbours, const Vec3& view, float size);
+  /// frame), drawn as a cone `half_fov_deg` wide either side (0: an arrow), with north (N) and sky marks
+  /// at the box's corner. Returns the camera clicked this frame, or -1.
+  int draw(int current, const std::vector<int>& neighbours, const Vec3& view, float size, double half_fov_deg = 0);
 
  private:
   std::vector<Vec3> positions_;

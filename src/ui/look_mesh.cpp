@@ -1,5 +1,6 @@
 #include "ui/look_mesh.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -77,6 +78,47 @@ void build_look_mesh(const player::ViewBasis& cam, const player::Look& look, flo
       emit_triangle(a, b, c, triangles);
       emit_triangle(b, d, c, triangles);
     }
+}
+
+double look_mesh_error(const player::ViewBasis& cam, const player::Look& look, float x0, float y0, float w, float h,
+                       const std::vector<MeshVertex>& tris, int source_width) {
+  const player::ViewBasis v = player::look_basis(cam, look);
+  const double tan_half = std::tan(look.fov_deg * std::numbers::pi / 360.0), aspect = double(w) / h;
+  double worst = 0;
+  for (std::size_t k = 0; k + 2 < tris.size(); k += 3) {
+    const MeshVertex &a = tris[k], &b = tris[k + 1], &c = tris[k + 2];
+    const double fx = ((a.x + b.x + c.x) / 3.0 - x0) / w, fy = ((a.y + b.y + c.y) / 3.0 - y0) / h;
+    const Vec3 d = v.forward + v.right * ((2 * fx - 1) * tan_half * aspect) + v.up * ((1 - 2 * fy) * tan_half);
+    const double cx = dot(d, cam.right), cy = dot(d, cam.up), cz = dot(d, cam.forward);
+    const double u = std::atan2(cx, cz) / (2 * std::numbers::pi) + 0.5;
+    const double t = 0.5 - std::atan2(cy, std::hypot(cx, cz)) / std::numbers::pi;
+    double du = (a.u + b.u + c.u) / 3.0 - u;
+    du -= std::round(du);  // u wraps at the seam
+    worst = std::max({worst, std::abs(du) * source_width, std::abs((a.v + b.v + c.v) / 3.0 - t) * source_width / 2});
+  }
+  return worst;
+}
+
+int build_fitted_look_mesh(const player::ViewBasis& cam, const player::Look& look, float x0, float y0, float w, float h,
+                           int source_width, std::vector<MeshVertex>& triangles, int* cells_y) {
+  // Error (source pixels) ~ kCurvature * source_width * (cell angle in radians)^2 away from the poles.
+  constexpr double kCurvature = 0.6, kMaxError = 0.5;
+  constexpr int kMaxCells = 128;
+  const double fov_y = std::clamp(look.fov_deg, 1.0, 179.0) * std::numbers::pi / 180.0;
+  const double aspect = h > 0 ? double(w) / h : 1.0;
+  const double fov_x = 2 * std::atan(std::tan(fov_y / 2) * aspect);
+  const double per_radian = std::sqrt(kCurvature * std::max(source_width, 1) / kMaxError);
+  int cx = std::clamp(int(std::ceil(fov_x * per_radian)), 8, kMaxCells);
+  int cy = std::clamp(int(std::ceil(fov_y * per_radian)), 8, kMaxCells);
+  for (;;) {
+    build_look_mesh(cam, look, x0, y0, w, h, triangles, cx, cy);
+    if ((cx >= kMaxCells && cy >= kMaxCells) || look_mesh_error(cam, look, x0, y0, w, h, triangles, source_width) <= kMaxError)
+      break;
+    cx = std::min(kMaxCells, cx + (cx + 1) / 2);
+    cy = std::min(kMaxCells, cy + (cy + 1) / 2);
+  }
+  if (cells_y) *cells_y = cy;
+  return cx;
 }
 
 }  // namespace panoptes::ui

@@ -22,4 +22,18 @@ struct MeshVertex {
 void build_look_mesh(const player::ViewBasis& camera, const player::Look& look, float x0, float y0, float w, float h,
                      std::vector<MeshVertex>& triangles, int cells_x = 96, int cells_y = 72);
 
+/// The worst distance, in pixels of a `source_width` x `source_width / 2` frame, between the linear
+/// texture coordinates at the triangles' centroids and the exact mapping there.
+double look_mesh_error(const player::ViewBasis& camera, const player::Look& look, float x0, float y0, float w, float h,
+                       const std::vector<MeshVertex>& triangles, int source_width);
+
+/// build_look_mesh() on the coarsest grid that keeps look_mesh_error() within half a source pixel:
+/// starting from an estimate for the field of view and the source width (the error of a cell grows with
+/// the source's pixels per radian times the square of the cell's angle) and refined by half until it
+/// fits or reaches 128 cells per side (the poles in view need the most). A 768-pixel frame in a 2:1
+/// window at 90° gets about half the triangles of the old fixed 96 x 72 grid, and the software GL
+/// rasteriser pays per triangle (docs/ui.md). Returns the grid's cells along x (and y in `cells_y`).
+int build_fitted_look_mesh(const player::ViewBasis& camera, const player::Look& look, float x0, float y0, float w,
+                           float h, int source_width, std::vector<MeshVertex>& triangles, int* cells_y = nullptr);
+
 }  // namespace panoptes::ui

@@ -51,3 +51,43 @@ TEST(LookMesh, InterpolatedTextureCoordinatesFollowTheExactMapping) {
     EXPECT_LT(worst, 0.5) << "yaw " << look.yaw_deg << " pitch " << look.pitch_deg;
   }
 }
+
+// The grid fitted to the frame at hand keeps the interpolation within half a source pixel for small and
+// large frames, windows and fields of view (views reaching within 10° of a pole are left out: at the pole
+// longitude is undefined and no grid is exact; the fixed grid was no better there), with
+// fewer triangles than the fixed 96 x 72 grid for the usual 768-pixel frames looking ahead (the software
+// GL rasteriser pays per triangle).
+TEST(LookMesh, FittedGridKeepsHalfASourcePixel) {
+  const player::ViewBasis cam;
+  struct Case {
+    int source_w;
+    float w, h;
+    double fov;
+  };
+  for (const Case c : {Case{768, 1360, 680, 90}, Case{1920, 1360, 680, 90}, Case{768, 800, 600, 120},
+                       Case{1920, 1920, 1080, 60}, Case{384, 640, 480, 20}}) {
+    for (const player::Look look : {player::Look{0, 0, c.fov}, player::Look{180, 10, c.fov},
+                                    player::Look{-100, 30, c.fov}, player::Look{170, -20, c.fov}}) {
+      if (std::abs(look.pitch_deg) + c.fov / 2 > 80) continue;
+      std::vector<ui::MeshVertex> tris;
+      int cy = 0;
+      const int cx = ui::build_fitted_look_mesh(cam, look, 0, 0, c.w, c.h, c.source_w, tris, &cy);
+      if (c.source_w == 768 && c.fov == 90 && look.pitch_deg == 0)
+        EXPECT_LT(cx * cy, 96 * 72 * 6 / 10) << "fewer triangles than the fixed grid";
+      // The mesh's own error measure against the test's independent exact mapping.
+      double worst = 0;
+      for (std::size_t k = 0; k < tris.size(); k += 3) {
+        const ui::MeshVertex &a = tris[k], &b = tris[k + 1], &d = tris[k + 2];
+        double u, v;
+        exact_uv(cam, look, (a.x + b.x + d.x) / 3, (a.y + b.y + d.y) / 3, c.w, c.h, u, v);
+        double du = (a.u + b.u + d.u) / 3.0 - u;
+        du -= std::round(du);
+        worst = std::max({worst, std::abs(du) * c.source_w, std::abs((a.v + b.v + d.v) / 3.0 - v) * c.source_w / 2});
+      }
+      EXPECT_NEAR(worst, ui::look_mesh_error(cam, look, 0, 0, c.w, c.h, tris, c.source_w), 1e-3);
+      EXPECT_LE(worst, 0.5 + 1e-6) << c.source_w << " px source, " << c.w << "x" << c.h << " view, fov " << c.fov
+                                   << ", yaw " << look.yaw_deg << " pitch " << look.pitch_deg << " (" << cx << "x"
+                                   << cy << " cells)";
+    }
+  }
+}

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace panoptes::ui {
 namespace {
@@ -67,6 +68,19 @@ int MiniMap::draw(int current, const std::vector<int>& neighbours, float size) {
       const bool front = m0.depth + m1.depth > 0;
       dl->AddLine(to_screen(m0, 1), to_screen(m1, 1), front ? IM_COL32(90, 110, 140, 255) : IM_COL32(60, 70, 90, 110));
     }
+  }
+
+  // Orientation marks (directions are in the domain's sky frame: x east, y north, z sky): the sky pole
+  // and north on the equator, drawn faint when on the far side.
+  for (const auto& [dir, label, colour] : {std::tuple{Vec3{0, 0, 1}, "sky", IM_COL32(120, 180, 255, 255)},
+                                           std::tuple{Vec3{0, 1, 0}, "N", IM_COL32(235, 90, 80, 255)}}) {
+    const MapPoint m = project_to_map(dir, azimuth_, kElevation);
+    const ImVec2 s = to_screen(m, 1.0);
+    const ImU32 col = m.depth >= 0 ? colour : (colour & 0x00ffffffu) | 0x70000000u;
+    dl->AddLine(c, s, col, 1.0f);
+    // The label inside the disc, so a mark on the rim does not spill over the map's edge.
+    const float tw = ImGui::CalcTextSize(label).x;
+    dl->AddText(ImVec2(s.x > c.x ? s.x - tw - 3 : s.x + 3, s.y - 14), col, label);
   }
 
   const ImVec2 mouse = ImGui::GetIO().MousePos;

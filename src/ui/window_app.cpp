@@ -23,13 +23,17 @@
 #include "core/png.hpp"
 #include "player/engine.hpp"
 #include "player/controls.hpp"
+#include "player/face_action.hpp"
+#include "player/step_toward.hpp"
 #include "player/headless.hpp"
 #include "player/playback_rule.hpp"
 #include "player/trace.hpp"
 #include "ui/drag_rotation.hpp"
 #include "ui/look_mesh.hpp"
+#include "ui/frame_loop.hpp"
 #include "ui/hud.hpp"
 #include "ui/hud_text.hpp"
+#include "ui/input_latency.hpp"
 #include "ui/sdl_keys.hpp"
 #include "ui/sdl_window.hpp"
 #include "ui/view_transform.hpp"
@@ -205,6 +209,8 @@ class WindowApp {
     equirect_ = controls_.is_360();
     lattice_ = player::lattice_shape(engine.manifest());
     if (!options.trace.empty()) trace_.emplace(options.trace);
+    walkable_ = controls_.mode() == player::ViewMode::lattice;
+    if (!options.latency_log.empty()) latency_.log_to(options.latency_log);
   }
 
   WindowResult run();
@@ -236,16 +242,20 @@ class WindowApp {
   ViewTransform view_;
   DragRotation drag_;
   Recorder recorder_;
+  InputLatency latency_;  // key / click → presented frame, from the input's own timestamp
+  FrameLoop loop_;        // which loop iterations draw (nothing is drawn while nothing changes)
   int shell_count_ = 1;
   // Look-around in 360° streams (issue 14): the view (kept by the shared key dispatch, which walks and
   // changes the field of view as every front end does), and the mesh that draws it on the GPU.
-  bool equirect_ = false;
+  bool equirect_ = false, walkable_ = false;
   std::array<int, 3> lattice_{0, 0, 0};
   std::optional<player::TraceWriter> trace_;
   int trace_step_ = 0;
   void write_trace(const player::ScriptCommand& c);
   std::vector<MeshVertex> mesh_;
   std::vector<SDL_Vertex> sdl_mesh_;
+  void face_the_action();
+  void step_toward_click(int x, int y, bool back);
 
   double t0_ = wall_seconds();
   bool quit_ = false;
@@ -262,7 +272,7 @@ class WindowApp {
   double next_stats_ = 0;
   double display_fps_ = 0, last_present_ = 0;
   player::Statistics stats_;
-  double switch_p99_ = 0;
+  double switch_p99_ = 0, input_p99_ = 0;
   // Display-path timings for the end-of-session summary (one double per frame: 0.5 MB per hour at 60 fps).
   std::vector<double> upload_ms_, draw_ms_;
 };
@@ -314,8 +324,43 @@ void WindowApp::zoom_by(double factor) {
     view_.zoom_at(factor, out_w_ / 2.0, out_h_ / 2.0);
 }
 
+// Turns the 360° view toward the strongest signal of the frame on screen (player/face_action.hpp).
+void WindowApp::face_the_action() {
+  if (!equirect_ || !shown_frame_) {
+    hud_.notify("C turns a 360-degree view toward the strongest signal; this database has fixed views");
+    return;
+  }
+  const auto& cam = engine_.manifest().cameras[std::size_t(engine_.selection().camera)];
+  const player::ViewBasis basis = player::camera_basis(cam);
+  const auto d = player::strongest_signal_direction(*shown_frame_, basis);
+  if (!d) {
+    hud_.notify("nothing stands out in this frame to turn to");
+    return;
+  }
+  look_ = player::look_towards(basis, *d, look_.fov_deg);
+  hud_.notify("facing the strongest signal: " + look_text(look_));
+}
+
+// Double-click in a walkable 360° database: one step toward the clicked direction (Shift: away from it),
+// keeping the world view direction, as a walk key does.
+void WindowApp::step_toward_click(int x, int y, bool back) {
+  const store::Manifest& m = engine_.manifest();
+  const int from = engine_.selection().camera;
+  const player::ViewBasis basis = player::camera_basis(m.cameras[std::size_t(from)]);
+  const Vec3 d = player::cutout_direction(basis, look_, x * px_x_, y * px_y_, out_w_, out_h_);
+  const int to = player::neighbour_toward(m, from, back ? -d : d);
+  if (to < 0 || !engine_.jump_to_camera(to)) {
+    hud_.notify(back ? "no camera behind that way" : "no camera that way");
+    return;
+  }
+  const Vec3 view = player::look_basis(basis, look_).forward;
+  look_ = player::look_towards(player::camera_basis(m.cameras[std::size_t(to)]), view, look_.fov_deg);
+  engine_.set_view_direction(view);
+}
+
 void WindowApp::do_action(player::Action action) {
   using player::Action;
+  if (action == Action::face_action) return face_the_action();
   // One dispatch for every front end (player/controls.hpp): walks, field of view and engine commands.
   switch (controls_.apply(action)) {
     case player::Controls::Result::done:
@@ -394,6 +439,10 @@ void WindowApp::handle_event(const SDL_Event& e) {
     }
     case SDL_MOUSEBUTTONDOWN:
       if (hud_.covers(float(e.button.x), float(e.button.y))) break;
+      if (e.button.button == SDL_BUTTON_LEFT && e.button.clicks == 2 && walkable_) {
+        step_toward_click(e.button.x, e.button.y, (SDL_GetModState() & KMOD_SHIFT) != 0);
+        break;
+      }
       if (e.button.button == SDL_BUTTON_LEFT && equirect_) {
         left_down_ = true;
       } else if (e.button.button == SDL_BUTTON_LEFT) {
@@ -452,6 +501,10 @@ void WindowApp::refresh_statistics() {
   for (const auto& s : stats_.switches) lat.push_back(s.latency_ms);
   switch_p99_ = player::summarize(std::move(lat)).p99;
   stats_.decode_ms.clear();  // not shown; drop the copy
+  std::vector<double> inputs;
+  inputs.reserve(latency_.samples().size());
+  for (const auto& s : latency_.samples()) inputs.push_back(s.latency_ms);
+  input_p99_ = player::summarize(std::move(inputs)).p99;
 }
 
 HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
@@ -467,6 +520,12 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   h.loop = engine_.loop();
   h.direction = engine_.direction();
   h.display_fps = display_fps_;
+  if (!latency_.samples().empty()) {
+    h.have_input_latency = true;
+    h.input_latency_ms = latency_.samples().back().latency_ms;
+    h.input_latency_p99_ms = input_p99_;
+    h.inputs_measured = int(latency_.samples().size());
+  }
   if (!stats_.switches.empty()) {
     h.have_switch = true;
     h.last_switch_ms = stats_.switches.back().latency_ms;
@@ -492,7 +551,12 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   // Inside a 360° stream the camera ahead is the likeliest walk: prefetch it first.
   if (equirect_) engine_.set_view_direction(h.view_direction);
   h.position_label = lattice_position_text(lattice_, shown.selection.camera);
-  if (equirect_) h.look_label = (lattice_[0] > 0 ? "" : "360 view   ") + look_text(look_);
+  if (equirect_) {
+    h.look_label = (lattice_[0] > 0 ? "" : "360 view   ") + look_text(look_);
+    h.half_fov_deg = std::atan(std::tan(look_.fov_deg * M_PI / 360) * double(out_w_) / std::max(1, out_h_)) * 180 / M_PI;
+    h.world_label = world_position_text(engine_.manifest().cameras[std::size_t(shown.selection.camera)].position,
+                                        h.view_direction, engine_.manifest().domain.up_axis == "z_down");
+  }
   if (!m.graph.empty()) {
     const auto& n = m.graph.neighbours[std::size_t(shown.selection.camera)];
     for (int id : {n.left, n.right, n.up, n.down, n.in, n.out})
@@ -549,13 +613,33 @@ WindowResult WindowApp::run() {
   bool last = false;
   while (!last) {
     if (options_.before_frame) options_.before_frame(result.frames_presented);
+    const std::size_t commands_before = next_command_;
     run_due_script_commands();
+    LoopEvents happened;
+    happened.every_frame = options_.virtual_time;
     SDL_Event e;
-    while (SDL_PollEvent(&e)) handle_event(e);
+    // Sleep until input arrives (or playback / the HUD's refresh is due) instead of redrawing an
+    // unchanged picture: a key is then handled the moment it comes.
+    if (const int wait = options_.virtual_time ? 0 : loop_.wait_ms(engine_.playing(), wall_seconds()); wait > 0) {
+      if (SDL_WaitEventTimeout(&e, wait)) {
+        latency_.observe(e);
+        handle_event(e);
+        happened.input = true;
+      }
+    }
+    while (SDL_PollEvent(&e)) {
+      latency_.observe(e);
+      handle_event(e);
+      happened.input = true;
+    }
     last = quit_ || (options_.max_frames > 0 && result.frames_presented + 1 >= options_.max_frames);
 
     engine_.tick();
     const player::ShownFrame shown = engine_.current_frame();
+    happened.new_frame = shown.frame.get() != uploaded_;
+    happened.busy = last || next_command_ != commands_before || screenshot_pending_ || recorder_.active() ||
+                    latency_.pending();
+    if (!loop_.should_draw(happened, wall_seconds())) continue;
     if (shown.frame.get() != uploaded_) {
       const auto& f = *shown.frame;
       const int cw = (f.width + 1) / 2;
@@ -576,17 +660,19 @@ WindowResult WindowApp::run() {
     SDL_Renderer* r = window_.renderer();
     SDL_SetRenderDrawColor(r, 16, 17, 20, 255);
     const double draw0 = wall_seconds();
-    SDL_RenderClear(r);
+    if (!equirect_) SDL_RenderClear(r);  // a look-around covers every pixel: no clear (a full-window fill on software GL)
     // Where the data is drawn: the fitted, zoomed frame; a look-around fills the window.
     const Rect fr = equirect_ ? Rect{0, 0, double(out_w_), double(out_h_)} : view_.frame_rect();
     if (equirect_) {
       // The perspective cut-out of the 360° frame over the whole window, textured on the GPU.
       const player::ViewBasis cam = player::camera_basis(engine_.manifest().cameras[std::size_t(shown.selection.camera)]);
-      build_look_mesh(cam, look_, 0, 0, float(out_w_), float(out_h_), mesh_);
+      build_fitted_look_mesh(cam, look_, 0, 0, float(out_w_), float(out_h_), texture_.width(), mesh_);
       sdl_mesh_.resize(mesh_.size());
       for (std::size_t k = 0; k < mesh_.size(); ++k)
         sdl_mesh_[k] = {{mesh_[k].x, mesh_[k].y}, {255, 255, 255, 255}, {mesh_[k].u, mesh_[k].v}};
-      SDL_RenderGeometry(r, texture_.texture(), sdl_mesh_.data(), int(sdl_mesh_.size()), nullptr, 0);
+      // The mesh samples the frame once converted to RGBA (the conversion is redone only for a new frame).
+      SDL_Texture* rgba = texture_.rgba();
+      SDL_RenderGeometry(r, rgba ? rgba : texture_.texture(), sdl_mesh_.data(), int(sdl_mesh_.size()), nullptr, 0);
     } else {
       const SDL_FRect dst{float(fr.x), float(fr.y), float(fr.w), float(fr.h)};
       SDL_RenderCopyF(r, texture_.texture(), nullptr, &dst);
@@ -636,6 +722,8 @@ WindowResult WindowApp::run() {
 
     if (last && !options_.screenshot_on_exit.empty()) write_png(options_.screenshot_on_exit.string(), window_.read_pixels());
     window_.present();
+    latency_.presented();
+    loop_.drawn(wall_seconds());
     draw_ms_.push_back((wall_seconds() - draw0) * 1e3);
 
     ++result.frames_presented;
@@ -680,14 +768,25 @@ WindowResult WindowApp::run() {
   const player::Summary dec = player::summarize(st.decode_ms);
   const player::Summary up = player::summarize(upload_ms_);
   const player::Summary draw = player::summarize(draw_ms_);
-  char buf[768];
+  std::vector<double> inputs;
+  int x_timed = 0;
+  for (const auto& s : latency_.samples()) {
+    inputs.push_back(s.latency_ms);
+    x_timed += s.x_server_time ? 1 : 0;
+  }
+  const player::Summary in = player::summarize(inputs);
+  result.inputs_measured = int(in.count);
+  result.input_latency_p50_ms = in.p50;
+  result.input_latency_p99_ms = in.p99;
+  char buf[1024];
   std::snprintf(buf, sizeof buf,
                 "%d window frames; %zu switches (%d prefetched), latency p50 %.2f ms p99 %.2f ms max %.2f ms; "
                 "%lld frames decoded, %.2f ms each (p50); cache hits %lld of %lld shown frames; "
-                "%zu texture uploads p50 %.2f ms; draw+HUD+present p50 %.2f ms p99 %.2f ms (%s renderer)",
+                "%zu texture uploads p50 %.2f ms; draw+HUD+present p50 %.2f ms p99 %.2f ms (%s renderer); "
+                "input -> presented frame p50 %.1f ms p99 %.1f ms over %zu inputs (%d timed by the X server)",
                 result.frames_presented, sw.count, hits, sw.p50, sw.p99, sw.max, (long long)dec.count, dec.p50,
                 (long long)st.cache_hits, (long long)st.frames_shown, up.count, up.p50, draw.p50, draw.p99,
-                window_.renderer_name().c_str());
+                window_.renderer_name().c_str(), in.p50, in.p99, in.count, x_timed);
   result.summary = buf;
   return result;
 }

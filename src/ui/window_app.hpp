@@ -53,11 +53,16 @@ struct WindowOptions {
   /// Called at the start of every window frame with the number of frames presented so far, before
   /// the frame's events are polled: tests push synthetic SDL mouse events here. Empty = none.
   std::function<void(int)> before_frame;
+  /// Write every measured input → presented-frame latency here, one line each (monotonic clock, ms):
+  /// what desktop_latency_bench compares with pixels watched from outside. Empty = none.
+  std::filesystem::path latency_log;
 };
 
 /// What the session ended with (for tests and for the command to print a summary).
 struct WindowResult {
-  int frames_presented = 0;     ///< window frames drawn
+  /// Window frames drawn and presented. With wall-clock time the window draws only when something
+  /// changed (and twice a second for the HUD), so this counts drawings, not elapsed display refreshes.
+  int frames_presented = 0;
   int camera = -1, task = -1;   ///< selection shown last
   int frame = -1;               ///< database frame shown last
   double zoom = 1.0;            ///< magnification at exit (1 = whole frame fitted to the window)
@@ -70,6 +75,8 @@ struct WindowResult {
   bool help_fits = false;       ///< the help overlay, when last drawn, showed every line without scrolling
   std::string status = "ok";    ///< health of the frame shown last: "ok", "missing", "unreadable"
   std::string summary;          ///< one-paragraph statistics (switch latency, fps, cache hits)
+  int inputs_measured = 0;      ///< keys, clicks and wheel turns whose latency to the screen was measured
+  double input_latency_p50_ms = 0, input_latency_p99_ms = 0;  ///< input's own timestamp → frame presented
 };
 
 /// Opens the database at `db`, shows it in a window and runs until the user closes the window (or

@@ -595,5 +595,46 @@ TEST_F(WindowTest, LatticeLookAroundWalksWithTheArrowsRelativeToTheView) {
   keep_for_humans(o.screenshot_on_exit, "ui_lattice_window_test.png");
 }
 
+// Issue 32.2: in a lattice 360° database a double-click steps toward the clicked direction and
+// Shift+double-click away from it; the view's world direction is kept.
+TEST_F(WindowTest, DoubleClickStepsTowardTheClickedDirection) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  store::SyntheticOptions so;
+  so.lattice = {3, 3, 1};
+  so.projection = "equirectangular";
+  so.width = 128, so.height = 64;
+  so.frames = 2;
+  so.threads = 1;
+  store::write_synthetic_database(dir_->path / "lattice_click", so);
+  const SDL_Keymod mods = SDL_GetModState();
+  auto double_click = [&](int x, int y) {
+    SDL_Event e{};
+    e.type = SDL_MOUSEBUTTONDOWN;
+    e.button.button = SDL_BUTTON_LEFT;
+    e.button.state = SDL_PRESSED;
+    e.button.clicks = 2;
+    e.button.x = x;
+    e.button.y = y;
+    SDL_PushEvent(&e);
+    e.type = SDL_MOUSEBUTTONUP;
+    e.button.state = SDL_RELEASED;
+    SDL_PushEvent(&e);
+  };
+  WindowOptions o = test_window();
+  o.width = 640, o.height = 320;  // the clicks land on the picture, clear of the HUD's windows
+  o.camera = 4;  // the centre (1, 1, 0), looking north (+y)
+  o.max_frames = 12;
+  o.before_frame = [&](int n) {
+    if (n == 3) double_click(200, 160);  // 37° left of ahead: still north, (1, 2, 0) = 7
+    if (n == 6) {
+      SDL_SetModState(KMOD_LSHIFT);
+      double_click(80, 160);  // Shift: away from 56° left: east, (2, 2, 0) = 8
+    }
+    if (n == 8) SDL_SetModState(mods);
+  };
+  const WindowResult r = run_window(dir_->path / "lattice_click", o);
+  EXPECT_EQ(r.camera, 8) << r.notice;
+}
+
 }  // namespace
 }  // namespace panoptes::ui

@@ -32,6 +32,12 @@ class YuvTexture {
   SDL_Texture* texture() const { return texture_; }
   int width() const { return width_; }
   int height() const { return height_; }
+  /// The last uploaded frame converted to RGBA on the GPU (one render-to-texture pass of the frame's
+  /// size, redone only after a new upload), or nullptr where the renderer has no render targets.
+  /// Meant for drawings that sample the frame many times over, such as the look-around mesh: sampling
+  /// one RGBA texture costs the software GL rasteriser far less than three planes plus the YUV→RGB
+  /// conversion for every window pixel (measured in docs/ui.md).
+  SDL_Texture* rgba();
   /// Nearest-neighbour sampling (to see individual pixels when zoomed far in) instead of linear.
   void set_pixelated(bool on);
   /// Number of uploads so far.
@@ -40,6 +46,8 @@ class YuvTexture {
  private:
   SDL_Renderer* renderer_;
   SDL_Texture* texture_ = nullptr;
+  SDL_Texture* rgba_ = nullptr;
+  bool rgba_current_ = false;
   int width_ = 0, height_ = 0;
   bool pixelated_ = false;
   std::int64_t uploads_ = 0;
