@@ -153,7 +153,8 @@ await check("keys: the opposite arrow retraces the last moves; HUD numbers tasks
   await page.keyboard.press("2");
   await expectShown(page, 0, 1, 0, "key 2 = task 2");
   const hudText = await page.evaluate(() => document.getElementById("hud").textContent);
-  assert.match(hudText, new RegExp(`task 2/${db.tasks.length} `), "the HUD numbers tasks as the digit keys do");
+  assert.match(hudText, new RegExp(`task 2 of ${db.tasks.length}: `), "the HUD numbers tasks as the digit keys do");
+  assert.match(hudText, new RegExp(`frame 0 of ${db.frames} `), "the HUD numbers frames from 0, as the desktop");
   // A synthetic database records no windows: no legend.
   assert.equal(await page.evaluate(() => document.getElementById("legend").hidden), true, "no legend without windows");
   assert.deepEqual(errors, []);
