@@ -67,6 +67,12 @@ export class LookView {
     this.hasFrame = false;
   }
 
+  /// Waits until the queued drawing is done (reads one pixel).
+  finish() {
+    const gl = this.gl;
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, this.pixel ?? (this.pixel = new Uint8Array(4)));
+  }
+
   /// Uploads a decoded frame (VideoFrame, canvas or image) as the panorama.
   upload(source) {
     const gl = this.gl;

@@ -37,6 +37,7 @@ const options = {
   // between the key and that frame (~3 decoders per switch, up to 11 ms of main thread; docs/web.md round 5).
   switchFirst: params.get("switchfirst") !== "0",
   releaseOnKey: params.get("release") === "key",  // close cold decoders in the key's handler (before round 5)
+  drawOnInput: params.get("drawoninput") !== "0",  // an input whose frame is decoded draws in its handler (issue 30)
 };
 
 const canvas = document.getElementById("view");
@@ -379,16 +380,30 @@ let lastTick = 0;
 function tick(now) {
   requestAnimationFrame(tick);
   if (!S.db) return;
-  // The switch drawn in the previous display frame is on screen from this frame's begin on: its
-  // latency runs from the input event to here (issue 30: not from the key handler, not to the draw).
-  if (S.presenting) {
-    const w = S.presenting;
-    w.ms = now - w.t0;
-    w.screenAt = now;
-    S.presenting = null;
-  }
   if (S.pending && lastTick) S.pending.diag.maxTickGap = Math.max(S.pending.diag.maxTickGap, now - lastTick);
   lastTick = now;
+  render(now);
+  // A switch drawn by an input's handler or just now goes out with this display frame, once this
+  // callback (and the pump's work in it) is done: its clock stops here.
+  if (S.presenting) onScreen(S.presenting);
+}
+/// Stops a switch's clock (issue 30, honest latency): from the input event's own timeStamp to the
+/// display frame in which the canvas changed — at the end of that frame's rAF callback, once the drawn
+/// pixels exist (a 1-pixel read waits for the GPU, which may still be drawing the cut-out: the draw
+/// call only queues it). Not from the key handler and not to the draw call.
+function onScreen(w) {
+  if (surface === "look" && lookView) lookView.finish();
+  else ctx.getImageData(0, 0, 1, 1);
+  const t = performance.now();
+  w.ms = t - w.t0;
+  w.screenAt = t;
+  if (S.presenting === w) S.presenting = null;
+}
+/// Draws what changed (a new frame, a switch's stream, a new look) and runs the pump. Called every
+/// display frame and, when an input changed the picture and its frame is decoded, at once from the
+/// input's handler: the change then reaches the next display frame instead of waiting a frame for
+/// the next rAF callback to draw it.
+function render(now) {
   const frame = currentFrame();
   const st = stream(S.camera, S.task);
   const key = `${S.camera}/${S.task}/${frame}`;
@@ -457,8 +472,8 @@ function tick(now) {
       const w = { command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, drawMs: now - S.pending.t0,
                   t0: S.pending.t0, hit: firstTickAfterSwitch, lag: (S.dir * (frame - shownFrame) + S.db.frames) % S.db.frames, diag: S.pending.diag };
       S.switches.push(w);
-      S.presenting = w;
       S.pending = null;
+      S.presenting = w;  // on screen with the display frame of this or the next rAF callback (tick)
     }
     drawMinimap();
   }
@@ -677,7 +692,13 @@ document.addEventListener("keydown", (e) => {
   if (act) act(e);
   else notify(WHY_NOT[b.action] ?? `${b.key}: "${b.action}" is not available in the web player`);
   inputEventTime = 0;
+  drawNowIfReady();
 });
+/// After an input: draw at once when the new picture's frame is decoded (else the rAF draws it when it is).
+function drawNowIfReady() {
+  if (!S.db || !options.drawOnInput) return;
+  if (S.pending ? cache.has(`${S.camera}/${S.task}/${currentFrame()}`) : S.lookDirty) render(performance.now());
+}
 canvas.addEventListener("wheel", (e) => {
   e.preventDefault();
   const r = canvas.getBoundingClientRect();
@@ -721,6 +742,7 @@ lookCanvas.addEventListener("pointermove", (e) => {
   const perPx = S.look.fov / Math.max(1, lookCanvas.getBoundingClientRect().height);
   setLook({ ...S.look, yaw: S.look.yaw - (e.clientX - lookLast[0]) * perPx, pitch: S.look.pitch + (e.clientY - lookLast[1]) * perPx });
   lookLast = [e.clientX, e.clientY];
+  drawNowIfReady();
 });
 const endLook = () => { lookLast = null; };
 lookCanvas.addEventListener("pointerup", endLook);
@@ -785,6 +807,7 @@ async function main() {
     if (r.ok) manifest = await r.json();
   } catch { /* a flat player still works: the rig stays "flat" */ }
   S.rig = rigOf(manifest, db.cameras.count);
+  showHelp();  // the help for this kind of database (the key table may be in already)
   if (S.rig.equirect) {
     try {
       lookView = new LookView(lookCanvas);
@@ -807,8 +830,12 @@ async function main() {
       c.style.height = `${h}px`;
     }
     if (lookView) {
-      lookCanvas.width = Math.round(w * devicePixelRatio);
-      lookCanvas.height = Math.round(h * devicePixelRatio);
+      // At most 1.5 × the panorama's height: at a 90° field of view that is 3 drawn pixels per source
+      // pixel already (more only costs fragment work, which software GL pays per pixel); the browser
+      // scales the canvas to its place.
+      const k = Math.min(1, (1.5 * db.image.height) / (h * devicePixelRatio));
+      lookCanvas.width = Math.round(w * devicePixelRatio * k);
+      lookCanvas.height = Math.round(h * devicePixelRatio * k);
       S.lookDirty = true;
     }
   };
