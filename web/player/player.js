@@ -37,7 +37,9 @@ const options = {
   // between the key and that frame (~3 decoders per switch, up to 11 ms of main thread; docs/web.md round 5).
   switchFirst: params.get("switchfirst") !== "0",
   releaseOnKey: params.get("release") === "key",  // close cold decoders in the key's handler (before round 5)
-  drawOnInput: params.get("drawoninput") !== "0",  // an input whose frame is decoded draws in its handler (issue 30)
+  // An input whose frame is decoded draws in its handler rather than at the next rAF. Measured slower
+  // (walks in a lattice, load 14-16: p50 39.5 ms vs 23 ms from the input event; docs/web.md): off.
+  drawOnInput: params.get("drawoninput") === "1",
 };
 
 const canvas = document.getElementById("view");
