@@ -19,12 +19,14 @@ function remainder(x, y) {
   return x - n * y;
 }
 
+/// The look's limits: player::clamped's, replaced by keys.json's `look` block when it is loaded.
+export const LOOK_LIMITS = { pitch_max_deg: 89, fov_min_deg: 20, fov_max_deg: 120 };
 /// The look's range, as player::clamped: pitch within ±89°, field of view 20°..120°, yaw in (−180°, 180°].
-export function clamped(l) {
+export function clamped(l, limits = LOOK_LIMITS) {
   const out = {
     yaw: remainder(l.yaw, 360),
-    pitch: Math.min(89, Math.max(-89, l.pitch)),
-    fov: Math.min(120, Math.max(20, l.fov)),
+    pitch: Math.min(limits.pitch_max_deg, Math.max(-limits.pitch_max_deg, l.pitch)),
+    fov: Math.min(limits.fov_max_deg, Math.max(limits.fov_min_deg, l.fov)),
   };
   if (out.yaw === -180) out.yaw = 180;
   return out;
@@ -91,14 +93,14 @@ export const WALKS = ["forward", "back", "left", "right", "up", "down"];
 
 /// The neighbour of `camera` (any of its six graph slots) whose displacement is best aligned with the
 /// walk's world direction (angle below 60°), or −1: player::walk_target.
-export function walkTarget(cams, camera, look, walk) {
+export function walkTarget(cams, camera, look, walk, minCos = 0.5) {
   if (!cams || !cams.neighbours || camera < 0 || camera >= cams.count) return -1;
   const here = positionOf(cams, camera);
   const cam = basisOfCamera(cams, camera);
   const view = lookBasis(cam, look);
   const d = { forward: view.forward, back: scale(view.forward, -1), right: view.right, left: scale(view.right, -1),
               up: cam.up, down: scale(cam.up, -1) }[walk];
-  let best = -1, bestCos = 0.5;  // cos 60°: never walk sideways when nothing lies ahead
+  let best = -1, bestCos = minCos;  // cos 60°: never walk sideways when nothing lies ahead
   for (let s = 0; s < 6; s++) {
     const id = cams.neighbours[6 * camera + s];
     if (id < 0 || id >= cams.count || id === camera) continue;

@@ -7,8 +7,8 @@ import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
-import { parseKeyTable, bindingOf, helpRows } from "./keys.js";
-import { clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
+import { parseKeyTable, bindingOf, helpRows, operationOf } from "./keys.js";
+import { LOOK_LIMITS, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
 import { LookView } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
 
@@ -73,7 +73,8 @@ const S = {
   playing: options.autoplay, loop: true, speed: 1, dir: 1,
   rig: { equirect: false, lattice: null, path: false, walkable: false },
   look: { yaw: 0, pitch: 0, fov: 90 }, lookDirty: false,
-  keys: null,         // the key table (keys.js), null until keys.json is in (or when it failed)
+  keys: null,         // the key table (keys.js), null until api/keys.json is in (or when it failed)
+  mode: "sphere",     // the key table's mode for this database: sphere, panorama or lattice
   hudHidden: false,
   anchorFrame: 0, anchorTime: 0,
   zoom: 1, panX: 0, panY: 0,
@@ -394,9 +395,13 @@ function tick(now) {
 /// pixels exist (a 1-pixel read waits for the GPU, which may still be drawing the cut-out: the draw
 /// call only queues it). Not from the key handler and not to the draw call.
 function onScreen(w) {
+  // The 2-D canvas is not read back: Chromium may move a canvas that is read from to the CPU. Its
+  // drawImage is rasterised when this frame is committed, right after this callback.
+  const t1 = performance.now();
   if (surface === "look" && lookView) lookView.finish();
-  else ctx.getImageData(0, 0, 1, 1);
   const t = performance.now();
+  w.diag.finishMs = t - t1;  // waiting for the GPU's drawing
+  w.diag.untilFinishMs = t1 - w.t0;  // draw, pump and the rest of the callback
   w.ms = t - w.t0;
   w.screenAt = t;
   if (S.presenting === w) S.presenting = null;
@@ -610,7 +615,7 @@ const move = (d) => {
 /// Walks to the neighbour in the walk's direction relative to the view, keeping the world view
 /// direction (player::walk_keeping_view).
 function walk(w) {
-  const to = walkTarget(S.cams, S.camera, S.look, w);
+  const to = walkTarget(S.cams, S.camera, S.look, w, S.keys && S.keys.walk ? S.keys.walk.min_cos : undefined);
   if (to < 0) { notify("no camera that way"); return false; }
   S.look = lookAfterWalk(S.cams, S.camera, to, S.look);
   S.lookDirty = true;
@@ -624,7 +629,7 @@ function setLook(l) {
 /// Speed factor, as player::Engine::set_speed (×¼..×8), keeping the playhead where it is.
 function setSpeed(v) {
   const f = currentFrame();
-  S.speed = Math.min(8, Math.max(0.25, v));
+  S.speed = Math.min(pb("speed_max", 8), Math.max(pb("speed_min", 0.25), v));
   setFrame(f);
   notify(`speed x${S.speed.toFixed(2)} (${(S.speed * S.fps).toFixed(1)} frames/s)`);
 }
@@ -647,40 +652,53 @@ function download(url, name) {
   a.download = name;
   a.click();
 }
-/// The actions of the key table (src/player/keys.hpp), by name. The table decides which key does what.
-const ACTIONS = {
+/// The operations the key table's actions stand for (api/keys.json `actions`: per mode), by name.
+const pb = (k, dflt) => (S.keys && S.keys.playback && S.keys.playback[k]) || dflt;
+const lk = (k, dflt) => (S.keys && S.keys.look && S.keys.look[k]) || dflt;
+const stepAxis = (d) => (S.db.axes[S.axis] ? select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, d), d > 0 ? "axis_up" : "axis_down")
+                                          : notify("this database has no parameter axis to step here"));
+const OPS = {
   play_pause: () => setPlaying(!S.playing),
   frame_forward: () => stepFrame(1),
   frame_back: () => stepFrame(-1),
   first_frame: () => setFrame(0),
   last_frame: () => setFrame(S.db.frames - 1),
   toggle_loop: () => { const f = currentFrame(); S.loop = !S.loop; setFrame(f); notify(S.loop ? "loop on" : "loop off"); },
-  faster: () => setSpeed(S.speed * 2),
-  slower: () => setSpeed(S.speed / 2),
+  faster: () => setSpeed(S.speed * pb("faster_factor", 2)),
+  slower: () => setSpeed(S.speed / pb("faster_factor", 2)),
   reverse: () => { const f = currentFrame(); S.dir = -S.dir; setFrame(f); },
-  speed_up: () => setSpeed(S.speed * 1.1),
-  speed_down: () => setSpeed(S.speed / 1.1),
+  speed_up: () => setSpeed(S.speed * pb("fine_factor", 1.1)),
+  speed_down: () => setSpeed(S.speed / pb("fine_factor", 1.1)),
   speed_reset: () => setSpeed(1),
-  camera_left: () => (S.rig.walkable ? walk("left") : move("left")),
-  camera_right: () => (S.rig.walkable ? walk("right") : move("right")),
-  camera_up: () => (S.rig.walkable ? walk("forward") : move("up")),
-  camera_down: () => (S.rig.walkable ? walk("back") : move("down")),
+  camera_left: () => move("left"),
+  camera_right: () => move("right"),
+  camera_up: () => move("up"),
+  camera_down: () => move("down"),
   shell_in: () => move("in"),
   shell_out: () => move("out"),
+  walk_forward: () => walk("forward"),
+  walk_back: () => walk("back"),
+  walk_left: () => walk("left"),
+  walk_right: () => walk("right"),
+  walk_up: () => walk("up"),
+  walk_down: () => walk("down"),
   next_task: () => select(S.camera, (S.task + 1) % S.db.tasks.length, "next_task"),
   previous_task: () => select(S.camera, (S.task + S.db.tasks.length - 1) % S.db.tasks.length, "previous_task"),
-  axis_up: () => (S.rig.walkable ? walk("up") : S.db.axes[S.axis] ? select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, 1), "axis_up") : notify("this database has no parameter axis to step here")),
-  axis_down: () => (S.rig.walkable ? walk("down") : S.db.axes[S.axis] ? select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, -1), "axis_down") : notify("this database has no parameter axis to step here")),
+  axis_up: () => stepAxis(1),
+  axis_down: () => stepAxis(-1),
   next_axis: () => { if (S.db.axes.length) S.axis = (S.axis + 1) % S.db.axes.length; else notify("this database has no parameter axis to step here"); },
-  zoom_in: () => (lookView ? setLook({ ...S.look, fov: S.look.fov / 1.25 }) : zoomAt(1.25, canvas.width / 2, canvas.height / 2)),
-  zoom_out: () => (lookView ? setLook({ ...S.look, fov: S.look.fov / 0.8 }) : zoomAt(0.8, canvas.width / 2, canvas.height / 2)),
-  zoom_reset: () => { if (lookView) setLook({ ...S.look, fov: 90 }); else { S.zoom = 1; S.panX = S.panY = 0; S.shown = null; } },
+  zoom_in: () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
+  zoom_out: () => zoomAt(0.8, canvas.width / 2, canvas.height / 2),
+  zoom_reset: () => { S.zoom = 1; S.panX = S.panY = 0; S.shown = null; },
+  fov_narrow: () => setLook({ ...S.look, fov: S.look.fov / lk("key_fov_factor", 1.25) }),
+  fov_widen: () => setLook({ ...S.look, fov: S.look.fov * lk("key_fov_factor", 1.25) }),
+  fov_reset: () => setLook({ ...S.look, fov: lk("fov_deg", 90) }),
   fullscreen: () => (document.fullscreenElement ? document.exitFullscreen() : document.getElementById("stage").requestFullscreen()).catch((e) => notify(`full screen: ${e.message}`)),
   screenshot: () => download((surface === "look" ? lookCanvas : canvas).toDataURL("image/png"), `panoptes-c${S.camera}-t${S.task}-f${currentFrame()}.png`),
   help: () => document.getElementById("help").classList.toggle("hidden"),
   toggle_hud: () => { S.hudHidden = !S.hudHidden; for (const id of ["hud", "minimap", "legend"]) document.getElementById(id).classList.toggle("off", S.hudHidden); },
 };
-for (let k = 1; k <= 9; k++) ACTIONS[`task_${k}`] = () => select(S.camera, k - 1, `task_${k}`);
+for (let k = 1; k <= 9; k++) OPS[`task_${k}`] = () => select(S.camera, k - 1, `task_${k}`);
 /// Actions of the desktop that a browser page cannot do (left out of the help).
 const NOT_HERE = new Set(["record", "quit"]);
 const WHY_NOT = { record: "recording is the desktop player's (panoptes play, R); here use S for a screenshot", quit: "close the tab to quit" };
@@ -690,9 +708,10 @@ document.addEventListener("keydown", (e) => {
   if (!b) return;
   e.preventDefault();
   inputEventTime = e.timeStamp;
-  const act = ACTIONS[b.action];
-  if (act) act(e);
-  else notify(WHY_NOT[b.action] ?? `${b.key}: "${b.action}" is not available in the web player`);
+  const op = operationOf(S.keys, b.action, S.mode);
+  if (op === null) notify(`${b.desktop} does nothing in this database`);
+  else if (OPS[op]) OPS[op](e);
+  else notify(WHY_NOT[op] ?? `${b.desktop}: "${op}" is not available in the web player`);
   inputEventTime = 0;
   drawNowIfReady();
 });
@@ -709,7 +728,8 @@ canvas.addEventListener("wheel", (e) => {
 // 360°: the wheel narrows / widens the field of view (×1.15 a notch, as the desktop).
 lookCanvas.addEventListener("wheel", (e) => {
   e.preventDefault();
-  setLook({ ...S.look, fov: S.look.fov * (e.deltaY < 0 ? 1 / 1.15 : 1.15) });
+  const k = lk("wheel_fov_factor", 1.15);
+  setLook({ ...S.look, fov: S.look.fov * (e.deltaY < 0 ? 1 / k : k) });
 }, { passive: false });
 
 let dragLast = null;
@@ -754,21 +774,23 @@ lookCanvas.addEventListener("pointercancel", endLook);
 function showHelp() {
   const el = document.getElementById("help");
   if (!S.keys) return;
-  const kind = S.rig.walkable ? "walk" : S.rig.equirect ? "360" : "flat";
+
   const mouse = S.rig.equirect ? "<b>drag</b>: look around · <b>wheel</b>: field of view" : "<b>drag</b>: rotate to the nearest camera · <b>wheel</b>: magnify";
   const esc = (t) => t.replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" })[c]);
-  el.innerHTML = mouse + " · " + helpRows(S.keys, kind, NOT_HERE).map((r) => `<b>${esc(r.keys)}</b>: ${esc(r.text)}`).join(" · ");
+  el.innerHTML = mouse + " · " + helpRows(S.keys, S.mode, NOT_HERE).map((r) => `<b>${esc(r.keys)}</b>: ${esc(r.text)}`).join(" · ");
 }
 
 // ---- start --------------------------------------------------------------------------------------
 /// Loads keys.json (beside index.html). Without it the keys do nothing and the page says why — the
 /// player keeps no second copy of the table.
 async function loadKeys() {
-  const url = base + "keys.json";
+  const url = base + "api/keys.json";
   try {
     const r = await fetch(url, { cache: "no-store" });
     if (!r.ok) throw new Error(`HTTP ${r.status}`);
     S.keys = parseKeyTable(await r.json(), url);
+    if (S.keys.look) Object.assign(LOOK_LIMITS, S.keys.look);
+    setMode();
     showHelp();
   } catch (e) {
     S.keysError = `the key table ${url} could not be loaded (${e.message}): keys do nothing; the mouse still works. ` +
@@ -777,6 +799,11 @@ async function loadKeys() {
     notify(S.keysError);
     clearTimeout(notifyTimer);  // stays
   }
+}
+/// The key table's mode: as published for this database (serve, export-web), else by the same rule
+/// from the manifest's rig (docs/web.md: panorama = equirectangular, lattice = also a lattice or path).
+function setMode() {
+  S.mode = (S.keys && S.keys.mode) || (S.rig.walkable ? "lattice" : S.rig.equirect ? "panorama" : "sphere");
 }
 /// Lattice and path rigs get the top-view map (larger, square); others the longitude/latitude map.
 function setupMinimap() {
@@ -809,6 +836,8 @@ async function main() {
     if (r.ok) manifest = await r.json();
   } catch { /* a flat player still works: the rig stays "flat" */ }
   S.rig = rigOf(manifest, db.cameras.count);
+  await keysLoaded;  // fetched meanwhile; its playback and look parameters are needed below
+  setMode();
   showHelp();  // the help for this kind of database (the key table may be in already)
   if (S.rig.equirect) {
     try {
@@ -855,12 +884,13 @@ async function main() {
   S.fps = Number(params.get("fps")) || (db.playback_fps > 0 ? db.playback_fps : db.fps);
   // The desktop's short-run rule (ui/window_app.cpp): without a preferred rate, a run that would flash
   // by in under 4 s at the movies' rate starts slower (×¼..×1), e.g. 24 frames at 30 fps last 3.2 s.
-  if (Number(params.get("speed")) > 0) S.speed = Math.min(8, Math.max(0.25, Number(params.get("speed"))));
+  const short = pb("short_run", { shortest_run_s: 4, speed_min: 0.25 });
+  if (Number(params.get("speed")) > 0) S.speed = Math.min(pb("speed_max", 8), Math.max(pb("speed_min", 0.25), Number(params.get("speed"))));
   else if (!Number(params.get("fps")) && !(db.playback_fps > 0) && db.frames > 1)
-    S.speed = Math.min(1, Math.max(0.25, db.frames / (S.fps * 4)));
+    S.speed = Math.min(1, Math.max(short.speed_min, db.frames / (S.fps * short.shortest_run_s)));
   if (lookView) {
     // A 360° frame starts looking along the camera's forward direction with a 90° field of view.
-    const yaw = Number(params.get("yaw")) || 0, pitch = Number(params.get("pitch")) || 0, fov = Number(params.get("fov")) || 90;
+    const yaw = Number(params.get("yaw")) || 0, pitch = Number(params.get("pitch")) || 0, fov = Number(params.get("fov")) || lk("fov_deg", 90);
     S.look = clamped({ yaw, pitch, fov });
     showSurface("look");
   }
@@ -887,7 +917,6 @@ async function main() {
     S.cams = camerasFromJson(db.cameras, db.graph);
     setupMinimap();
   }
-  await keysLoaded;
   // A database still being written grows: re-read its manifest every 2 s and re-open the streams
   // (their fragment indexes) when the frame count moved on.
   const refresh = setInterval(async () => {
@@ -914,6 +943,8 @@ window.panoptes = {
                   speed: S.speed, fps: S.fps, direction: S.dir, loop: S.loop, look: { ...S.look }, rig: S.rig, surface, hudHidden: S.hudHidden }),
   /// The key table as loaded (null before or when keys.json failed) and why it failed.
   keys: () => (S.keys ? S.keys.rows : null),
+  /// The key table's mode in use: sphere, panorama or lattice.
+  mode: () => S.mode,
   keysError: () => S.keysError ?? null,
   /// Sets the 360° look {yaw, pitch, fov} (clamped as the desktop).
   setLook: (l) => setLook({ ...S.look, ...l }),

@@ -15,8 +15,6 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
-. "$here/player_dir.sh"
-player_dir "$panoptes" "$tmp"
 
 "$panoptes" synth-db "$tmp/db" --cameras 8 --tasks 3 --frames 24 --size 160x120 --gop 4 >/dev/null
 rm "$tmp/db/movies/c5/t1.mp4"                                   # missing

@@ -13,8 +13,6 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
-. "$here/player_dir.sh"
-player_dir "$panoptes" "$tmp"
 
 "$panoptes" synth-db "$tmp/db" --lattice 3x3x3 --projection equirectangular --tasks 2 --frames 24 --size 256x128 --gop 4 >/dev/null
 : > "$tmp/serve.log"
