@@ -828,17 +828,26 @@ async function main() {
   const db = await res.json();
   mark("database.json");
   // The key table (generated from the C++ one by serve / export-web) and the manifest's rig (360°,
-  // lattice) come alongside the first frame's fetches.
+  // lattice) are fetched while the first stream opens; only drawing waits for them.
   const keysLoaded = loadKeys();
-  let manifest = null;
-  try {
-    const r = await fetch(base + "db/panoptes.json", { cache: "no-store" });
-    if (r.ok) manifest = await r.json();
-  } catch { /* a flat player still works: the rig stays "flat" */ }
+  const manifestLoaded = fetch(base + "db/panoptes.json", { cache: "no-store" })
+    .then((r) => (r.ok ? r.json() : null)).catch(() => null);  // without it the player shows frames flat
+  document.title = `${db.title || "Panoptes"} — Panoptes web player`;
+  document.getElementById("title").textContent =
+    `${db.title}: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames (${db.status})`;
+  S.camera = Math.min(Number(params.get("camera") || 0), db.cameras.count - 1);
+  S.task = Math.min(Number(params.get("task") || 0), db.tasks.length - 1);
+  S.anchorFrame = Math.min(Number(params.get("frame") || 0), db.frames - 1);
+  S.anchorTime = performance.now();
+  S.db = db;
+  // Playback rate: ?fps=N, else the database's preferred rate (the desktop player's rule), else the movies'.
+  S.fps = Number(params.get("fps")) || (db.playback_fps > 0 ? db.playback_fps : db.fps);
+  pump();  // the first stream's open starts now, not at the first display frame (up to 16 ms later)
+  const manifest = await manifestLoaded;
   S.rig = rigOf(manifest, db.cameras.count);
-  await keysLoaded;  // fetched meanwhile; its playback and look parameters are needed below
+  await keysLoaded;  // its playback and look parameters are needed below
   setMode();
-  showHelp();  // the help for this kind of database (the key table may be in already)
+  showHelp();  // the help for this kind of database
   if (S.rig.equirect) {
     try {
       lookView = new LookView(lookCanvas);
@@ -872,29 +881,19 @@ async function main() {
   };
   fit();
   addEventListener("resize", fit);
-  document.title = `${db.title || "Panoptes"} — Panoptes web player`;
-  document.getElementById("title").textContent =
-    `${db.title}: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames (${db.status})`;
-  S.camera = Math.min(Number(params.get("camera") || 0), db.cameras.count - 1);
-  S.task = Math.min(Number(params.get("task") || 0), db.tasks.length - 1);
-  S.anchorFrame = Math.min(Number(params.get("frame") || 0), db.frames - 1);
-  S.anchorTime = performance.now();
-  S.db = db;
-  // Playback rate: ?fps=N, else the database's preferred rate (the desktop player's rule), else the movies'.
-  S.fps = Number(params.get("fps")) || (db.playback_fps > 0 ? db.playback_fps : db.fps);
   // The desktop's short-run rule (ui/window_app.cpp): without a preferred rate, a run that would flash
   // by in under 4 s at the movies' rate starts slower (×¼..×1), e.g. 24 frames at 30 fps last 3.2 s.
   const short = pb("short_run", { shortest_run_s: 4, speed_min: 0.25 });
   if (Number(params.get("speed")) > 0) S.speed = Math.min(pb("speed_max", 8), Math.max(pb("speed_min", 0.25), Number(params.get("speed"))));
   else if (!Number(params.get("fps")) && !(db.playback_fps > 0) && db.frames > 1)
     S.speed = Math.min(1, Math.max(short.speed_min, db.frames / (S.fps * short.shortest_run_s)));
+  S.anchorTime = performance.now();  // the clock starts with the first display loop, at that speed
   if (lookView) {
     // A 360° frame starts looking along the camera's forward direction with a 90° field of view.
     const yaw = Number(params.get("yaw")) || 0, pitch = Number(params.get("pitch")) || 0, fov = Number(params.get("fov")) || lk("fov_deg", 90);
     S.look = clamped({ yaw, pitch, fov });
     showSurface("look");
   }
-  pump();  // the first stream's open starts now, not at the first display frame (up to 16 ms later)
   requestAnimationFrame(tick);
   // The first frame does not need the cameras: it is fetched meanwhile. Navigation by the graph, the
   // mini-map and drag start when the table is in (at 10^6 cameras it is tens of MB).
