@@ -10,7 +10,7 @@ import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
 
-const [url, chromium, nodeModules, panoptes, dbDir, shotDir, switchesArg] = process.argv.slice(2);
+const [url, chromium, nodeModules, panoptes, dbDir, shotDir, switchesArg, sphereUrl, sphereDir] = process.argv.slice(2);
 const require = createRequire(nodeModules + "/");
 // Until serve / export-web publish api/keys.json (issue 30), the page gets the table built from the C++ source.
 const { provideKeys } = await import(new URL("./keys_fixture.mjs", import.meta.url).href);
@@ -145,12 +145,7 @@ await check("walk keys reach the lattice neighbour the view faces; the same scri
     ["walk=up", "PageUp"], ["key=Tab", "Tab"], ["walk=left", "ArrowLeft"], ["walk=down", "PageDown"],
   ];
   const script = steps.map(([line], k) => `t=${(0.2 * (k + 1)).toFixed(1)} ${line}`).join("\n") + "\n";
-  const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "look-test-"));
-  fs.writeFileSync(path.join(tmp, "s.txt"), script);
-  execFileSync(panoptes, ["play", dbDir, "--headless", "--paused", "--camera", String(start), "--script", path.join(tmp, "s.txt"),
-                          "--stats", path.join(tmp, "stats.json")], { stdio: "ignore" });
-  const headless = JSON.parse(fs.readFileSync(path.join(tmp, "stats.json"), "utf8")).switches.map((w) => [w.to.camera, w.to.task, w.to.frame]);
-  fs.rmSync(tmp, { recursive: true });
+  const headless = headlessSwitches(dbDir, start, script);
 
   const { page } = await open(`?play=0&camera=${start}`);
   for (const [line, key] of steps) {
@@ -168,6 +163,46 @@ await check("walk keys reach the lattice neighbour the view faces; the same scri
   assert.deepEqual(web, headless, "browser (camera, task, frame) sequence = play --headless's");
   assert.ok(headless.length >= 5, `the script switches ${headless.length} times`);
   await expectCamera(page, web.at(-1)[0], "after the script");
+  await page.close();
+});
+
+/// The (camera, task) of each switch `panoptes play --headless --paused` makes running `script`.
+function headlessSwitches(db, camera, script) {
+  const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "look-test-"));
+  try {
+    fs.writeFileSync(path.join(tmp, "s.txt"), script);
+    execFileSync(panoptes, ["play", db, "--headless", "--paused", "--camera", String(camera), "--script", path.join(tmp, "s.txt"),
+                            "--stats", path.join(tmp, "stats.json")], { stdio: "ignore" });
+    return JSON.parse(fs.readFileSync(path.join(tmp, "stats.json"), "utf8")).switches.map((w) => [w.to.camera, w.to.task, w.to.frame]);
+  } finally {
+    fs.rmSync(tmp, { recursive: true });
+  }
+}
+
+await check("sphere rig: the same key script as play --headless gives the same (camera, task, frame) sequence", async () => {
+  if (!sphereUrl) return;
+  // Key names as in scripts (the desktop's) and as the browser's KeyboardEvent.key.
+  const steps = [["Right", "ArrowRight"], ["Right", "ArrowRight"], ["Up", "ArrowUp"], ["Tab", "Tab"], ["Left", "ArrowLeft"],
+                 ["Left", "ArrowLeft"], ["Down", "ArrowDown"], ["3", "3"], ["Shift+Tab", "Shift+Tab"]];
+  const headless = headlessSwitches(sphereDir, 0, steps.map(([k], i) => `t=${(0.2 * (i + 1)).toFixed(1)} key=${k}`).join("\n") + "\n");
+  const page = await browser.newPage();
+  await provideKeys(page, keysSource);
+  await page.goto(sphereUrl + "?play=0&camera=0");
+  await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded() && window.panoptes.keys(), { timeout: 20000 });
+  assert.equal(await page.evaluate(() => window.panoptes.mode()), "sphere");
+  for (const [, key] of steps) {
+    const before = await page.evaluate(() => window.panoptes.switches().length);
+    if (key === "Shift+Tab") {
+      await page.keyboard.down("Shift");
+      await page.keyboard.press("Tab");
+      await page.keyboard.up("Shift");
+    } else await page.keyboard.press(key);
+    await page.waitForFunction((n) => window.panoptes.switches().length > n && window.panoptes.switches().at(-1).screenAt !== undefined, { timeout: 2500 }, before)
+      .catch(() => {});
+  }
+  const web = (await page.evaluate(() => window.panoptes.switches())).map((w) => [w.to[0], w.to[1], 0]);
+  assert.ok(headless.length >= 6, `the script switches ${headless.length} times`);
+  assert.deepEqual(web, headless, "browser (camera, task, frame) sequence = play --headless's");
   await page.close();
 });
 
