@@ -160,6 +160,8 @@ function neighbourSelections(camera, task) {
 }
 
 function select(camera, task, command) {
+  const eventTime = inputEventTime;  // used once: a refused select must not leave it to a later one
+  inputEventTime = 0;
   if (camera < 0 || task < 0 || camera >= S.db.cameras.count || task >= S.db.tasks.length) return false;
   if (camera === S.camera && task === S.task) return false;
   // A switch not yet on screen when the next one comes is recorded as superseded (never shown).
@@ -177,9 +179,8 @@ function select(camera, task, command) {
   };
   // The switch's clock starts at the input event's own timeStamp (same time base as performance.now()):
   // the time the event waited for the main thread is part of what the user waits for (issue 30).
-  const th = performance.now(), t0 = inputEventTime > 0 && inputEventTime <= th ? inputEventTime : th;
+  const th = performance.now(), t0 = eventTime > 0 && eventTime <= th ? eventTime : th;
   diag.keyQueuedMs = th - t0;  // 0 for the API
-  inputEventTime = 0;
   diag.at = t0;
   // demux0, output0, warm0: main-thread time on demuxing, decoder outputs and decoder creation from the key to the first display frame.
   S.pending = { t0, command, from: [S.camera, S.task], diag, demux0: traffic.demuxMs, output0: traffic.outputMs, warm0: traffic.warmMs, warms0: traffic.warms };
