@@ -231,7 +231,7 @@ const busy = new Set();  // "c/t" with a pump batch in flight
 function firstMissing(c, t, f, ahead, stride = 1) {
   const n = S.db.frames;
   for (let k = 0; k < ahead; k++) {
-    let g = S.playing ? (f + k) % n : Math.min(f + k, n - 1);
+    let g = S.playing ? (((f + k * S.dir) % n) + n) % n : Math.min(f + k, n - 1);  // ahead in the playback direction (J)
     g -= g % stride;
     if (!cache.has(`${c}/${t}/${g}`)) return g;
   }

@@ -217,6 +217,21 @@ await check("J plays backwards; Backspace resets the speed; ] and [ change it by
   assert.ok(Math.abs((await state(page)).speed - s0 * 1.1) < 1e-9, "] = x1.1");
   await page.keyboard.press("Backspace");
   assert.equal((await state(page)).speed, 1, "Backspace = x1");
+  // Backwards, frames keep reaching the screen: over 1.5 s they step backwards through many distinct
+  // frames. (The pump's decoding ahead in the playback direction is not what this tells apart: with
+  // gop 4 a frame decoded on demand brings its fragment's others, fast enough here either way.)
+  const seen = await page.evaluate(() => new Promise((done) => {
+    const out = [], t0 = performance.now();
+    const poll = () => {
+      const s = window.panoptes.shown();
+      if (s && out.at(-1) !== s.frame) out.push(s.frame);
+      if (performance.now() - t0 < 1500) requestAnimationFrame(poll); else done(out);
+    };
+    requestAnimationFrame(poll);
+  }));
+  const n = (await state(page)).frames;
+  const back = seen.slice(1).filter((f, i) => (seen[i] - f + n) % n < n / 2).length;
+  assert.ok(seen.length >= 6 && back === seen.length - 1, `frames shown backwards: ${seen.join(" ")}`);
   await page.close();
 });
 
