@@ -8,7 +8,7 @@ import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
 import { parseKeyTable, bindingOf, helpRows, operationOf } from "./keys.js";
-import { LOOK_LIMITS, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
+import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
 import { LookView } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
 
@@ -364,8 +364,14 @@ function showSurface(which) {
   canvas.hidden = which !== "flat";
   lookCanvas.hidden = which !== "look";
 }
+/// The orientation marks' world for the current camera (?marks=0, or before the cameras are in: none).
+function lookScene() {
+  if (!S.cams || !S.domainBox || params.get("marks") === "0") return null;
+  return { basis: basisOfCamera(S.cams, S.camera), position: positionOf(S.cams, S.camera), box: S.domainBox, sky: S.sky, north: [1, 0, 0] };
+}
 function drawFrame(vf) {
   if (lookView) {
+    lookView.setScene(lookScene());
     lookView.upload(vf);
     lookView.draw(S.look);
     S.lookDirty = false;
@@ -430,7 +436,8 @@ function render(now) {
   }
   if (S.pending) S.pending.seen = true;
   if (same && S.lookDirty && lookView && lookView.hasFrame && surface === "look") {
-    lookView.draw(S.look);  // the look changed (drag, wheel, walk), the frame did not
+    lookView.setScene(lookScene());
+    lookView.draw(S.look);  // the look changed (drag, wheel, walk) or the cameras came in, the frame did not
     S.lookDirty = false;
     drawMinimap();
   }
@@ -808,6 +815,7 @@ function setMode() {
 }
 /// Lattice and path rigs get the top-view map (larger, square); others the longitude/latitude map.
 function setupMinimap() {
+  S.lookDirty = true;  // the cut-out's orientation marks need the cameras
   if (!(S.rig.lattice || S.rig.path) || !S.cams) return;
   S.latticeMap = new LatticeMap(S.cams, S.domainBox ?? null);
   minimap.width = minimap.height = 260;
@@ -859,6 +867,7 @@ async function main() {
   const dom = manifest && manifest.domain;
   if (dom && Array.isArray(dom.origin) && Array.isArray(dom.spacing) && Array.isArray(dom.dims))
     S.domainBox = { lo: dom.origin, hi: dom.origin.map((o, a) => o + dom.spacing[a] * Math.max(0, dom.dims[a] - 1)) };
+  S.sky = dom && dom.up_axis === "z_down" ? [0, 0, -1] : [0, 0, 1];  // store::Domain::sky()
   canvas.width = db.image.width;
   canvas.height = db.image.height;
   // Frames are shown as large as the window allows (in-situ renders are often small). The 360°

@@ -94,6 +94,70 @@ await check("360° lattice: cut-out, help from the key table, short-run rule, fr
   await page.close();
 });
 
+await check("the cut-out equals player::perspective_cutout's mapping of the same decoded frame", async () => {
+  // The decoded equirectangular frame as play --headless writes it (--frames-out: the frame itself).
+  const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "look-test-"));
+  let png;
+  try {
+    execFileSync(panoptes, ["play", dbDir, "--headless", "--paused", "--camera", String(start), "--duration", "0.05",
+                            "--frames-out", path.join(tmp, "out")], { stdio: "ignore" });
+    png = fs.readFileSync(path.join(tmp, "out", fs.readdirSync(path.join(tmp, "out")).sort()[0])).toString("base64");
+  } finally {
+    fs.rmSync(tmp, { recursive: true });
+  }
+  // The camera's world frame (camera table; look.js's cameraBasis = player::camera_basis) and the
+  // view, as src/player/look.cpp's perspective_cutout builds them, in world coordinates.
+  const L = await import(new URL("../player/look.js", import.meta.url).href);
+  const { parseCameraTable } = await import(new URL("../player/cameras.js", import.meta.url).href);
+  const buf = fs.readFileSync(path.join(dbDir, manifest.camera_table.file));
+  const table = parseCameraTable(buf.buffer.slice(buf.byteOffset, buf.byteOffset + buf.length), "cameras");
+  const cam = L.basisOfCamera(table, start), look = { yaw: 30, pitch: 20, fov: 90 };
+  const view = L.lookBasis(cam, look);
+  const { page } = await open(`?play=0&camera=${start}&yaw=${look.yaw}&pitch=${look.pitch}&fov=${look.fov}&marks=0`);
+  await page.waitForFunction(() => window.panoptes.state().surface === "look");
+  await new Promise((r) => setTimeout(r, 300));
+  const d = await page.evaluate(async (b64, cam, view, fov) => {
+    const img = new Image();
+    img.src = "data:image/png;base64," + b64;
+    await img.decode();
+    const SW = img.width, SH = img.height, W = 256, H = 128;
+    const grab = (src, w, h) => {
+      const c = document.createElement("canvas");
+      c.width = w;
+      c.height = h;
+      const g = c.getContext("2d");
+      g.drawImage(src, 0, 0, w, h);
+      return g.getImageData(0, 0, w, h).data;
+    };
+    const src = grab(img, SW, SH), cut = grab(document.getElementById("look"), W, H);
+    // perspective_cutout (src/player/look.cpp), line for line.
+    const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const tanHalf = Math.tan((fov * Math.PI) / 360), aspect = W / H;
+    const ref = new Float64Array(W * H * 3), mirrored = new Float64Array(W * H * 3);
+    for (let y = 0; y < H; y++)
+      for (let x = 0; x < W; x++) {
+        const sx = (2 * (x + 0.5) / W - 1) * tanHalf * aspect, sy = (1 - 2 * (y + 0.5) / H) * tanHalf;
+        const dd = [0, 1, 2].map((a) => view.forward[a] + view.right[a] * sx + view.up[a] * sy);
+        const cx = dot(dd, cam.right), cy = dot(dd, cam.up), cz = dot(dd, cam.forward);
+        const lon = Math.atan2(cx, cz), lat = Math.atan2(cy, Math.hypot(cx, cz));
+        const u = (lon / Math.PI + 1) * 0.5 * SW - 0.5, w = (0.5 - lat / Math.PI) * SH - 0.5;
+        const x0 = Math.floor(u), y0 = Math.floor(w), fx = u - x0, fy = w - y0;
+        const xa = ((x0 % SW) + SW) % SW, xb = (xa + 1) % SW, ya = Math.min(SH - 1, Math.max(0, y0)), yb = Math.min(SH - 1, Math.max(0, y0 + 1));
+        for (let c = 0; c < 3; c++) {
+          const p = (xx, yy) => src[4 * (yy * SW + xx) + c];
+          const top = p(xa, ya) + (p(xb, ya) - p(xa, ya)) * fx, bottom = p(xa, yb) + (p(xb, yb) - p(xa, yb)) * fx;
+          ref[3 * (y * W + x) + c] = top + (bottom - top) * fy;
+          mirrored[3 * ((H - 1 - y) * W + x) + c] = top + (bottom - top) * fy;
+        }
+      }
+    const mad = (r) => { let s = 0; for (let i = 0; i < W * H; i++) for (let c = 0; c < 3; c++) s += Math.abs(cut[4 * i + c] - r[3 * i + c]); return s / (3 * W * H); };
+    return { same: mad(ref), mirrored: mad(mirrored) };
+  }, png, cam, view, look.fov);
+  console.log(`cut-out vs perspective_cutout's mapping: mean |diff| ${d.same.toFixed(2)} levels (upside down: ${d.mirrored.toFixed(2)})`);
+  assert.ok(d.same < 3 && d.same < d.mirrored / 3, `the WebGL cut-out matches player::perspective_cutout (${d.same.toFixed(2)} vs ${d.mirrored.toFixed(2)} upside down)`);
+  await page.close();
+});
+
 await check("drag changes yaw and pitch by fov/height degrees per pixel; wheel and +/-/0 the field of view", async () => {
   const { page } = await open(`?play=0&camera=${start}`);
   const box = await (await page.$("#look")).boundingBox();
