@@ -2,76 +2,26 @@
 // VideoFrame is the texture and a fragment shader maps every pixel's ray to longitude/latitude — the
 // same mapping as the desktop's look mesh (src/ui/look_mesh.cpp) and its CPU reference
 // player::perspective_cutout (longitude wraps, bilinear sampling, latitude clamped at the poles).
+import { lookBasis } from "./look.js";
 
 const VERTEX = `#version 300 es
 in vec2 p;
 out vec2 ndc;
 void main() { ndc = p; gl_Position = vec4(p, 0.0, 1.0); }`;
 
-// Directions are in the camera's own frame: x = right, y = up, z = forward. The orientation marks
-// (issue 32: "where am I, where do I look") are drawn over the frame in world terms: the domain box's
-// 12 edges as the curves they are in the cut-out, the horizon (directions level with the sky), and
-// ticks on it every 30° of heading (from north towards east = north × sky), the north one longer and
-// yellow.
+// Directions are in the camera's own frame: x = right, y = up, z = forward.
 const FRAGMENT = `#version 300 es
 precision highp float;
 in vec2 ndc;
 uniform vec3 F, R, U;
 uniform vec2 tanHalf;
 uniform sampler2D tex;
-uniform bool marks;
-uniform vec3 camRight, camUp, camForward, camPos, sky, north, boxLo, boxHi;
-uniform float pixelAngle;  // radians per drawn pixel at the centre
 out vec4 colour;
 const float PI = 3.14159265358979;
-// Angle (radians) between the ray from the camera along unit w and the segment a-b, or 10 when the
-// closest approach lies behind the camera.
-float segmentAngle(vec3 w, vec3 a, vec3 b) {
-  vec3 e = b - a, o = camPos - a;
-  float ee = dot(e, e), we = dot(w, e), wo = dot(w, o), eo = dot(e, o);
-  float den = ee - we * we;
-  float s = den > 1e-12 * ee ? clamp((eo - we * wo) / den, 0.0, 1.0) : 0.0;  // along the segment
-  vec3 q = a + e * s - camPos;
-  float t = dot(q, w);
-  if (t <= 0.0) return 10.0;
-  return length(q - w * t) / t;
-}
 void main() {
   vec3 d = F + R * (ndc.x * tanHalf.x) + U * (ndc.y * tanHalf.y);
   float lon = atan(d.x, d.z), lat = atan(d.y, length(d.xz));
-  vec3 c = texture(tex, vec2((lon / PI + 1.0) * 0.5, 0.5 - lat / PI)).rgb;
-  if (marks) {
-    vec3 w = normalize(camRight * d.x + camUp * d.y + camForward * d.z);
-    float px = pixelAngle * length(d) / length(F);  // a pixel's angle grows off-centre
-    // Box edges: 4 along each axis.
-    float edge = 10.0;
-    for (int axis = 0; axis < 3; ++axis)
-      for (int k = 0; k < 4; ++k) {
-        vec3 a = boxLo, b;
-        int u = (axis + 1) % 3, v = (axis + 2) % 3;
-        if ((k & 1) == 1) a[u] = boxHi[u];
-        if ((k & 2) == 2) a[v] = boxHi[v];
-        b = a;
-        b[axis] = boxHi[axis];
-        edge = min(edge, segmentAngle(w, a, b));
-      }
-    c = mix(c, vec3(0.92), 0.75 * (1.0 - smoothstep(0.6, 1.4, edge / px)));
-    // Horizon and heading ticks (heading from north towards east = north x sky).
-    float h = asin(clamp(dot(w, sky), -1.0, 1.0));
-    c = mix(c, vec3(0.45, 0.8, 1.0), 0.5 * (1.0 - smoothstep(0.5, 1.2, abs(h) / px)));
-    vec3 level = w - sky * dot(w, sky);
-    float levelLen = length(level);
-    if (levelLen > 1e-4) {
-      level /= levelLen;
-      float heading = atan(dot(level, cross(north, sky)), dot(level, north));
-      float tick = radians(30.0), nearest = tick * floor(heading / tick + 0.5);
-      float off = abs(heading - nearest) * levelLen;
-      bool isNorth = abs(nearest) < 0.01;
-      float len = (isNorth ? 14.0 : 7.0) * px;
-      if (off < 1.2 * px && abs(h) < len) c = mix(c, isNorth ? vec3(1.0, 0.85, 0.2) : vec3(0.45, 0.8, 1.0), 0.85);
-    }
-  }
-  colour = vec4(c, 1.0);
+  colour = vec4(texture(tex, vec2((lon / PI + 1.0) * 0.5, 0.5 - lat / PI)).rgb, 1.0);
 }`;
 
 /// player::look_basis of a camera's own frame, in the shader's coordinates (x = right, y = up, z =
@@ -109,9 +59,7 @@ export class LookView {
     gl.linkProgram(prog);
     if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(`look shader: ${gl.getProgramInfoLog(prog)}`);
     this.prog = prog;
-    this.u = Object.fromEntries(["F", "R", "U", "tanHalf", "tex", "marks", "camRight", "camUp", "camForward", "camPos", "sky", "north",
-                                 "boxLo", "boxHi", "pixelAngle"].map((n) => [n, gl.getUniformLocation(prog, n)]));
-    this.scene = null;
+    this.u = Object.fromEntries(["F", "R", "U", "tanHalf", "tex"].map((n) => [n, gl.getUniformLocation(prog, n)]));
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
     const buf = gl.createBuffer();
@@ -135,12 +83,6 @@ export class LookView {
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, this.pixel ?? (this.pixel = new Uint8Array(4)));
   }
 
-  /// The world around the camera for the orientation marks, or null for none: {basis: {right, up,
-  /// forward}, position, sky, north, box: {lo, hi}} (world coordinates).
-  setScene(scene) {
-    this.scene = scene;
-  }
-
   /// Uploads a decoded frame (VideoFrame, canvas or image) as the panorama.
   upload(source) {
     const gl = this.gl;
@@ -162,22 +104,73 @@ export class LookView {
     gl.uniform3fv(this.u.U, v.up);
     gl.uniform2f(this.u.tanHalf, t * (w / h), t);
     gl.uniform1i(this.u.tex, 0);
-    const sc = this.scene;
-    gl.uniform1i(this.u.marks, sc ? 1 : 0);
-    if (sc) {
-      gl.uniform3fv(this.u.camRight, sc.basis.right);
-      gl.uniform3fv(this.u.camUp, sc.basis.up);
-      gl.uniform3fv(this.u.camForward, sc.basis.forward);
-      // Relative to the camera: float32 positions of a 50 km domain would lose the metres.
-      gl.uniform3fv(this.u.camPos, [0, 0, 0]);
-      gl.uniform3fv(this.u.boxLo, sc.box.lo.map((x, a) => x - sc.position[a]));
-      gl.uniform3fv(this.u.boxHi, sc.box.hi.map((x, a) => x - sc.position[a]));
-      gl.uniform3fv(this.u.sky, sc.sky);
-      gl.uniform3fv(this.u.north, sc.north);
-      gl.uniform1f(this.u.pixelAngle, (2 * t) / h);
-    }
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, this.tex);
     gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
+  }
+}
+
+/// The orientation marks over the cut-out (issue 32: where am I, where do I look), drawn into a 2-D
+/// canvas laid over it: the domain box's 12 edges, the horizon (directions level with the sky) and
+/// ticks on it every 30° of heading (from north towards east = north × sky), north longer and yellow.
+/// Straight lines stay straight in the cut-out (a perspective view): each edge is clipped to the space
+/// in front of the viewer and drawn as one line. (In the fragment shader, the distance to 12 edges per
+/// pixel cost ~50 ms a frame on software GL.)
+/// scene: {basis: {right, up, forward}, position, sky, north, box: {lo, hi}} in world coordinates.
+export function drawOrientationMarks(ctx, w, h, scene, look) {
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  if (!scene) return;
+  const v = lookBasis(scene.basis, look);
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const t = Math.tan((look.fov * Math.PI) / 360), aspect = w / h, near = 1e-6;
+  const view = (d) => [dot(d, v.right), dot(d, v.up), dot(d, v.forward)];
+  const screen = (q) => [((q[0] / (q[2] * t * aspect)) + 1) * 0.5 * w, (1 - q[1] / (q[2] * t)) * 0.5 * h];
+  /// A line between two view-space points, the part behind the viewer cut off.
+  const line = (a, b) => {
+    if (a[2] < near && b[2] < near) return;
+    const cut = (p, q) => { const s = (near - p[2]) / (q[2] - p[2]); return p.map((x, i) => x + (q[i] - x) * s); };
+    if (a[2] < near) a = cut(a, b);
+    else if (b[2] < near) b = cut(b, a);
+    const [x0, y0] = screen(a), [x1, y1] = screen(b);
+    ctx.moveTo(x0, y0);
+    ctx.lineTo(x1, y1);
+  };
+  const px = Math.max(1, h / 360);
+  const rel = (p) => view(p.map((x, a) => x - scene.position[a]));
+  const { lo, hi } = scene.box;
+  ctx.lineCap = "round";
+  ctx.strokeStyle = "rgba(235,235,235,0.75)";
+  ctx.lineWidth = 1.6 * px;
+  ctx.beginPath();
+  for (let axis = 0; axis < 3; axis++)
+    for (let k = 0; k < 4; k++) {
+      const a = lo.slice(), u = (axis + 1) % 3, vv = (axis + 2) % 3;
+      if (k & 1) a[u] = hi[u];
+      if (k & 2) a[vv] = hi[vv];
+      const b = a.slice();
+      b[axis] = hi[axis];
+      line(rel(a), rel(b));
+    }
+  ctx.stroke();
+  // The horizon: the level directions, 72 chords of its circle.
+  const sky = scene.sky, north = scene.north;
+  const east = [north[1] * sky[2] - north[2] * sky[1], north[2] * sky[0] - north[0] * sky[2], north[0] * sky[1] - north[1] * sky[0]];
+  const dirAt = (heading, elevation) => [0, 1, 2].map((i) => (north[i] * Math.cos(heading) + east[i] * Math.sin(heading)) * Math.cos(elevation) + sky[i] * Math.sin(elevation));
+  ctx.strokeStyle = "rgba(115,205,255,0.6)";
+  ctx.lineWidth = 1.4 * px;
+  ctx.beginPath();
+  for (let k = 0; k < 72; k++) line(view(dirAt((k * Math.PI) / 36, 0)), view(dirAt(((k + 1) * Math.PI) / 36, 0)));
+  ctx.stroke();
+  for (const isNorth of [false, true]) {
+    ctx.strokeStyle = isNorth ? "rgba(255,215,50,0.95)" : "rgba(115,205,255,0.85)";
+    ctx.lineWidth = 2 * px;
+    ctx.beginPath();
+    for (let k = 0; k < 12; k++) {
+      if ((k === 0) !== isNorth) continue;
+      const e = ((isNorth ? 3 : 1.5) * Math.PI) / 180 * (look.fov / 90);
+      line(view(dirAt((k * Math.PI) / 6, -e)), view(dirAt((k * Math.PI) / 6, e)));
+    }
+    ctx.stroke();
   }
 }

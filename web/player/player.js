@@ -9,7 +9,7 @@ import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
 import { parseKeyTable, bindingOf, helpRows, operationOf } from "./keys.js";
 import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
-import { LookView } from "./look_view.js";
+import { LookView, drawOrientationMarks } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
 
 const params = new URLSearchParams(location.search);
@@ -46,6 +46,7 @@ const canvas = document.getElementById("view");
 const ctx = canvas.getContext("2d");
 // 360° databases: the cut-out is drawn by WebGL2 into its own canvas (a canvas has one context kind).
 const lookCanvas = document.getElementById("look");
+const marksCanvas = document.getElementById("marks");  // orientation marks over the cut-out
 let lookView = null;
 const hud = document.getElementById("hud");
 const legendCanvas = document.getElementById("legend");
@@ -362,18 +363,23 @@ function showSurface(which) {
   if (which === surface) return;
   surface = which;
   canvas.hidden = which !== "flat";
-  lookCanvas.hidden = which !== "look";
+  lookCanvas.hidden = marksCanvas.hidden = which !== "look";
 }
 /// The orientation marks' world for the current camera (?marks=0, or before the cameras are in: none).
 function lookScene() {
   if (!S.cams || !S.domainBox || params.get("marks") === "0") return null;
   return { basis: basisOfCamera(S.cams, S.camera), position: positionOf(S.cams, S.camera), box: S.domainBox, sky: S.sky, north: [1, 0, 0] };
 }
+/// The cut-out and its marks, at the current look.
+function drawLook() {
+  lookView.draw(S.look);
+  drawOrientationMarks(marksCtx, marksCanvas.width, marksCanvas.height, lookScene(), S.look);
+}
+const marksCtx = marksCanvas.getContext("2d");
 function drawFrame(vf) {
   if (lookView) {
-    lookView.setScene(lookScene());
     lookView.upload(vf);
-    lookView.draw(S.look);
+    drawLook();
     S.lookDirty = false;
     showSurface("look");
     return;
@@ -436,8 +442,7 @@ function render(now) {
   }
   if (S.pending) S.pending.seen = true;
   if (same && S.lookDirty && lookView && lookView.hasFrame && surface === "look") {
-    lookView.setScene(lookScene());
-    lookView.draw(S.look);  // the look changed (drag, wheel, walk) or the cameras came in, the frame did not
+    drawLook();  // the look changed (drag, wheel, walk) or the cameras came in, the frame did not
     S.lookDirty = false;
     drawMinimap();
   }
@@ -875,7 +880,7 @@ async function main() {
   const fit = () => {
     const s = Math.max(0.1, Math.min((innerWidth - 20) / db.image.width, (innerHeight - 110) / db.image.height));
     const w = Math.floor(db.image.width * s), h = Math.floor(db.image.height * s);
-    for (const c of [canvas, lookCanvas]) {
+    for (const c of [canvas, lookCanvas, marksCanvas]) {
       c.style.width = `${w}px`;
       c.style.height = `${h}px`;
     }
@@ -886,6 +891,8 @@ async function main() {
       const k = Math.min(1, (1.5 * db.image.height) / (h * devicePixelRatio));
       lookCanvas.width = Math.round(w * devicePixelRatio * k);
       lookCanvas.height = Math.round(h * devicePixelRatio * k);
+      marksCanvas.width = Math.round(w * devicePixelRatio);  // lines at the display's resolution
+      marksCanvas.height = Math.round(h * devicePixelRatio);
       S.lookDirty = true;
     }
   };
