@@ -7,6 +7,10 @@ import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
+import { parseKeyTable, bindingOf, helpRows, operationOf } from "./keys.js";
+import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
+import { LookView, drawOrientationMarks } from "./look_view.js";
+import { LatticeMap } from "./lattice_map.js";
 
 const params = new URLSearchParams(location.search);
 const base = new URL(".", location.href).href.split("?")[0];
@@ -33,10 +37,17 @@ const options = {
   // between the key and that frame (~3 decoders per switch, up to 11 ms of main thread; docs/web.md round 5).
   switchFirst: params.get("switchfirst") !== "0",
   releaseOnKey: params.get("release") === "key",  // close cold decoders in the key's handler (before round 5)
+  // An input whose frame is decoded draws in its handler rather than at the next rAF. Measured slower
+  // (walks in a lattice, load 14-16: p50 39.5 ms vs 23 ms from the input event; docs/web.md): off.
+  drawOnInput: params.get("drawoninput") === "1",
 };
 
 const canvas = document.getElementById("view");
 const ctx = canvas.getContext("2d");
+// 360° databases: the cut-out is drawn by WebGL2 into its own canvas (a canvas has one context kind).
+const lookCanvas = document.getElementById("look");
+const marksCanvas = document.getElementById("marks");  // orientation marks over the cut-out
+let lookView = null;
 const hud = document.getElementById("hud");
 const legendCanvas = document.getElementById("legend");
 const statusLine = document.getElementById("status");
@@ -54,12 +65,18 @@ cache.onPut = (key) => {
   }
 };
 const streams = new Map();  // "c/t" → Stream, LRU
+let inputEventTime = 0;  // timeStamp of the input event being handled (keys, clicks, drags), for select()
 const MAX_STREAMS = 96;  // the neighbours and their neighbours (opened ahead) stay open
 const drag = new DragRotation();
 
 const S = {
   db: null, cams: null, camera: 0, task: 0, axis: 0,
-  playing: options.autoplay, loop: true, speed: 1,
+  playing: options.autoplay, loop: true, speed: 1, dir: 1,
+  rig: { equirect: false, lattice: null, path: false, walkable: false },
+  look: { yaw: 0, pitch: 0, fov: 90 }, lookDirty: false,
+  keys: null,         // the key table (keys.js), null until api/keys.json is in (or when it failed)
+  mode: "sphere",     // the key table's mode for this database: sphere, panorama or lattice
+  hudHidden: false,
   anchorFrame: 0, anchorTime: 0,
   zoom: 1, panX: 0, panY: 0,
   shown: null,        // {camera, task, frame, status} last drawn
@@ -87,10 +104,11 @@ function stream(camera, task) {
 function currentFrame(now = performance.now()) {
   const n = S.db.frames;
   if (!S.playing) return S.anchorFrame;
-  let f = S.anchorFrame + Math.floor(((now - S.anchorTime) / 1000) * S.fps * S.speed);
-  if (f >= n) {
-    if (S.loop) f %= n;
-    else { f = n - 1; S.playing = false; S.anchorFrame = f; }
+  // As player::Engine: the position runs forward or backward (J) and wraps or stops at either end.
+  let f = S.anchorFrame + S.dir * Math.floor(((now - S.anchorTime) / 1000) * S.fps * S.speed + 1e-9);
+  if (f >= n || f < 0) {
+    if (S.loop) f = ((f % n) + n) % n;
+    else { f = f < 0 ? 0 : n - 1; S.playing = false; S.anchorFrame = f; }
   }
   return f;
 }
@@ -143,6 +161,8 @@ function neighbourSelections(camera, task) {
 }
 
 function select(camera, task, command) {
+  const eventTime = inputEventTime;  // used once: a refused select must not leave it to a later one
+  inputEventTime = 0;
   if (camera < 0 || task < 0 || camera >= S.db.cameras.count || task >= S.db.tasks.length) return false;
   if (camera === S.camera && task === S.task) return false;
   // A switch not yet on screen when the next one comes is recorded as superseded (never shown).
@@ -158,9 +178,10 @@ function select(camera, task, command) {
     warm: !!(st && st.decoder && st.decoder.state === "configured"),
     maxTickGap: 0,
   };
-  const t0 = performance.now();
-  diag.keyQueuedMs = lastKeyEvent ? t0 - lastKeyEvent : 0;  // 0 for a drag, a click or the API
-  lastKeyEvent = 0;
+  // The switch's clock starts at the input event's own timeStamp (same time base as performance.now()):
+  // the time the event waited for the main thread is part of what the user waits for (issue 30).
+  const th = performance.now(), t0 = eventTime > 0 && eventTime <= th ? eventTime : th;
+  diag.keyQueuedMs = th - t0;  // 0 for the API
   diag.at = t0;
   // demux0, output0, warm0: main-thread time on demuxing, decoder outputs and decoder creation from the key to the first display frame.
   S.pending = { t0, command, from: [S.camera, S.task], diag, demux0: traffic.demuxMs, output0: traffic.outputMs, warm0: traffic.warmMs, warms0: traffic.warms };
@@ -175,8 +196,8 @@ function select(camera, task, command) {
   S.releaseDue = true;
   const t1 = performance.now();
   pump();
-  diag.selectMs = performance.now() - t0;
-  diag.releaseMs = t1 - t0;
+  diag.selectMs = performance.now() - th;
+  diag.releaseMs = t1 - th;
   diag.closed = closed;
   return true;
 }
@@ -211,7 +232,7 @@ const busy = new Set();  // "c/t" with a pump batch in flight
 function firstMissing(c, t, f, ahead, stride = 1) {
   const n = S.db.frames;
   for (let k = 0; k < ahead; k++) {
-    let g = S.playing ? (f + k) % n : Math.min(f + k, n - 1);
+    let g = S.playing ? (((f + k * S.dir) % n) + n) % n : Math.min(f + k, n - 1);  // ahead in the playback direction (J)
     g -= g % stride;
     if (!cache.has(`${c}/${t}/${g}`)) return g;
   }
@@ -318,6 +339,7 @@ function pump() {
 
 // ---- drawing ------------------------------------------------------------------------------------
 function drawPlaceholder(camera, task, status, message) {
+  showSurface("flat");
   const w = canvas.width, h = canvas.height;
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.fillStyle = "#4a0d0d";
@@ -335,7 +357,33 @@ function drawPlaceholder(camera, task, status, message) {
   ctx.fillText(`camera ${camera} · task ${task + 1}`, w / 2, h / 2 + h / 12);
   S.message = message;
 }
+/// Which canvas is shown: "flat" (the 2-D canvas: flat frames, placeholders) or "look" (the 360° cut-out).
+let surface = "flat";
+function showSurface(which) {
+  if (which === surface) return;
+  surface = which;
+  canvas.hidden = which !== "flat";
+  lookCanvas.hidden = marksCanvas.hidden = which !== "look";
+}
+/// The orientation marks' world for the current camera (?marks=0, or before the cameras are in: none).
+function lookScene() {
+  if (!S.cams || !S.domainBox || params.get("marks") === "0") return null;
+  return { basis: basisOfCamera(S.cams, S.camera), position: positionOf(S.cams, S.camera), box: S.domainBox, sky: S.sky, north: [1, 0, 0] };
+}
+/// The cut-out and its marks, at the current look.
+function drawLook() {
+  lookView.draw(S.look);
+  drawOrientationMarks(marksCtx, marksCanvas.width, marksCanvas.height, lookScene(), S.look);
+}
+const marksCtx = marksCanvas.getContext("2d");
 function drawFrame(vf) {
+  if (lookView) {
+    lookView.upload(vf);
+    drawLook();
+    S.lookDirty = false;
+    showSurface("look");
+    return;
+  }
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.fillStyle = "#000";
   if (S.zoom !== 1) ctx.fillRect(0, 0, canvas.width, canvas.height);
@@ -350,6 +398,32 @@ function tick(now) {
   if (!S.db) return;
   if (S.pending && lastTick) S.pending.diag.maxTickGap = Math.max(S.pending.diag.maxTickGap, now - lastTick);
   lastTick = now;
+  render(now);
+  // A switch drawn by an input's handler or just now goes out with this display frame, once this
+  // callback (and the pump's work in it) is done: its clock stops here.
+  if (S.presenting) onScreen(S.presenting);
+}
+/// Stops a switch's clock (issue 30, honest latency): from the input event's own timeStamp to the
+/// display frame in which the canvas changed — at the end of that frame's rAF callback, once the drawn
+/// pixels exist (a 1-pixel read waits for the GPU, which may still be drawing the cut-out: the draw
+/// call only queues it). Not from the key handler and not to the draw call.
+function onScreen(w) {
+  // The 2-D canvas is not read back: Chromium may move a canvas that is read from to the CPU. Its
+  // drawImage is rasterised when this frame is committed, right after this callback.
+  const t1 = performance.now();
+  if (surface === "look" && lookView) lookView.finish();
+  const t = performance.now();
+  w.diag.finishMs = t - t1;  // waiting for the GPU's drawing
+  w.diag.untilFinishMs = t1 - w.t0;  // draw, pump and the rest of the callback
+  w.ms = t - w.t0;
+  w.screenAt = t;
+  if (S.presenting === w) S.presenting = null;
+}
+/// Draws what changed (a new frame, a switch's stream, a new look) and runs the pump. Called every
+/// display frame and, when an input changed the picture and its frame is decoded, at once from the
+/// input's handler: the change then reaches the next display frame instead of waiting a frame for
+/// the next rAF callback to draw it.
+function render(now) {
   const frame = currentFrame();
   const st = stream(S.camera, S.task);
   const key = `${S.camera}/${S.task}/${frame}`;
@@ -367,6 +441,11 @@ function tick(now) {
     d.warms = traffic.warms - S.pending.warms0;
   }
   if (S.pending) S.pending.seen = true;
+  if (same && S.lookDirty && lookView && lookView.hasFrame && surface === "look") {
+    drawLook();  // the look changed (drag, wheel, walk) or the cameras came in, the frame did not
+    S.lookDirty = false;
+    drawMinimap();
+  }
   if (!same) {
     const vf = cache.get(key);
     if (st.status === "ok" && st.damaged && st.damaged.has(frame)) {
@@ -390,7 +469,7 @@ function tick(now) {
       // this stream decoded on demand arrives late, show it rather than keep the old stream on screen.
       if (S.playing) {
         for (let back = 1; back <= 3; back++) {
-          const g = (frame - back + S.db.frames) % S.db.frames;
+          const g = (frame - back * S.dir + S.db.frames) % S.db.frames;  // behind the playhead, either direction
           if (S.shown && S.shown.camera === S.camera && S.shown.task === S.task && S.shown.frame === g) break;
           const late = cache.get(`${S.camera}/${S.task}/${g}`);
           if (late) {
@@ -406,11 +485,15 @@ function tick(now) {
   if (drawn) {
     const now = performance.now();
     S.shown = { camera: S.camera, task: S.task, frame: shownFrame, status };
+    S.shownKey = `${S.camera}/${S.task}/${shownFrame}`;
     if (S.firstFrameMs === null) { S.firstFrameMs = now; mark("drawn"); }
     if (S.pending) {
-      S.switches.push({ command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, hit: firstTickAfterSwitch,
-                        lag: (frame - shownFrame + S.db.frames) % S.db.frames, diag: S.pending.diag });
+      // ms: until the display frame that shows this draw (set at the next rAF; until then the draw).
+      const w = { command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, drawMs: now - S.pending.t0,
+                  t0: S.pending.t0, hit: firstTickAfterSwitch, lag: (S.dir * (frame - shownFrame) + S.db.frames) % S.db.frames, diag: S.pending.diag };
+      S.switches.push(w);
       S.pending = null;
+      S.presenting = w;  // on screen with the display frame of this or the next rAF callback (tick)
     }
     drawMinimap();
   }
@@ -424,14 +507,24 @@ function updateHud(frame) {
   const db = S.db, c = S.camera, task = db.tasks[S.task];
   const last = S.switches.findLast((w) => w.ms !== null);
   const axes = task.axes.map((a) => `${a.axis}=${db.axes.find((x) => x.name === a.axis)?.values[a.index]}`).join(" ");
-  const active = db.axes[S.axis] ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
+  const active = db.axes[S.axis] && !S.rig.walkable ? `PgUp/PgDn: ${db.axes[S.axis].name}` : "";
+  // Frames from 0 and "x speed, reverse, once" as the desktop HUD (ui/hud.cpp); tasks from 1 as the digit keys.
+  const speed = Number(S.speed.toPrecision(2));
+  let where;
+  if (!S.cams) where = `camera ${c}  (loading the camera table…)`;
+  else if (S.rig.lattice || S.rig.path) {
+    const p = positionOf(S.cams, c), v = viewDirection(S.cams, c, S.look);
+    const node = S.rig.lattice ? `  lattice (${latticeNode(S.rig.lattice, c).join(", ")}) of ${S.rig.lattice.join("x")}` : "";
+    const heading = ((Math.atan2(v[1], v[0]) * 180) / Math.PI + 360) % 360;  // from north (x) towards east (y)
+    where = `camera ${c}${node}  at (${p.map((x) => Number(x.toPrecision(4))).join(", ")})${db.domain_units ? " " + db.domain_units : ""}  heading ${Math.round(heading) % 360}°`;
+  } else where = `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°  shell ${S.cams.shell[c]}`;
   const text =
-    `${timeText(db, db.times[frame] ?? frame)}  frame ${frame + 1}/${db.frames}  ${S.playing ? "playing" : "paused"}${S.speed !== 1 ? " ×" + S.speed : ""}\n` +
-    (S.cams ? `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°  shell ${S.cams.shell[c]}\n`
-            : `camera ${c}  (loading the camera table…)\n`) +
-    `task ${S.task + 1}/${db.tasks.length} "${task.name}" ${axes}  ${active}\n` +
-    `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (next frame)" : " (waited for a decode)") : "—"}` +
-    `  zoom ${S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
+    `${timeText(db, db.times[frame] ?? frame)}  frame ${frame} of ${db.frames}  ${S.playing ? "playing" : "paused"} x${speed}${S.dir < 0 ? " reverse" : ""}${S.loop ? "" : " once"}\n` +
+    where + "\n" +
+    (S.rig.equirect ? (S.rig.walkable ? "" : "360 view  ") + lookText(S.look) + "\n" : "") +
+    `task ${S.task + 1} of ${db.tasks.length}: "${task.name}" ${axes}  ${active}\n` +
+    `last switch ${last ? last.ms.toFixed(1) + " ms" + (last.hit ? " (next frame)" : " (waited for a decode)") : "—"} (input event to screen)` +
+    `${S.rig.equirect ? "" : "  zoom " + S.zoom.toFixed(2)}${options.prefetch ? "" : "  prefetch off"}`;
   if (text !== lastHud) hud.textContent = lastHud = text;  // a DOM write per display frame costs a layout
   // The legend changes with the task and, for relative windows, with the frame's reference.
   const bars = taskLegend(db, S.task, frame), legendKey = JSON.stringify(bars);
@@ -451,6 +544,12 @@ function mapXY(i) {
 let mapBackground = null, mapBackgroundShell = null;
 function drawMinimap() {
   if (!S.cams) return;
+  if (S.latticeMap) {
+    const nb = COLUMNS.map((d) => graphNeighbour(S.camera, d)).filter((i) => i >= 0);
+    const fovH = (2 * Math.atan(Math.tan((S.look.fov * Math.PI) / 360) * (lookCanvas.width / lookCanvas.height)) * 180) / Math.PI;
+    S.latticeMap.draw(mapCtx, minimap.width, minimap.height, S.camera, nb, viewDirection(S.cams, S.camera, S.rig.equirect ? S.look : { yaw: 0, pitch: 0, fov: 90 }), S.rig.equirect ? fovH : 0);
+    return;
+  }
   const w = minimap.width, h = minimap.height, n = S.cams.count;
   const shell = S.cams.shell[S.camera];
   const radius = n > 2000 ? 1 : n > 300 ? 2 : 3;
@@ -496,6 +595,12 @@ minimap.addEventListener("click", (e) => {
   const px = ((e.clientX - r.left) / r.width) * minimap.width, py = ((e.clientY - r.top) / r.height) * minimap.height;
   let best = -1, bestD = Infinity;
   if (!S.cams) return;
+  inputEventTime = e.timeStamp;
+  if (S.latticeMap) {
+    const c = S.latticeMap.pick(px, py, minimap.width, minimap.height, S.camera);
+    if (c >= 0 && c !== S.camera) { trail.clear(); select(c, S.task, "minimap"); }
+    return;
+  }
   for (let i = 0; i < S.cams.count; i++) {
     const [x, y] = mapXY(i);
     const d = (x - px) ** 2 + (y - py) ** 2;
@@ -515,48 +620,129 @@ function zoomAt(factor, px, py) {
   S.shown = null;  // redraw
 }
 // Arrow keys (and Z/X): the opposite of the last move(s) retraces them (MoveTrail in cameras.js).
-const move = (d) => select(trail.next(S.camera, d, graphNeighbour(S.camera, d)), S.task, d);
-const actions = {
-  ArrowLeft: () => move("left"),
-  ArrowRight: () => move("right"),
-  ArrowUp: () => move("up"),
-  ArrowDown: () => move("down"),
-  z: () => move("in"),
-  x: () => move("out"),
-  Tab: (e) => select(S.camera, (S.task + (e.shiftKey ? S.db.tasks.length - 1 : 1)) % S.db.tasks.length, e.shiftKey ? "previous task" : "next task"),
-  PageUp: () => S.db.axes[S.axis] && select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, 1), "axis +1"),
-  PageDown: () => S.db.axes[S.axis] && select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, -1), "axis -1"),
-  a: () => { if (S.db.axes.length) S.axis = (S.axis + 1) % S.db.axes.length; },
-  " ": () => setPlaying(!S.playing),
-  ".": () => { S.playing = false; setFrame((currentFrame() + 1) % S.db.frames); },
-  ",": () => { S.playing = false; setFrame((currentFrame() + S.db.frames - 1) % S.db.frames); },
-  Home: () => setFrame(0),
-  End: () => setFrame(S.db.frames - 1),
-  l: () => { S.loop = !S.loop; },
-  ">": () => { const f = currentFrame(); S.speed = Math.min(8, S.speed * 2); setFrame(f); },
-  "<": () => { const f = currentFrame(); S.speed = Math.max(0.25, S.speed / 2); setFrame(f); },
-  "+": () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
-  "=": () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
-  "-": () => zoomAt(0.8, canvas.width / 2, canvas.height / 2),
-  0: () => { S.zoom = 1; S.panX = S.panY = 0; S.shown = null; },
-  "]": () => actions.PageUp(),
-  "[": () => actions.PageDown(),
-  h: () => document.getElementById("help").classList.toggle("hidden"),
+const move = (d) => {
+  const to = trail.next(S.camera, d, graphNeighbour(S.camera, d));
+  if (to < 0) notify(d === "in" || d === "out" ? `no ${d === "in" ? "closer" : "farther"} shell from this camera` : "no camera that way");
+  return select(to, S.task, d);
 };
-for (let k = 1; k <= 9; k++) actions[String(k)] = () => select(S.camera, k - 1, `task ${k}`);
-let lastKeyEvent = 0;  // the key's event time (diagnostics: how long it waited for the main thread)
+/// Walks to the neighbour in the walk's direction relative to the view, keeping the world view
+/// direction (player::walk_keeping_view).
+function walk(w) {
+  const to = walkTarget(S.cams, S.camera, S.look, w, S.keys && S.keys.walk ? S.keys.walk.min_cos : undefined);
+  if (to < 0) { notify("no camera that way"); return false; }
+  S.look = lookAfterWalk(S.cams, S.camera, to, S.look);
+  S.lookDirty = true;
+  trail.clear();
+  return select(to, S.task, `walk_${w}`);
+}
+function setLook(l) {
+  S.look = clamped(l);
+  S.lookDirty = true;
+}
+/// Speed factor, as player::Engine::set_speed (×¼..×8), keeping the playhead where it is.
+function setSpeed(v) {
+  const f = currentFrame();
+  S.speed = Math.min(pb("speed_max", 8), Math.max(pb("speed_min", 0.25), v));
+  setFrame(f);
+  notify(`speed x${S.speed.toFixed(2)} (${(S.speed * S.fps).toFixed(1)} frames/s)`);
+}
+/// A stepped frame wraps when looping, else stops at the ends (Engine::step_frame).
+function stepFrame(d) {
+  const n = S.db.frames, f = currentFrame() + d;
+  S.playing = false;
+  setFrame(S.loop ? ((f % n) + n) % n : Math.max(0, Math.min(n - 1, f)));
+}
+let notifyTimer = 0;
+/// A line in the status bar for 3 s (a key that changed nothing says why).
+function notify(text) {
+  S.message = text;
+  clearTimeout(notifyTimer);
+  notifyTimer = setTimeout(() => { if (S.message === text) S.message = ""; }, 3000);
+}
+function download(url, name) {
+  const a = document.createElement("a");
+  a.href = url;
+  a.download = name;
+  a.click();
+}
+/// The operations the key table's actions stand for (api/keys.json `actions`: per mode), by name.
+const pb = (k, dflt) => (S.keys && S.keys.playback && S.keys.playback[k]) || dflt;
+const lk = (k, dflt) => (S.keys && S.keys.look && S.keys.look[k]) || dflt;
+const stepAxis = (d) => (S.db.axes[S.axis] ? select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, d), d > 0 ? "axis_up" : "axis_down")
+                                          : notify("this database has no parameter axis to step here"));
+const OPS = {
+  play_pause: () => setPlaying(!S.playing),
+  frame_forward: () => stepFrame(1),
+  frame_back: () => stepFrame(-1),
+  first_frame: () => setFrame(0),
+  last_frame: () => setFrame(S.db.frames - 1),
+  toggle_loop: () => { const f = currentFrame(); S.loop = !S.loop; setFrame(f); notify(S.loop ? "loop on" : "loop off"); },
+  faster: () => setSpeed(S.speed * pb("faster_factor", 2)),
+  slower: () => setSpeed(S.speed / pb("faster_factor", 2)),
+  reverse: () => { const f = currentFrame(); S.dir = -S.dir; setFrame(f); },
+  speed_up: () => setSpeed(S.speed * pb("fine_factor", 1.1)),
+  speed_down: () => setSpeed(S.speed / pb("fine_factor", 1.1)),
+  speed_reset: () => setSpeed(1),
+  camera_left: () => move("left"),
+  camera_right: () => move("right"),
+  camera_up: () => move("up"),
+  camera_down: () => move("down"),
+  shell_in: () => move("in"),
+  shell_out: () => move("out"),
+  walk_forward: () => walk("forward"),
+  walk_back: () => walk("back"),
+  walk_left: () => walk("left"),
+  walk_right: () => walk("right"),
+  walk_up: () => walk("up"),
+  walk_down: () => walk("down"),
+  next_task: () => select(S.camera, (S.task + 1) % S.db.tasks.length, "next_task"),
+  previous_task: () => select(S.camera, (S.task + S.db.tasks.length - 1) % S.db.tasks.length, "previous_task"),
+  axis_up: () => stepAxis(1),
+  axis_down: () => stepAxis(-1),
+  next_axis: () => { if (S.db.axes.length) S.axis = (S.axis + 1) % S.db.axes.length; else notify("this database has no parameter axis to step here"); },
+  zoom_in: () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
+  zoom_out: () => zoomAt(0.8, canvas.width / 2, canvas.height / 2),
+  zoom_reset: () => { S.zoom = 1; S.panX = S.panY = 0; S.shown = null; },
+  fov_narrow: () => setLook({ ...S.look, fov: S.look.fov / lk("key_fov_factor", 1.25) }),
+  fov_widen: () => setLook({ ...S.look, fov: S.look.fov * lk("key_fov_factor", 1.25) }),
+  fov_reset: () => setLook({ ...S.look, fov: lk("fov_deg", 90) }),
+  fullscreen: () => (document.fullscreenElement ? document.exitFullscreen() : document.getElementById("stage").requestFullscreen()).catch((e) => notify(`full screen: ${e.message}`)),
+  screenshot: () => download((surface === "look" ? lookCanvas : canvas).toDataURL("image/png"), `panoptes-c${S.camera}-t${S.task}-f${currentFrame()}.png`),
+  help: () => document.getElementById("help").classList.toggle("hidden"),
+  toggle_hud: () => { S.hudHidden = !S.hudHidden; for (const id of ["hud", "minimap", "legend"]) document.getElementById(id).classList.toggle("off", S.hudHidden); },
+};
+for (let k = 1; k <= 9; k++) OPS[`task_${k}`] = () => select(S.camera, k - 1, `task_${k}`);
+/// Actions of the desktop that a browser page cannot do (left out of the help).
+const NOT_HERE = new Set(["record", "quit"]);
+const WHY_NOT = { record: "recording is the desktop player's (panoptes play, R); here use S for a screenshot", quit: "close the tab to quit" };
 document.addEventListener("keydown", (e) => {
   if (!S.db) return;
-  lastKeyEvent = e.timeStamp;
-  const action = actions[e.key] ?? actions[e.key.toLowerCase()];
-  if (!action || e.ctrlKey || e.metaKey || e.altKey) return;
+  const b = bindingOf(e, S.keys);
+  if (!b) return;
   e.preventDefault();
-  action(e);
+  inputEventTime = e.timeStamp;
+  const op = operationOf(S.keys, b.action, S.mode);
+  if (op === null) notify(`${b.desktop} does nothing in this database`);
+  else if (OPS[op]) OPS[op](e);
+  else notify(WHY_NOT[op] ?? `${b.desktop}: "${op}" is not available in the web player`);
+  inputEventTime = 0;
+  drawNowIfReady();
 });
+/// After an input: draw at once when the new picture's frame is decoded (else the rAF draws it when it is).
+function drawNowIfReady() {
+  if (!S.db || !options.drawOnInput) return;
+  if (S.pending ? cache.has(`${S.camera}/${S.task}/${currentFrame()}`) : S.lookDirty) render(performance.now());
+}
 canvas.addEventListener("wheel", (e) => {
   e.preventDefault();
   const r = canvas.getBoundingClientRect();
   zoomAt(e.deltaY < 0 ? 1.15 : 1 / 1.15, ((e.clientX - r.left) / r.width) * canvas.width, ((e.clientY - r.top) / r.height) * canvas.height);
+}, { passive: false });
+// 360°: the wheel narrows / widens the field of view (×1.15 a notch, as the desktop).
+lookCanvas.addEventListener("wheel", (e) => {
+  e.preventDefault();
+  const k = lk("wheel_fov_factor", 1.15);
+  setLook({ ...S.look, fov: S.look.fov * (e.deltaY < 0 ? 1 / k : k) });
 }, { passive: false });
 
 let dragLast = null;
@@ -573,13 +759,74 @@ canvas.addEventListener("pointermove", (e) => {
   drag.move(e.clientX - dragLast[0], e.clientY - dragLast[1], canvas.getBoundingClientRect().height);
   dragLast = [e.clientX, e.clientY];
   const c = nearestCamera(dirs(), S.cams.shell, drag.dir, S.cams.shell[S.camera]);
-  if (c >= 0 && c !== S.camera) { trail.clear(); select(c, S.task, "drag"); }
+  if (c >= 0 && c !== S.camera) { trail.clear(); inputEventTime = e.timeStamp; select(c, S.task, "drag"); }
 });
 const endDrag = () => { drag.end(); dragLast = null; };
 canvas.addEventListener("pointerup", endDrag);
 canvas.addEventListener("pointercancel", endDrag);
+// 360°: grab-and-drag looks around — the scene follows the pointer, one displayed pixel = fov / height
+// degrees (ui/window_app.cpp).
+let lookLast = null;
+lookCanvas.addEventListener("pointerdown", (e) => {
+  if (e.button !== 0) return;
+  lookCanvas.setPointerCapture(e.pointerId);
+  lookLast = [e.clientX, e.clientY];
+});
+lookCanvas.addEventListener("pointermove", (e) => {
+  if (!lookLast) return;
+  const perPx = S.look.fov / Math.max(1, lookCanvas.getBoundingClientRect().height);
+  setLook({ ...S.look, yaw: S.look.yaw - (e.clientX - lookLast[0]) * perPx, pitch: S.look.pitch + (e.clientY - lookLast[1]) * perPx });
+  lookLast = [e.clientX, e.clientY];
+  drawNowIfReady();
+});
+const endLook = () => { lookLast = null; };
+lookCanvas.addEventListener("pointerup", endLook);
+lookCanvas.addEventListener("pointercancel", endLook);
+
+/// The help line for the database at hand, from the key table.
+function showHelp() {
+  const el = document.getElementById("help");
+  if (!S.keys) return;
+
+  const mouse = S.rig.equirect ? "<b>drag</b>: look around · <b>wheel</b>: field of view" : "<b>drag</b>: rotate to the nearest camera · <b>wheel</b>: magnify";
+  const esc = (t) => t.replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" })[c]);
+  el.innerHTML = mouse + " · " + helpRows(S.keys, S.mode, NOT_HERE).map((r) => `<b>${esc(r.keys)}</b>: ${esc(r.text)}`).join(" · ");
+}
 
 // ---- start --------------------------------------------------------------------------------------
+/// Loads keys.json (beside index.html). Without it the keys do nothing and the page says why — the
+/// player keeps no second copy of the table.
+async function loadKeys() {
+  const url = base + "api/keys.json";
+  try {
+    const r = await fetch(url, { cache: "no-store" });
+    if (!r.ok) throw new Error(`HTTP ${r.status}`);
+    S.keys = parseKeyTable(await r.json(), url);
+    if (S.keys.look) Object.assign(LOOK_LIMITS, S.keys.look);
+    setMode();
+    showHelp();
+  } catch (e) {
+    S.keysError = `the key table ${url} could not be loaded (${e.message}): keys do nothing; the mouse still works. ` +
+      "It is written by panoptes serve / export-web of this version.";
+    document.getElementById("help").textContent = S.keysError;
+    notify(S.keysError);
+    clearTimeout(notifyTimer);  // stays
+  }
+}
+/// The key table's mode: as published for this database (serve, export-web), else by the same rule
+/// from the manifest's rig (docs/web.md: panorama = equirectangular, lattice = also a lattice or path).
+function setMode() {
+  S.mode = (S.keys && S.keys.mode) || (S.rig.walkable ? "lattice" : S.rig.equirect ? "panorama" : "sphere");
+}
+/// Lattice and path rigs get the top-view map (larger, square); others the longitude/latitude map.
+function setupMinimap() {
+  S.lookDirty = true;  // the cut-out's orientation marks need the cameras
+  if (!(S.rig.lattice || S.rig.path) || !S.cams) return;
+  S.latticeMap = new LatticeMap(S.cams, S.domainBox ?? null);
+  minimap.width = minimap.height = 260;
+  minimap.classList.add("lattice");
+  minimap.title = "top view (north up): click a camera of this depth layer";
+}
 async function main() {
   mark("scripts");
   if (!("VideoDecoder" in window)) {
@@ -594,16 +841,11 @@ async function main() {
   }
   const db = await res.json();
   mark("database.json");
-  canvas.width = db.image.width;
-  canvas.height = db.image.height;
-  // Frames are shown as large as the window allows (in-situ renders are often small).
-  const fit = () => {
-    const s = Math.max(0.1, Math.min((innerWidth - 20) / db.image.width, (innerHeight - 110) / db.image.height));
-    canvas.style.width = `${Math.floor(db.image.width * s)}px`;
-    canvas.style.height = `${Math.floor(db.image.height * s)}px`;
-  };
-  fit();
-  addEventListener("resize", fit);
+  // The key table (generated from the C++ one by serve / export-web) and the manifest's rig (360°,
+  // lattice) are fetched while the first stream opens; only drawing waits for them.
+  const keysLoaded = loadKeys();
+  const manifestLoaded = fetch(base + "db/panoptes.json", { cache: "no-store" })
+    .then((r) => (r.ok ? r.json() : null)).catch(() => null);  // without it the player shows frames flat
   document.title = `${db.title || "Panoptes"} — Panoptes web player`;
   document.getElementById("title").textContent =
     `${db.title}: ${db.cameras.count} cameras × ${db.tasks.length} tasks, ${db.frames} frames (${db.status})`;
@@ -615,6 +857,60 @@ async function main() {
   // Playback rate: ?fps=N, else the database's preferred rate (the desktop player's rule), else the movies'.
   S.fps = Number(params.get("fps")) || (db.playback_fps > 0 ? db.playback_fps : db.fps);
   pump();  // the first stream's open starts now, not at the first display frame (up to 16 ms later)
+  const manifest = await manifestLoaded;
+  S.rig = rigOf(manifest, db.cameras.count);
+  await keysLoaded;  // its playback and look parameters are needed below
+  setMode();
+  showHelp();  // the help for this kind of database
+  if (S.rig.equirect) {
+    try {
+      lookView = new LookView(lookCanvas);
+    } catch (e) {
+      S.message = e.message;  // shown flat, as before
+    }
+  }
+  const dom = manifest && manifest.domain;
+  if (dom && Array.isArray(dom.origin) && Array.isArray(dom.spacing) && Array.isArray(dom.dims))
+    S.domainBox = { lo: dom.origin, hi: dom.origin.map((o, a) => o + dom.spacing[a] * Math.max(0, dom.dims[a] - 1)) };
+  S.sky = dom && dom.up_axis === "z_down" ? [0, 0, -1] : [0, 0, 1];  // store::Domain::sky()
+  canvas.width = db.image.width;
+  canvas.height = db.image.height;
+  // Frames are shown as large as the window allows (in-situ renders are often small). The 360°
+  // cut-out fills the same place (2:1, as the desktop window), at the display's pixel density.
+  const fit = () => {
+    const s = Math.max(0.1, Math.min((innerWidth - 20) / db.image.width, (innerHeight - 110) / db.image.height));
+    const w = Math.floor(db.image.width * s), h = Math.floor(db.image.height * s);
+    for (const c of [canvas, lookCanvas, marksCanvas]) {
+      c.style.width = `${w}px`;
+      c.style.height = `${h}px`;
+    }
+    if (lookView) {
+      // At most 1.5 × the panorama's height: at a 90° field of view that is 3 drawn pixels per source
+      // pixel already (more only costs fragment work, which software GL pays per pixel); the browser
+      // scales the canvas to its place.
+      const k = Math.min(1, (1.5 * db.image.height) / (h * devicePixelRatio));
+      lookCanvas.width = Math.round(w * devicePixelRatio * k);
+      lookCanvas.height = Math.round(h * devicePixelRatio * k);
+      marksCanvas.width = Math.round(w * devicePixelRatio);  // lines at the display's resolution
+      marksCanvas.height = Math.round(h * devicePixelRatio);
+      S.lookDirty = true;
+    }
+  };
+  fit();
+  addEventListener("resize", fit);
+  // The desktop's short-run rule (ui/window_app.cpp): without a preferred rate, a run that would flash
+  // by in under 4 s at the movies' rate starts slower (×¼..×1), e.g. 24 frames at 30 fps last 3.2 s.
+  const short = pb("short_run", { shortest_run_s: 4, speed_min: 0.25 });
+  if (Number(params.get("speed")) > 0) S.speed = Math.min(pb("speed_max", 8), Math.max(pb("speed_min", 0.25), Number(params.get("speed"))));
+  else if (!Number(params.get("fps")) && !(db.playback_fps > 0) && db.frames > 1)
+    S.speed = Math.min(1, Math.max(short.speed_min, db.frames / (S.fps * short.shortest_run_s)));
+  S.anchorTime = performance.now();  // the clock starts with the first display loop, at that speed
+  if (lookView) {
+    // A 360° frame starts looking along the camera's forward direction with a 90° field of view.
+    const yaw = Number(params.get("yaw")) || 0, pitch = Number(params.get("pitch")) || 0, fov = Number(params.get("fov")) || lk("fov_deg", 90);
+    S.look = clamped({ yaw, pitch, fov });
+    showSurface("look");
+  }
   requestAnimationFrame(tick);
   // The first frame does not need the cameras: it is fetched meanwhile. Navigation by the graph, the
   // mini-map and drag start when the table is in (at 10^6 cameras it is tens of MB).
@@ -629,11 +925,13 @@ async function main() {
         if (cams.count !== db.cameras.count) throw new Error(`${cams.count} cameras, the manifest says ${db.cameras.count}`);
         S.cameraTableMs = { started: tStart, loaded: t0, parsed: performance.now(), bytes: buf.byteLength };
         S.cams = cams;
+        setupMinimap();
         drawMinimap();
       })
       .catch((e) => { S.message = `${url}: ${e.message}`; });
   } else {
     S.cams = camerasFromJson(db.cameras, db.graph);
+    setupMinimap();
   }
   // A database still being written grows: re-read its manifest every 2 s and re-open the streams
   // (their fragment indexes) when the frame count moved on.
@@ -654,9 +952,21 @@ async function main() {
   }, 2000);
 }
 
+let pixelHashCanvas = null;
 /// For tests and the benchmark (headless Chromium through puppeteer).
 window.panoptes = {
-  state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, frames: S.db ? S.db.frames : 0, playing: S.playing, zoom: S.zoom }),
+  state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, frames: S.db ? S.db.frames : 0, playing: S.playing, zoom: S.zoom,
+                  speed: S.speed, fps: S.fps, direction: S.dir, loop: S.loop, look: { ...S.look }, rig: S.rig, surface, hudHidden: S.hudHidden }),
+  /// The key table as loaded (null before or when keys.json failed) and why it failed.
+  keys: () => (S.keys ? S.keys.rows : null),
+  /// The key table's mode in use: sphere, panorama or lattice.
+  mode: () => S.mode,
+  keysError: () => S.keysError ?? null,
+  /// Sets the 360° look {yaw, pitch, fov} (clamped as the desktop).
+  setLook: (l) => setLook({ ...S.look, ...l }),
+  /// The camera a walk ("forward", "back", "left", "right", "up", "down") leads to from here, or -1.
+  walkTarget: (w) => walkTarget(S.cams, S.camera, S.look, w),
+  message: () => S.message,
   pause: () => setPlaying(false),
   shown: () => S.shown,
   switches: () => S.switches,
@@ -678,8 +988,31 @@ window.panoptes = {
   /// The stamp in the canvas pixels (zoom 1 only), or null.
   readStamp: () => {
     const w = canvas.width, h = canvas.height, b = stampBlock(w, h);
-    const img = ctx.getImageData(0, 0, STAMP_COLUMNS * b, STAMP_ROWS * b);
+    let g = ctx;
+    if (surface === "look") {  // the cut-out does not show the stamp: read the decoded frame it shows
+      const vf = S.shownKey && cache.map.get(S.shownKey);
+      if (!vf) return null;
+      const scratch = document.createElement("canvas");
+      scratch.width = w;
+      scratch.height = h;
+      g = scratch.getContext("2d");
+      g.drawImage(vf, 0, 0, w, h);
+    }
+    const img = g.getImageData(0, 0, STAMP_COLUMNS * b, STAMP_ROWS * b);
     return readStamp(img.data, img.width, w, h);
+  },
+  /// A hash of the shown canvas's pixels (the latency benchmark polls it for the change).
+  pixelHash: () => {
+    const c = surface === "look" ? lookCanvas : canvas;
+    const scratch = pixelHashCanvas ?? (pixelHashCanvas = document.createElement("canvas"));
+    scratch.width = 64;
+    scratch.height = 32;
+    const g = scratch.getContext("2d", { willReadFrequently: true });
+    g.drawImage(c, 0, 0, 64, 32);
+    const d = g.getImageData(0, 0, 64, 32).data;
+    let hsh = 2166136261;
+    for (let i = 0; i < d.length; i++) hsh = Math.imul(hsh ^ d[i], 16777619);
+    return hsh >>> 0;
   },
   select: (camera, task) => select(camera, task, "api"),
   /// The decoded frames of (camera, task) in the frame cache, ascending.

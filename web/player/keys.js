@@ -1,0 +1,67 @@
+// The player's key table as data: api/keys.json, generated from the C++ table (src/player/keys.cpp)
+// by `panoptes serve` and `panoptes export-web` (format: the top of docs/web.md), so the browser keeps
+// no second copy of it. A key press matches a binding, the binding names an action, the table's
+// `actions` says what the action does in the database's mode (sphere, panorama, lattice) — an
+// operation the player executes.
+
+export const MODES = ["sphere", "panorama", "lattice"];
+
+/// Checks and indexes keys.json. Throws Error naming the source and what is wrong.
+export function parseKeyTable(json, source = "keys.json") {
+  const rows = json && json.bindings;
+  if (!Array.isArray(rows) || rows.length === 0) throw new Error(`${source}: no "bindings" (expected the format of docs/web.md)`);
+  for (const [i, r] of rows.entries())
+    if (!r || typeof r.desktop !== "string" || typeof r.action !== "string" || !Array.isArray(r.keys))
+      throw new Error(`${source}: binding ${i} lacks "desktop", "action" or "keys"`);
+  if (json.mode !== undefined && !MODES.includes(json.mode)) throw new Error(`${source}: unknown mode "${json.mode}"`);
+  // event.key → bindings; those that name `shift` are tried first (Shift+Tab before Tab).
+  const byKey = new Map();
+  for (const r of rows)
+    for (const k of r.keys) {
+      if (!byKey.has(k)) byKey.set(k, []);
+      byKey.get(k).push(r);
+    }
+  for (const list of byKey.values()) list.sort((a, b) => (b.shift !== undefined) - (a.shift !== undefined));
+  return { rows, byKey, mode: json.mode ?? null, actions: json.actions ?? {}, walk: json.walk ?? null, look: json.look ?? null,
+           playback: json.playback ?? null, numbering: json.numbering ?? null };
+}
+
+/// The binding of a keydown event (event.key among its keys, and its shift state when it names one),
+/// or undefined; events with Ctrl, Alt or Meta match nothing.
+export function bindingOf(e, table) {
+  if (!table || e.ctrlKey || e.metaKey || e.altKey) return undefined;
+  return (table.byKey.get(e.key) ?? []).find((r) => r.shift === undefined || r.shift === e.shiftKey);
+}
+
+/// What an action does in a mode: the table's operation, null for nothing, the action's own name
+/// when the table has no `actions` entry for it.
+export function operationOf(table, action, mode) {
+  const a = table.actions[action];
+  if (!a || !(mode in a)) return action;
+  return a[mode];
+}
+
+/// Key names as a person reads them.
+const SHOWN = { Left: "←", Right: "→", Up: "↑", Down: "↓", Period: ".", Comma: ",", "Shift+Period": ">", "Shift+Comma": "<",
+                PageUp: "PgUp", PageDown: "PgDn" };
+const shown = (k) => SHOWN[k] ?? k;
+
+/// The help rows for the mode: [{keys, text, action}], the table's order, keys of one action with the
+/// same text on one line, digit keys folded into the first. Bindings not active in the mode, or whose
+/// action this player cannot do (`unsupported`: a Set of action names), are left out.
+export function helpRows(table, mode, unsupported = new Set()) {
+  const out = [], byAction = new Map();
+  for (const r of table.rows) {
+    if (unsupported.has(r.action) || (Array.isArray(r.modes) && !r.modes.includes(mode))) continue;
+    if (operationOf(table, r.action, mode) === null) continue;
+    const d = r.description;
+    const text = (d && typeof d === "object" ? d[mode] : d) ?? r.action;
+    const prev = byAction.get(r.action);
+    if (prev && prev.text === text) { prev.keys.push(shown(r.desktop)); continue; }
+    if (/^task_[2-9]$/.test(r.action) && byAction.has("task_1")) continue;
+    const row = { keys: [shown(r.desktop)], text, action: r.action };
+    byAction.set(r.action, row);
+    out.push(row);
+  }
+  return out.map((r) => ({ keys: r.keys.join(", "), text: r.text, action: r.action }));
+}

@@ -1,0 +1,135 @@
+// Looking around inside 360° (equirectangular) streams and walking between lattice cameras: a line
+// for line port of the desktop's rules in src/player/look.cpp (Look, camera_basis, look_basis,
+// look_towards, walk_target), so that a key walks to the same camera in the browser as in
+// `panoptes play` and `play --headless`. Vectors are [x, y, z] arrays in world coordinates.
+const DEG = Math.PI / 180;
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const norm = (a) => Math.hypot(a[0], a[1], a[2]);
+const normalize = (a) => scale(a, 1 / norm(a));
+
+/// C's remainder(): x − n·y with n the integer nearest x/y (ties to even).
+function remainder(x, y) {
+  const q = x / y;
+  let n = Math.round(q);
+  if (Math.abs(q - Math.trunc(q)) === 0.5) n = 2 * Math.round(q / 2);  // ties to even, as C
+  return x - n * y;
+}
+
+/// The look's limits: player::clamped's, replaced by keys.json's `look` block when it is loaded.
+export const LOOK_LIMITS = { pitch_max_deg: 89, fov_min_deg: 20, fov_max_deg: 120 };
+/// The look's range, as player::clamped: pitch within ±89°, field of view 20°..120°, yaw in (−180°, 180°].
+export function clamped(l, limits = LOOK_LIMITS) {
+  const out = {
+    yaw: remainder(l.yaw, 360),
+    pitch: Math.min(limits.pitch_max_deg, Math.max(-limits.pitch_max_deg, l.pitch)),
+    fov: Math.min(limits.fov_max_deg, Math.max(limits.fov_min_deg, l.fov)),
+  };
+  if (out.yaw === -180) out.yaw = 180;
+  return out;
+}
+
+/// The frame {forward, right, up} of a camera (position, lookAt, up), as player::camera_basis.
+export function cameraBasis(position, lookAt, up) {
+  const d = sub(lookAt, position);
+  if (!(norm(d) > 0)) return { forward: [0, 1, 0], right: [1, 0, 0], up: [0, 0, 1] };
+  const forward = normalize(d);
+  let u = up;
+  if (norm(u) === 0 || norm(cross(forward, normalize(u))) < 1e-6) {
+    const ax = Math.abs(forward[0]), ay = Math.abs(forward[1]), az = Math.abs(forward[2]);
+    u = az <= ax && az <= ay ? [0, 0, 1] : ay <= ax ? [0, 1, 0] : [1, 0, 0];
+  }
+  const right = normalize(cross(forward, u));
+  return { forward, right, up: cross(right, forward) };
+}
+
+/// The frame after turning by the look's yaw (about the camera's up), then its pitch.
+export function lookBasis(c, l) {
+  const cy = Math.cos(l.yaw * DEG), sy = Math.sin(l.yaw * DEG);
+  const cp = Math.cos(l.pitch * DEG), sp = Math.sin(l.pitch * DEG);
+  const heading = add(scale(c.forward, cy), scale(c.right, sy));
+  const right = sub(scale(c.right, cy), scale(c.forward, sy));
+  const forward = add(scale(heading, cp), scale(c.up, sp));
+  return { forward, right, up: cross(right, forward) };
+}
+
+/// The look of a camera (frame c) facing the world direction d, with field of view fov.
+export function lookTowards(c, d, fov) {
+  const x = dot(d, c.right), y = dot(d, c.up), z = dot(d, c.forward);
+  return clamped({ yaw: Math.atan2(x, z) / DEG, pitch: Math.atan2(y, Math.hypot(x, z)) / DEG, fov });
+}
+
+/// The manifest's rig: {equirect, lattice: [nx, ny, nz] or null, path}. As player::is_equirectangular
+/// and player::lattice_shape (a shape that does not match the camera count is not trusted).
+export function rigOf(manifest, cameraCount) {
+  const p = (manifest && manifest.rig && manifest.rig.parameters) || {};
+  const equirect = p.projection === "equirectangular";
+  let lattice = null;
+  if (Array.isArray(p.lattice) && p.lattice.length === 3 &&
+      p.lattice.every((v) => Number.isInteger(v) && v >= 1 && v <= 1 << 24) &&
+      p.lattice[0] * p.lattice[1] * p.lattice[2] === cameraCount)
+    lattice = p.lattice.slice();
+  return { equirect, lattice, path: p.path === true, walkable: equirect && (lattice !== null || p.path === true) };
+}
+
+/// Lattice node [i, j, k] of a camera id (i fastest), as player::lattice_node.
+export function latticeNode(shape, c) {
+  if (!shape || shape[0] < 1 || shape[1] < 1 || c < 0) return [0, 0, 0];
+  return [c % shape[0], Math.floor(c / shape[0]) % shape[1], Math.floor(c / (shape[0] * shape[1]))];
+}
+
+const vec = (cams, column, c) => [cams[column][3 * c], cams[column][3 * c + 1], cams[column][3 * c + 2]];
+/// The frame of camera c of the player's camera columns (cameras.js).
+export function basisOfCamera(cams, c) {
+  return cameraBasis(vec(cams, "position", c), vec(cams, "look_at", c), vec(cams, "up", c));
+}
+export const positionOf = (cams, c) => vec(cams, "position", c);
+
+/// The six walks, named as player::Walk.
+export const WALKS = ["forward", "back", "left", "right", "up", "down"];
+
+/// The neighbour of `camera` (any of its six graph slots) whose displacement is best aligned with the
+/// walk's world direction (angle below 60°), or −1: player::walk_target.
+export function walkTarget(cams, camera, look, walk, minCos = 0.5) {
+  if (!cams || !cams.neighbours || camera < 0 || camera >= cams.count) return -1;
+  const here = positionOf(cams, camera);
+  const cam = basisOfCamera(cams, camera);
+  const view = lookBasis(cam, look);
+  const d = { forward: view.forward, back: scale(view.forward, -1), right: view.right, left: scale(view.right, -1),
+              up: cam.up, down: scale(cam.up, -1) }[walk];
+  let best = -1, bestCos = minCos;  // cos 60°: never walk sideways when nothing lies ahead
+  for (let s = 0; s < 6; s++) {
+    const id = cams.neighbours[6 * camera + s];
+    if (id < 0 || id >= cams.count || id === camera) continue;
+    const step = sub(positionOf(cams, id), here);
+    const len = norm(step);
+    if (!(len > 0)) continue;
+    const c = dot(step, d) / len;
+    if (c > bestCos) { bestCos = c; best = id; }
+  }
+  return best;
+}
+
+/// The look at camera `to` that keeps the world view direction of `look` at camera `from`
+/// (player::walk_keeping_view).
+export function lookAfterWalk(cams, from, to, look) {
+  const view = lookBasis(basisOfCamera(cams, from), look);
+  return lookTowards(basisOfCamera(cams, to), view.forward, look.fov);
+}
+
+/// The world view direction of a look at camera c.
+export function viewDirection(cams, c, look) {
+  return lookBasis(basisOfCamera(cams, c), look).forward;
+}
+
+/// "look yaw -90  pitch +13  fov 60", as the desktop HUD (ui::look_text).
+export function lookText(l) {
+  const signed = (v) => {
+    const r = Math.round(v);
+    return r === 0 ? "0" : (r > 0 ? "+" : "") + r;
+  };
+  return `look yaw ${signed(l.yaw)}  pitch ${signed(l.pitch)}  fov ${Math.round(l.fov)}`;
+}
