@@ -81,7 +81,7 @@ std::vector<std::vector<Image>> capture_frames(const bench::InsituSetting& s, in
   const seismic::RunConfig rc = seismic::parse_run_config(seis_text, s.config, ".");
   if (!s.rig.empty()) cfg.rig = s.rig;
   cfg.output_dir = (std::filesystem::temp_directory_path() / ("insitu_study_" + std::to_string(::getpid()))).string();
-  cfg.overwrite = true;
+  cfg.mode = insitu::OutputMode::overwrite;
   cfg.up = {0, 0, -1};
   seismic::Solver solver(rc.solver);
   const auto& g = rc.solver.grid;

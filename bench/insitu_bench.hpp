@@ -91,7 +91,7 @@ inline InsituResult run_insitu_setting(const InsituSetting& s, const std::string
   if (s.gop > 0) cfg.video.gop = s.gop;
   if (s.crf >= 0) cfg.video.crf = s.crf;
   cfg.output_dir = out_dir;
-  cfg.overwrite = true;
+  cfg.mode = insitu::OutputMode::overwrite;
   cfg.up = {0, 0, -1};  // as panoptes run: depth is +z
   cfg.validate();
 
