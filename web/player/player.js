@@ -401,7 +401,12 @@ function tick(now) {
   render(now);
   // A switch drawn by an input's handler or just now goes out with this display frame, once this
   // callback (and the pump's work in it) is done: its clock stops here.
-  if (S.presenting) onScreen(S.presenting);
+  if (S.presenting) {
+    onScreen(S.presenting);
+    // The HUD written in render() carried the provisional figure (to the draw): show the final one in
+    // this same display frame, not one frame later.
+    updateHud(currentFrame());
+  }
 }
 /// Stops a switch's clock (issue 30, honest latency): from the input event's own timeStamp to the
 /// display frame in which the canvas changed — at the end of that frame's rAF callback, once the drawn

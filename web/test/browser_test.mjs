@@ -11,8 +11,6 @@ const serveBase = serveArg.replace(/\?.*/, "");  // the URL printed by serve, wi
 const serveUrl = serveArg;
 const require = createRequire(nodeModules + "/");
 // Until serve / export-web publish api/keys.json (issue 30), the page gets the table built from the C++ source.
-const { provideKeys } = await import(new URL("./keys_fixture.mjs", import.meta.url).href);
-const keysSource = new URL("../../src/player/keys.cpp", import.meta.url).pathname;
 const puppeteer = require("puppeteer-core");
 
 // The exported site behind the plainest static server: whole files only (200, no Range support).
@@ -48,7 +46,6 @@ async function check(name, fn) {
 
 async function open(url) {
   const page = await browser.newPage();
-  await provideKeys(page, keysSource);
   const errors = [];
   page.on("pageerror", (e) => errors.push(e.message));
   // Fetches of the missing and corrupt movies' indexes fail by design (404/422): not an error here.

@@ -12,9 +12,6 @@ import path from "node:path";
 
 const [url, chromium, nodeModules, panoptes, dbDir, shotDir, switchesArg, sphereUrl, sphereDir] = process.argv.slice(2);
 const require = createRequire(nodeModules + "/");
-// Until serve / export-web publish api/keys.json (issue 30), the page gets the table built from the C++ source.
-const { provideKeys } = await import(new URL("./keys_fixture.mjs", import.meta.url).href);
-const keysSource = new URL("../../src/player/keys.cpp", import.meta.url).pathname;
 const puppeteer = require("puppeteer-core");
 const latencySwitches = Number(switchesArg || 40);
 
@@ -36,7 +33,6 @@ async function check(name, fn) {
 }
 async function open(query) {
   const page = await browser.newPage();
-  await provideKeys(page, keysSource);
   await page.setViewport({ width: 1100, height: 700 });
   const errors = [];
   page.on("pageerror", (e) => errors.push(e.message));
@@ -250,7 +246,6 @@ await check("sphere rig: the same key script as play --headless gives the same (
                  ["Left", "ArrowLeft"], ["Down", "ArrowDown"], ["3", "3"], ["Shift+Tab", "Shift+Tab"]];
   const headless = headlessSwitches(sphereDir, 0, steps.map(([k], i) => `t=${(0.2 * (i + 1)).toFixed(1)} key=${k}`).join("\n") + "\n");
   const page = await browser.newPage();
-  await provideKeys(page, keysSource);
   await page.goto(sphereUrl + "?play=0&camera=0");
   await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded() && window.panoptes.keys(), { timeout: 20000 });
   assert.equal(await page.evaluate(() => window.panoptes.mode()), "sphere");

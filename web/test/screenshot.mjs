@@ -6,8 +6,6 @@ const [url, out, chromium, nodeModules] = process.argv.slice(2);
 const puppeteer = createRequire(nodeModules + "/")("puppeteer-core");
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox"] });
 const page = await browser.newPage();
-const { provideKeys } = await import(new URL("./keys_fixture.mjs", import.meta.url).href);
-await provideKeys(page, new URL("../../src/player/keys.cpp", import.meta.url).pathname);  // until serve publishes api/keys.json
 await page.setViewport({ width: 1000, height: 860 });
 await page.goto(url + "?play=1&camera=30&task=2&frame=11");
 await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded(), { timeout: 30000 });

@@ -8,8 +8,6 @@ const puppeteer = createRequire(nodeModules + "/")("puppeteer-core");
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true,
   args: ["--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"] });
 const page = await browser.newPage();
-const { provideKeys } = await import(new URL("./keys_fixture.mjs", import.meta.url).href);
-await provideKeys(page, new URL("../../src/player/keys.cpp", import.meta.url).pathname);  // until serve publishes api/keys.json
 await page.setViewport({ width: 1100, height: 700 });
 await page.goto(url + query);
 await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded() && window.panoptes.keys(), { timeout: 30000 });
