@@ -47,7 +47,7 @@ inline Manifest sample_manifest(int cameras, int tasks, int width = 64, int heig
   Manifest m;
   m.title = "sample";
   m.provenance = {"store test", "0.1.0", "2026-11-21T00:00:00Z", "host", "store_test --x", {{"note", "a b"}}};
-  m.domain = {{256, 512, 160}, {0, 0, 0}, {0.5, 0.5, 0.5}, "km", ""};
+  m.domain = {{256, 512, 160}, {0, 0, 0}, {0.5, 0.5, 0.5}, "km", "", ""};
   m.image.width = width;
   m.image.height = height;
   m.video.gop = 5;
