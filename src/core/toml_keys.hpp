@@ -4,9 +4,12 @@
 // Header-only so that only the modules that parse TOML (and link tomlplusplus) pull in toml++.
 #include <toml++/toml.h>
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 
@@ -73,6 +76,40 @@ inline std::string str(const Source& c, const toml::table& t, const std::string&
   }
   if (auto v = n->value_exact<std::string>()) return *v;
   c.fail(where + key, "expected a string");
+}
+
+/// The finite number `n` (an integer or a float); `key` names it in the error.
+inline double number_of(const Source& c, const toml::node& n, const std::string& key) {
+  if (auto v = n.value_exact<double>()) {
+    if (!std::isfinite(*v)) c.fail(key, "expected a finite number");
+    return *v;
+  }
+  if (auto v = n.value_exact<int64_t>()) return double(*v);
+  c.fail(key, "expected a number");
+}
+
+/// The number at `key`, `def` when absent.
+inline double num(const Source& c, const toml::table& t, const std::string& key, const std::string& where, double def) {
+  const auto* n = t.get(key);
+  return n ? number_of(c, *n, where + key) : def;
+}
+
+/// The array of numbers `n`.
+inline std::vector<double> numbers(const Source& c, const toml::node& n, const std::string& key) {
+  const auto* a = n.as_array();
+  if (!a) c.fail(key, "expected an array of numbers");
+  std::vector<double> v;
+  for (std::size_t i = 0; i < a->size(); ++i) v.push_back(number_of(c, *a->get(i), key + "[" + std::to_string(i) + "]"));
+  return v;
+}
+
+/// The colour [r, g, b] `n`, each in [0, 1].
+inline std::array<float, 3> colour(const Source& c, const toml::node& n, const std::string& key) {
+  const auto v = numbers(c, n, key);
+  if (v.size() != 3) c.fail(key, "expected [r, g, b] with three numbers in [0, 1]");
+  for (double x : v)
+    if (!(x >= 0 && x <= 1)) c.fail(key, "expected [r, g, b] with three numbers in [0, 1]");
+  return {float(v[0]), float(v[1]), float(v[2])};
 }
 
 }  // namespace panoptes::toml_keys

@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/file_read.hpp"
 #include "core/toml_keys.hpp"
+#include "insitu/task_plan.hpp"
 
 namespace panoptes::insitu {
 
@@ -32,153 +33,9 @@ const toml::table* table(const Ctx& c, const toml::table& t, const std::string& 
   return n->as_table();
 }
 
-double number_of(const Ctx& c, const toml::node& n, const std::string& key) {
-  if (auto v = n.value_exact<double>()) {
-    if (!std::isfinite(*v)) c.fail(key, "expected a finite number");
-    return *v;
-  }
-  if (auto v = n.value_exact<int64_t>()) return double(*v);
-  c.fail(key, "expected a number");
-}
-
-double num(const Ctx& c, const toml::table& t, const std::string& key, const std::string& where, double def) {
-  const auto* n = t.get(key);
-  return n ? number_of(c, *n, where + key) : def;
-}
-
-std::vector<double> numbers(const Ctx& c, const toml::node& n, const std::string& key) {
-  const auto* a = n.as_array();
-  if (!a) c.fail(key, "expected an array of numbers");
-  std::vector<double> v;
-  for (std::size_t i = 0; i < a->size(); ++i) v.push_back(number_of(c, *a->get(i), key + "[" + std::to_string(i) + "]"));
-  return v;
-}
-
-std::array<float, 3> colour(const Ctx& c, const toml::node& n, const std::string& key) {
-  const auto v = numbers(c, n, key);
-  if (v.size() != 3) c.fail(key, "expected [r, g, b] with three numbers in [0, 1]");
-  for (double x : v)
-    if (!(x >= 0 && x <= 1)) c.fail(key, "expected [r, g, b] with three numbers in [0, 1]");
-  return {float(v[0]), float(v[1]), float(v[2])};
-}
-
-WindowConfig window_of(const Ctx& c, const toml::node& n, const std::string& key, bool relative) {
-  const auto v = numbers(c, n, key);
-  if (v.size() != 2 || !(v[0] < v[1])) c.fail(key, "expected [lo, hi] with lo < hi");
-  return {v[0], v[1], relative};
-}
-
-TaskConfig parse_task(const Ctx& c, const toml::table& t, std::size_t index) {
-  const std::string where = "task[" + std::to_string(index) + "].";
-  TaskConfig tc;
-  const std::string type = str(c, t, "type", where, "volume");
-  static const std::set<std::string> common{"type", "name", "field", "fields"};
-  std::set<std::string> allowed = common;
-  if (type == "volume") {
-    tc.kind = TaskConfig::Kind::volume;
-    allowed.insert({"preset", "extinction_scale", "window", "windows", "relative", "axis_name"});
-  } else if (type == "volume2") {
-    tc.kind = TaskConfig::Kind::volume2;
-    allowed.insert({"preset", "preset2", "extinction_scale", "window", "window2", "relative"});
-  } else if (type == "isosurface") {
-    tc.kind = TaskConfig::Kind::isosurface;
-    allowed.insert({"isovalues", "isovalue", "relative", "colour", "axis_name"});
-  } else if (type == "slice") {
-    tc.kind = TaskConfig::Kind::slice;
-    allowed.insert({"preset", "window", "relative", "axis", "position", "positions", "axis_name"});
-  } else {
-    c.fail(where + "type", "\"" + type + "\"; expected volume, volume2, isosurface or slice");
-  }
-  only_keys(c, t, where.substr(0, where.size() - 1), allowed);
-  tc.name = str(c, t, "name", where, "");
-  if (tc.name.empty()) c.fail(where + "name", "missing (every task needs a unique name)");
-  if (const auto* f = t.get("field")) {
-    if (t.get("fields")) c.fail(where + "field", "give either field or fields, not both");
-    auto s = f->value_exact<std::string>();
-    if (!s || s->empty()) c.fail(where + "field", "expected a field name");
-    tc.fields = {*s};
-  } else if (const auto* fs = t.get("fields")) {
-    const auto* a = fs->as_array();
-    if (!a) c.fail(where + "fields", "expected an array of field names");
-    for (std::size_t i = 0; i < a->size(); ++i) {
-      auto s = a->get(i)->value_exact<std::string>();
-      if (!s || s->empty()) c.fail(where + "fields", "expected an array of field names");
-      tc.fields.push_back(*s);
-    }
-  }
-  const std::size_t want = tc.kind == TaskConfig::Kind::volume2 ? 2 : 1;
-  if (tc.fields.size() != want)
-    c.fail(where + (want == 2 ? "fields" : "field"),
-           want == 2 ? "a volume2 task reads exactly two fields: fields = [\"a\", \"b\"]"
-                     : "this task reads exactly one field: field = \"name\"");
-  const bool relative = boolean(c, t, "relative", where, true);
-  tc.axis = str(c, t, "axis_name", where, "");
-  auto check_preset = [&](const std::string& key, const std::string& p) {
-    const auto names = render::TransferFunction::preset_names();
-    if (std::find(names.begin(), names.end(), p) == names.end()) {
-      std::string list;
-      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-      c.fail(where + key, "unknown preset \"" + p + "\" (expected one of: " + list + ")");
-    }
-  };
-  switch (tc.kind) {
-    case TaskConfig::Kind::volume:
-    case TaskConfig::Kind::volume2:
-      tc.preset = str(c, t, "preset", where, tc.kind == TaskConfig::Kind::volume2 ? "p-wave" : "hot");
-      check_preset("preset", tc.preset);
-      tc.extinction_scale = float(num(c, t, "extinction_scale", where, 1));
-      if (!(tc.extinction_scale > 0)) c.fail(where + "extinction_scale", "expected a number > 0");
-      if (const auto* ws = t.get("windows")) {
-        if (t.get("window")) c.fail(where + "windows", "give either window or windows, not both");
-        const auto* a = ws->as_array();
-        if (!a || a->empty()) c.fail(where + "windows", "expected an array of [lo, hi] pairs");
-        tc.windows.clear();
-        for (std::size_t i = 0; i < a->size(); ++i)
-          tc.windows.push_back(window_of(c, *a->get(i), where + "windows[" + std::to_string(i) + "]", relative));
-      } else {
-        tc.windows = {t.get("window") ? window_of(c, *t.get("window"), where + "window", relative)
-                                      : WindowConfig{0, 1, relative}};
-      }
-      if (tc.kind == TaskConfig::Kind::volume2) {
-        tc.preset2 = str(c, t, "preset2", where, "s-wave");
-        check_preset("preset2", tc.preset2);
-        tc.window2 = t.get("window2") ? window_of(c, *t.get("window2"), where + "window2", relative)
-                                      : WindowConfig{0, 1, relative};
-      }
-      break;
-    case TaskConfig::Kind::isosurface:
-      tc.iso_relative = boolean(c, t, "relative", where, false);
-      if (const auto* v = t.get("isovalues")) {
-        if (t.get("isovalue")) c.fail(where + "isovalues", "give either isovalue or isovalues, not both");
-        tc.isovalues = numbers(c, *v, where + "isovalues");
-      } else if (const auto* v1 = t.get("isovalue")) {
-        tc.isovalues = {number_of(c, *v1, where + "isovalue")};
-      }
-      if (tc.isovalues.empty()) c.fail(where + "isovalues", "missing (at least one isovalue is required)");
-      if (const auto* col = t.get("colour")) tc.colour = colour(c, *col, where + "colour");
-      break;
-    case TaskConfig::Kind::slice: {
-      tc.preset = str(c, t, "preset", where, "diverging");
-      check_preset("preset", tc.preset);
-      tc.windows = {t.get("window") ? window_of(c, *t.get("window"), where + "window", relative)
-                                    : WindowConfig{-1, 1, relative}};
-      const std::string axis = str(c, t, "axis", where, "z");
-      if (axis != "x" && axis != "y" && axis != "z") c.fail(where + "axis", "\"" + axis + "\"; expected x, y or z");
-      tc.slice_axis = axis[0] - 'x';
-      if (const auto* p = t.get("positions")) {
-        if (t.get("position")) c.fail(where + "positions", "give either position or positions, not both");
-        tc.slice_positions = numbers(c, *p, where + "positions");
-      } else if (const auto* p1 = t.get("position")) {
-        tc.slice_positions = {number_of(c, *p1, where + "position")};
-      }
-      if (tc.slice_positions.empty()) c.fail(where + "positions", "expected at least one position");
-      for (double f : tc.slice_positions)
-        if (!(f >= 0 && f <= 1)) c.fail(where + "positions", "expected fractions of the domain in [0, 1]");
-      break;
-    }
-  }
-  return tc;
-}
+using toml_keys::colour;
+using toml_keys::num;
+using toml_keys::numbers;
 
 }  // namespace
 
@@ -208,8 +65,9 @@ void SessionConfig::validate() const {
   std::set<std::string> names;
   for (const TaskConfig& t : tasks) {
     if (!names.insert(t.name).second) throw Error("task \"" + t.name + "\": the name is used twice");
-    if (t.kind == TaskConfig::Kind::isosurface && t.isovalues.empty())
-      throw Error("task \"" + t.name + "\": no isovalue");
+    // Configurations built in code (C API, Python) skip parse_task_table's checks: an empty sweep
+    // would render nothing.
+    if (planned_task_count(t) == 0) throw Error("task \"" + t.name + "\": no isovalue, window or slice position");
   }
   if ((schedule.every_steps > 0) == (schedule.every_time > 0))
     throw Error("schedule: give exactly one of every_steps (> 0) or every_time (> 0)");
@@ -353,7 +211,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     for (std::size_t i = 0; i < a->size(); ++i) {
       const auto* tt = a->get(i)->as_table();
       if (!tt) c.fail("task[" + std::to_string(i) + "]", "expected a table [[task]]");
-      s.tasks.push_back(parse_task(c, *tt, i));
+      s.tasks.push_back(parse_task_table(c, *tt, i));
     }
   }
   if (s.tasks.empty()) c.fail("task", "no [[task]] given; at least one visualization task is required");

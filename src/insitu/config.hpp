@@ -33,10 +33,11 @@ struct WindowConfig {
 /// One task, or a sweep of tasks along one parameter axis (several isovalues, windows or slice
 /// positions give several tasks, placed on a manifest axis so the player can step through them).
 struct TaskConfig {
-  enum class Kind { volume, volume2, isosurface, slice };
-  Kind kind = Kind::volume;
+  /// The renderer's kind; a volume reading two fields is TOML's type = "volume2" (task_plan.hpp maps
+  /// the [[task]] keys of every kind).
+  render::TaskKind kind = render::TaskKind::volume;
   std::string name;                  ///< unique; sweeps append " <value>" per task
-  std::vector<std::string> fields;   ///< 1 field (volume2: 2)
+  std::vector<std::string> fields;   ///< 1 field (a volume of two fields: 2)
   std::string preset = "hot";        ///< transfer function (volume, slice colour map)
   std::string preset2 = "s-wave";    ///< volume2: second field's transfer function
   float extinction_scale = 1;

@@ -7,6 +7,7 @@
 #include "camera/rig_spec.hpp"
 #include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
+#include "insitu/task_plan.hpp"
 #include "video/writer_memory.hpp"
 
 namespace panoptes::insitu {
@@ -27,10 +28,7 @@ MemoryEstimate estimate_session_memory(const SessionConfig& cfg, double block_po
       if (std::find(fields.begin(), fields.end(), f) == fields.end()) fields.push_back(f);
   double tasks = 0;  // sweeps expand to one task per value
   for (const TaskConfig& t : cfg.tasks)
-    tasks += double(std::max<std::size_t>(
-        1, t.kind == TaskConfig::Kind::isosurface ? t.isovalues.size()
-                                                  : t.kind == TaskConfig::Kind::slice ? t.slice_positions.size()
-                                                                                      : t.windows.size()));
+    tasks += double(std::max<std::size_t>(1, planned_task_count(t)));
   const double px = double(cfg.width) * cfg.height;
   const double owned = std::ceil(double(cameras) / ranks);
   MemoryEstimate e;

@@ -1,13 +1,17 @@
 #include "insitu/task_plan.hpp"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <set>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/toml_keys.hpp"
 
 namespace panoptes::insitu {
 
@@ -34,7 +38,144 @@ render::ValueWindow window_of(const WindowConfig& w) {
   return w.relative ? render::ValueWindow::relative_to(w.lo, w.hi) : render::ValueWindow::absolute(w.lo, w.hi);
 }
 
+// A volume of two fields (the paper's p- and s-waves in one image) is a render volume; TOML spells it
+// "volume2" so that a one-field volume's window sweeps and a two-field volume's keys stay apart.
+constexpr const char* kVolume2 = "volume2";
+
+bool two_fields(const TaskConfig& t) { return t.kind == render::TaskKind::volume && t.fields.size() == 2; }
+
+WindowConfig window_at(const toml_keys::Source& c, const toml::node& n, const std::string& key, bool relative) {
+  const auto v = toml_keys::numbers(c, n, key);
+  if (v.size() != 2 || !(v[0] < v[1])) c.fail(key, "expected [lo, hi] with lo < hi");
+  return {v[0], v[1], relative};
+}
+
 }  // namespace
+
+TaskConfig parse_task_table(const toml_keys::Source& c, const toml::table& t, std::size_t index) {
+  using toml_keys::boolean;
+  using toml_keys::num;
+  using toml_keys::number_of;
+  using toml_keys::numbers;
+  using toml_keys::str;
+  const std::string where = "task[" + std::to_string(index) + "].";
+  TaskConfig tc;
+  const std::string type = str(c, t, "type", where, "volume");
+  const bool volume2 = type == kVolume2;
+  try {
+    tc.kind = volume2 ? render::TaskKind::volume : render::parse_task_kind(type);
+  } catch (const Error&) {
+    c.fail(where + "type", "\"" + type + "\"; expected volume, volume2, isosurface or slice");
+  }
+  std::set<std::string> allowed{"type", "name", "field", "fields"};
+  switch (tc.kind) {
+    case render::TaskKind::volume:
+      if (volume2) allowed.insert({"preset", "preset2", "extinction_scale", "window", "window2", "relative"});
+      else allowed.insert({"preset", "extinction_scale", "window", "windows", "relative", "axis_name"});
+      break;
+    case render::TaskKind::isosurface: allowed.insert({"isovalues", "isovalue", "relative", "colour", "axis_name"}); break;
+    case render::TaskKind::slice:
+      allowed.insert({"preset", "window", "relative", "axis", "position", "positions", "axis_name"});
+      break;
+  }
+  toml_keys::only_keys(c, t, where.substr(0, where.size() - 1), allowed);
+  tc.name = str(c, t, "name", where, "");
+  if (tc.name.empty()) c.fail(where + "name", "missing (every task needs a unique name)");
+  if (const auto* f = t.get("field")) {
+    if (t.get("fields")) c.fail(where + "field", "give either field or fields, not both");
+    auto s = f->value_exact<std::string>();
+    if (!s || s->empty()) c.fail(where + "field", "expected a field name");
+    tc.fields = {*s};
+  } else if (const auto* fs = t.get("fields")) {
+    const auto* a = fs->as_array();
+    if (!a) c.fail(where + "fields", "expected an array of field names");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      auto s = a->get(i)->value_exact<std::string>();
+      if (!s || s->empty()) c.fail(where + "fields", "expected an array of field names");
+      tc.fields.push_back(*s);
+    }
+  }
+  const std::size_t want = volume2 ? 2 : 1;
+  if (tc.fields.size() != want)
+    c.fail(where + (want == 2 ? "fields" : "field"),
+           want == 2 ? "a volume2 task reads exactly two fields: fields = [\"a\", \"b\"]"
+                     : "this task reads exactly one field: field = \"name\"");
+  const bool relative = boolean(c, t, "relative", where, true);
+  tc.axis = str(c, t, "axis_name", where, "");
+  auto check_preset = [&](const std::string& key, const std::string& p) {
+    const auto names = render::TransferFunction::preset_names();
+    if (std::find(names.begin(), names.end(), p) == names.end()) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      c.fail(where + key, "unknown preset \"" + p + "\" (expected one of: " + list + ")");
+    }
+  };
+  switch (tc.kind) {
+    case render::TaskKind::volume:
+      tc.preset = str(c, t, "preset", where, volume2 ? "p-wave" : "hot");
+      check_preset("preset", tc.preset);
+      tc.extinction_scale = float(num(c, t, "extinction_scale", where, 1));
+      if (!(tc.extinction_scale > 0)) c.fail(where + "extinction_scale", "expected a number > 0");
+      if (const auto* ws = t.get("windows")) {
+        if (t.get("window")) c.fail(where + "windows", "give either window or windows, not both");
+        const auto* a = ws->as_array();
+        if (!a || a->empty()) c.fail(where + "windows", "expected an array of [lo, hi] pairs");
+        tc.windows.clear();
+        for (std::size_t i = 0; i < a->size(); ++i)
+          tc.windows.push_back(window_at(c, *a->get(i), where + "windows[" + std::to_string(i) + "]", relative));
+      } else {
+        tc.windows = {t.get("window") ? window_at(c, *t.get("window"), where + "window", relative)
+                                      : WindowConfig{0, 1, relative}};
+      }
+      if (volume2) {
+        tc.preset2 = str(c, t, "preset2", where, "s-wave");
+        check_preset("preset2", tc.preset2);
+        tc.window2 = t.get("window2") ? window_at(c, *t.get("window2"), where + "window2", relative)
+                                      : WindowConfig{0, 1, relative};
+      }
+      break;
+    case render::TaskKind::isosurface:
+      tc.iso_relative = boolean(c, t, "relative", where, false);
+      if (const auto* v = t.get("isovalues")) {
+        if (t.get("isovalue")) c.fail(where + "isovalues", "give either isovalue or isovalues, not both");
+        tc.isovalues = numbers(c, *v, where + "isovalues");
+      } else if (const auto* v1 = t.get("isovalue")) {
+        tc.isovalues = {number_of(c, *v1, where + "isovalue")};
+      }
+      if (tc.isovalues.empty()) c.fail(where + "isovalues", "missing (at least one isovalue is required)");
+      if (const auto* col = t.get("colour")) tc.colour = toml_keys::colour(c, *col, where + "colour");
+      break;
+    case render::TaskKind::slice: {
+      tc.preset = str(c, t, "preset", where, "diverging");
+      check_preset("preset", tc.preset);
+      tc.windows = {t.get("window") ? window_at(c, *t.get("window"), where + "window", relative)
+                                    : WindowConfig{-1, 1, relative}};
+      const std::string axis = str(c, t, "axis", where, "z");
+      if (axis != "x" && axis != "y" && axis != "z") c.fail(where + "axis", "\"" + axis + "\"; expected x, y or z");
+      tc.slice_axis = axis[0] - 'x';
+      if (const auto* p = t.get("positions")) {
+        if (t.get("position")) c.fail(where + "positions", "give either position or positions, not both");
+        tc.slice_positions = numbers(c, *p, where + "positions");
+      } else if (const auto* p1 = t.get("position")) {
+        tc.slice_positions = {number_of(c, *p1, where + "position")};
+      }
+      if (tc.slice_positions.empty()) c.fail(where + "positions", "expected at least one position");
+      for (double f : tc.slice_positions)
+        if (!(f >= 0 && f <= 1)) c.fail(where + "positions", "expected fractions of the domain in [0, 1]");
+      break;
+    }
+  }
+  return tc;
+}
+
+std::size_t planned_task_count(const TaskConfig& t) {
+  switch (t.kind) {
+    case render::TaskKind::volume: return two_fields(t) ? 1 : t.windows.size();
+    case render::TaskKind::isosurface: return t.isovalues.size();
+    case render::TaskKind::slice: return t.slice_positions.size();
+  }
+  return 1;
+}
 
 TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeometry& grid) {
   auto field_index = [&](const std::string& name) {
@@ -50,19 +191,18 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
     std::string axis_suffix;
     std::vector<double> axis_values;
     switch (tc.kind) {
-      case TaskConfig::Kind::volume:
+      case render::TaskKind::volume:
+        if (two_fields(tc)) break;
         n = tc.windows.size();
         axis_suffix = "window";
         for (const auto& w : tc.windows) axis_values.push_back(w.hi);
         break;
-      case TaskConfig::Kind::volume2:
-        break;
-      case TaskConfig::Kind::isosurface:
+      case render::TaskKind::isosurface:
         n = tc.isovalues.size();
         axis_suffix = "isovalue";
         axis_values = tc.isovalues;
         break;
-      case TaskConfig::Kind::slice:
+      case render::TaskKind::slice:
         n = tc.slice_positions.size();
         axis_suffix = "position";
         axis_values = tc.slice_positions;
@@ -76,7 +216,24 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
       t.entry.fields = tc.fields;
       if (n > 1) t.entry.axes = {{axis_name, int(i)}};
       switch (tc.kind) {
-        case TaskConfig::Kind::volume: {
+        case render::TaskKind::volume: {
+          if (two_fields(tc)) {
+            const WindowConfig& w = tc.windows[0];
+            t.spec = render::TaskSpec::volume2(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale),
+                                               window_of(w), f2,
+                                               render::TransferFunction::preset(tc.preset2, tc.extinction_scale),
+                                               window_of(tc.window2));
+            t.relative = w.relative;
+            t.relative2 = tc.window2.relative;
+            t.entry.method = "volume";
+            t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
+                                  {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
+                                  {"relative", w.relative},      {"extinction_scale", tc.extinction_scale},
+                                  {"relative2", tc.window2.relative},
+                                  {"transfer_function", transfer_json(t.spec.tf)},
+                                  {"transfer_function2", transfer_json(t.spec.tf2)}};
+            break;
+          }
           const WindowConfig& w = tc.windows[i];
           t.spec = render::TaskSpec::volume(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale), window_of(w));
           t.relative = w.relative;
@@ -86,24 +243,7 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
                                 {"transfer_function", transfer_json(t.spec.tf)}};
           break;
         }
-        case TaskConfig::Kind::volume2: {
-          const WindowConfig& w = tc.windows[0];
-          t.spec = render::TaskSpec::volume2(f, render::TransferFunction::preset(tc.preset, tc.extinction_scale),
-                                             window_of(w), f2,
-                                             render::TransferFunction::preset(tc.preset2, tc.extinction_scale),
-                                             window_of(tc.window2));
-          t.relative = w.relative;
-          t.relative2 = tc.window2.relative;
-          t.entry.method = "volume";
-          t.entry.parameters = {{"preset", tc.preset},         {"window", {w.lo, w.hi}},
-                                {"preset2", tc.preset2},       {"window2", {tc.window2.lo, tc.window2.hi}},
-                                {"relative", w.relative},      {"extinction_scale", tc.extinction_scale},
-                                {"relative2", tc.window2.relative},
-                                {"transfer_function", transfer_json(t.spec.tf)},
-                                {"transfer_function2", transfer_json(t.spec.tf2)}};
-          break;
-        }
-        case TaskConfig::Kind::isosurface:
+        case render::TaskKind::isosurface:
           t.spec = render::TaskSpec::isosurface(f, float(tc.isovalues[i]), {tc.colour[0], tc.colour[1], tc.colour[2]});
           t.iso_relative = tc.iso_relative;
           t.iso_fraction = tc.isovalues[i];
@@ -111,7 +251,7 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
           t.entry.parameters = {{"isovalue", tc.isovalues[i]}, {"relative", tc.iso_relative},
                                 {"colour", {tc.colour[0], tc.colour[1], tc.colour[2]}}};
           break;
-        case TaskConfig::Kind::slice: {
+        case render::TaskKind::slice: {
           const WindowConfig& w = tc.windows[0];
           const int a = tc.slice_axis;
           const double pos = grid.origin[a] + tc.slice_positions[i] * (grid.dims[a] - 1) * grid.spacing[a];
@@ -179,28 +319,37 @@ TaskConfig parse_task_shorthand(const std::string& text, const std::string& fiel
   TaskConfig t;
   t.name = text;
   t.fields = {field};
-  if (parts[0] == "volume" && (parts.size() == 2 || parts.size() == 4)) {
-    t.kind = TaskConfig::Kind::volume;
-    t.preset = preset(parts[1]);
-    // Relative default: [0, ref] (|v| for the wave presets), [-ref, ref] for the diverging map.
-    t.windows = {parts.size() == 4 ? absolute(parts[2], parts[3])
-                                   : WindowConfig{t.preset == "diverging" ? -1.0 : 0.0, 1.0, true}};
-  } else if (parts[0] == "iso" && parts.size() == 2) {
-    t.kind = TaskConfig::Kind::isosurface;
-    t.isovalues = {number(parts[1])};
-  } else if (parts[0] == "slice" && (parts.size() == 3 || parts.size() == 4 || parts.size() == 6)) {
-    t.kind = TaskConfig::Kind::slice;
-    const std::string axes = "xyz";
-    if (parts[1].size() != 1 || axes.find(parts[1][0]) == std::string::npos)
-      throw Error("--task \"" + text + "\": slice axis \"" + parts[1] + "\"; expected x, y or z");
-    t.slice_axis = int(axes.find(parts[1][0]));
-    const double f = number(parts[2]);
-    if (!(f >= 0 && f <= 1)) throw Error("--task \"" + text + "\": slice position " + parts[2] + "; expected a fraction in [0, 1]");
-    t.slice_positions = {f};
-    t.preset = parts.size() >= 4 ? preset(parts[3]) : "diverging";
-    t.windows = {parts.size() == 6 ? absolute(parts[4], parts[5]) : WindowConfig{-1, 1, true}};
-  } else {
+  // The first word is a render::TaskKind word; "iso" abbreviates "isosurface".
+  try {
+    t.kind = render::parse_task_kind(parts[0] == "iso" ? "isosurface" : parts[0]);
+  } catch (const Error&) {
     throw Error("--task \"" + text + "\"" + usage);
+  }
+  switch (t.kind) {
+    case render::TaskKind::volume:
+      if (parts.size() != 2 && parts.size() != 4) throw Error("--task \"" + text + "\"" + usage);
+      t.preset = preset(parts[1]);
+      // Relative default: [0, ref] (|v| for the wave presets), [-ref, ref] for the diverging map.
+      t.windows = {parts.size() == 4 ? absolute(parts[2], parts[3])
+                                     : WindowConfig{t.preset == "diverging" ? -1.0 : 0.0, 1.0, true}};
+      break;
+    case render::TaskKind::isosurface:
+      if (parts.size() != 2) throw Error("--task \"" + text + "\"" + usage);
+      t.isovalues = {number(parts[1])};
+      break;
+    case render::TaskKind::slice: {
+      if (parts.size() != 3 && parts.size() != 4 && parts.size() != 6) throw Error("--task \"" + text + "\"" + usage);
+      const std::string axes = "xyz";
+      if (parts[1].size() != 1 || axes.find(parts[1][0]) == std::string::npos)
+        throw Error("--task \"" + text + "\": slice axis \"" + parts[1] + "\"; expected x, y or z");
+      t.slice_axis = int(axes.find(parts[1][0]));
+      const double f = number(parts[2]);
+      if (!(f >= 0 && f <= 1)) throw Error("--task \"" + text + "\": slice position " + parts[2] + "; expected a fraction in [0, 1]");
+      t.slice_positions = {f};
+      t.preset = parts.size() >= 4 ? preset(parts[3]) : "diverging";
+      t.windows = {parts.size() == 6 ? absolute(parts[4], parts[5]) : WindowConfig{-1, 1, true}};
+      break;
+    }
   }
   return t;
 }
@@ -212,7 +361,7 @@ std::vector<TaskConfig> tasks_from_shorthand(const std::vector<std::string>& tex
     for (const TaskConfig& t : tasks)
       if (t.name == text) throw Error("--task \"" + text + "\" is given twice");
     TaskConfig t = parse_task_shorthand(text, field);
-    isos += t.kind == TaskConfig::Kind::isosurface;
+    isos += t.kind == render::TaskKind::isosurface;
     tasks.push_back(std::move(t));
   }
   if (isos < 2) return tasks;
@@ -220,7 +369,7 @@ std::vector<TaskConfig> tasks_from_shorthand(const std::vector<std::string>& tex
   std::vector<TaskConfig> merged;
   std::size_t sweep = SIZE_MAX;  // an index: merged grows, a pointer into it would dangle
   for (TaskConfig& t : tasks) {
-    if (t.kind != TaskConfig::Kind::isosurface) {
+    if (t.kind != render::TaskKind::isosurface) {
       merged.push_back(std::move(t));
       continue;
     }
@@ -236,7 +385,7 @@ std::vector<TaskConfig> tasks_from_shorthand(const std::vector<std::string>& tex
     merged[sweep].isovalues.push_back(t.isovalues[0]);
   }
   for (const TaskConfig& t : merged)
-    if (t.kind != TaskConfig::Kind::isosurface && t.name == "iso")
+    if (t.kind != render::TaskKind::isosurface && t.name == "iso")
       throw Error("--task names: \"iso\" is the isovalue sweep's name");
   return merged;
 }
@@ -269,14 +418,12 @@ std::string task_table_toml(const TaskConfig& t) {
     return s + "]";
   };
   std::string s = "[[task]]\nname = " + q(t.name) + "\n";
-  const char* type[] = {"volume", "volume2", "isosurface", "slice"};
-  s += "type = " + q(type[int(t.kind)]) + "\n";
+  s += "type = " + q(two_fields(t) ? kVolume2 : render::to_string(t.kind)) + "\n";
   if (t.fields.size() == 1) s += "field = " + q(t.fields[0]) + "\n";
   else s += "fields = [" + q(t.fields.at(0)) + ", " + q(t.fields.at(1)) + "]\n";
-  if (!t.axis.empty() && t.kind != TaskConfig::Kind::volume2) s += "axis_name = " + q(t.axis) + "\n";
+  if (!t.axis.empty() && !two_fields(t)) s += "axis_name = " + q(t.axis) + "\n";
   switch (t.kind) {
-    case TaskConfig::Kind::volume:
-    case TaskConfig::Kind::volume2:
+    case render::TaskKind::volume:
       s += "preset = " + q(t.preset) + "\n";
       if (t.extinction_scale != 1) s += "extinction_scale = " + numf(t.extinction_scale) + "\n";
       s += std::string("relative = ") + (t.windows.at(0).relative ? "true" : "false") + "\n";
@@ -288,15 +435,15 @@ std::string task_table_toml(const TaskConfig& t) {
           s += (i ? ", " : "") + list({t.windows[i].lo, t.windows[i].hi});
         s += "]\n";
       }
-      if (t.kind == TaskConfig::Kind::volume2)
+      if (two_fields(t))
         s += "preset2 = " + q(t.preset2) + "\nwindow2 = " + list({t.window2.lo, t.window2.hi}) + "\n";
       break;
-    case TaskConfig::Kind::isosurface:
+    case render::TaskKind::isosurface:
       s += (t.isovalues.size() == 1 ? "isovalue = " + num(t.isovalues[0]) : "isovalues = " + list(t.isovalues)) + "\n";
       s += std::string("relative = ") + (t.iso_relative ? "true" : "false") + "\n";
       s += "colour = [" + numf(t.colour[0]) + ", " + numf(t.colour[1]) + ", " + numf(t.colour[2]) + "]\n";
       break;
-    case TaskConfig::Kind::slice:
+    case render::TaskKind::slice:
       s += std::string("axis = \"") + char('x' + t.slice_axis) + "\"\n";
       s += (t.slice_positions.size() == 1 ? "position = " + num(t.slice_positions[0])
                                           : "positions = " + list(t.slice_positions)) + "\n";

@@ -3,6 +3,8 @@
 // or `panoptes render`'s --task shorthand, which means the same tables). It holds the renderer's task
 // list, how each window or isovalue follows the per-field reference, the parameter axes of sweeps and
 // the manifest's task entries — one vocabulary and one manifest wording for every door (issue 30).
+// The task kinds are render::TaskKind; this file is the only insitu file that maps a kind's TOML keys,
+// shorthand and manifest entry, so a new kind touches render/ plus task_plan.cpp (docs/extending.md).
 #include <string>
 #include <vector>
 
@@ -10,7 +12,19 @@
 #include "render/renderer.hpp"
 #include "store/manifest.hpp"
 
+namespace panoptes::toml_keys {
+struct Source;
+}
+
 namespace panoptes::insitu {
+
+/// Reads one [[task]] table (the `index`-th, for messages): `type` is a render::TaskKind word
+/// ("volume", "isosurface", "slice") or "volume2" (a volume of two fields); only the kind's keys are
+/// accepted. Throws FileError naming `task[index].KEY` and what was expected.
+TaskConfig parse_task_table(const toml_keys::Source& source, const toml::table& table, std::size_t index);
+
+/// How many tasks `task` expands to (one per window, isovalue or slice position of a sweep).
+std::size_t planned_task_count(const TaskConfig& task);
 
 /// One rendered task: the renderer's spec (reference 1) and how its window / isovalue follow the
 /// reference of the field it reads, with the manifest entry that describes it.

@@ -67,4 +67,45 @@ TEST(TaskPlan, ShorthandErrorsNameTheOption) {
   EXPECT_THROW(insitu::tasks_from_shorthand({"volume:hot", "volume:hot"}, "v"), Error);
 }
 
+// One vocabulary (issue 30): the TOML `type` and the shorthand's first word are render::TaskKind's
+// words; "volume2" is a render volume reading two fields; each table expands to planned_task_count()
+// tasks, the number the plan builds.
+TEST(TaskPlan, KindsAreRenderTaskKinds) {
+  const insitu::SessionConfig cfg = insitu::parse_session_config_text(
+      "[schedule]\nevery_steps = 1\n"
+      "[[task]]\nname = \"v\"\ntype = \"volume\"\nfield = \"a\"\nwindows = [[0, 1], [0, 0.5]]\n"
+      "[[task]]\nname = \"ps\"\ntype = \"volume2\"\nfields = [\"a\", \"b\"]\n"
+      "[[task]]\nname = \"iso\"\ntype = \"isosurface\"\nfield = \"a\"\nisovalues = [0.1, 0.2, 0.3]\n"
+      "[[task]]\nname = \"s\"\ntype = \"slice\"\nfield = \"b\"\n",
+      "kinds");
+  ASSERT_EQ(cfg.tasks.size(), 4u);
+  EXPECT_EQ(cfg.tasks[0].kind, render::TaskKind::volume);
+  EXPECT_EQ(cfg.tasks[1].kind, render::TaskKind::volume);
+  EXPECT_EQ(cfg.tasks[1].fields.size(), 2u);
+  EXPECT_EQ(cfg.tasks[2].kind, render::TaskKind::isosurface);
+  EXPECT_EQ(cfg.tasks[3].kind, render::TaskKind::slice);
+  const insitu::TaskPlan plan(cfg.tasks, kGrid);
+  std::size_t expanded = 0;
+  for (const auto& t : cfg.tasks) expanded += insitu::planned_task_count(t);
+  EXPECT_EQ(expanded, plan.size());
+  EXPECT_EQ(plan.size(), 2u + 1 + 3 + 1);
+  EXPECT_EQ(plan.tasks()[2].spec.kind, render::TaskKind::volume);
+  EXPECT_EQ(plan.tasks()[2].spec.field2, 1);
+  // The volume2 table prints back as volume2; the shorthand takes render's full word as well as "iso".
+  EXPECT_NE(insitu::task_table_toml(cfg.tasks[1]).find("type = \"volume2\"\nfields = [\"a\", \"b\"]"), std::string::npos);
+  EXPECT_EQ(insitu::parse_task_shorthand("isosurface:0.5", "a").kind, render::TaskKind::isosurface);
+  EXPECT_EQ(insitu::parse_task_shorthand("iso:0.5", "a").isovalues, std::vector<double>{0.5});
+  try {
+    (void)insitu::parse_session_config_text("[schedule]\nevery_steps = 1\n[[task]]\nname = \"c\"\ntype = \"cube\"\nfield = \"a\"\n", "kinds");
+    ADD_FAILURE() << "type = \"cube\" accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("task[0].type: \"cube\"; expected volume, volume2, isosurface or slice"), std::string::npos)
+        << e.what();
+  }
+  // A configuration built in code with an empty sweep is refused by validate().
+  insitu::SessionConfig empty = cfg;
+  empty.tasks[2].isovalues.clear();
+  EXPECT_THROW(empty.validate(), Error);
+}
+
 }  // namespace

@@ -16,6 +16,7 @@
 #include "camera/rig_spec.hpp"
 #include "insitu/resources.hpp"
 #include "insitu/session.hpp"
+#include "insitu/task_plan.hpp"
 #include "python/bindings.hpp"
 
 #ifdef PANOPTES_HAVE_MPI4PY
@@ -206,14 +207,7 @@ class PySession {
   int task_count() const {
     if (session_) return session_->task_count();
     std::size_t n = 0;
-    for (const insitu::TaskConfig& t : config_.tasks) {
-      switch (t.kind) {
-        case insitu::TaskConfig::Kind::volume: n += t.windows.size(); break;
-        case insitu::TaskConfig::Kind::volume2: n += 1; break;
-        case insitu::TaskConfig::Kind::isosurface: n += t.isovalues.size(); break;
-        case insitu::TaskConfig::Kind::slice: n += t.slice_positions.size(); break;
-      }
-    }
+    for (const insitu::TaskConfig& t : config_.tasks) n += insitu::planned_task_count(t);
     return int(n);
   }
   int snapshots() const { return session_ ? session_->snapshots() : 0; }

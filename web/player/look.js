@@ -133,3 +133,70 @@ export function lookText(l) {
   };
   return `look yaw ${signed(l.yaw)}  pitch ${signed(l.pitch)}  fov ${Math.round(l.fov)}`;
 }
+
+/// The world direction through point (x, y) of a w × h perspective cut-out `look` of a camera with frame
+/// `cam` (the cut-out's mapping; the centre is the view's forward): player::cutout_direction.
+export function cutoutDirection(cam, look, x, y, w, h) {
+  const v = lookBasis(cam, look);
+  const tanHalf = Math.tan((look.fov * Math.PI) / 360), aspect = h > 0 ? w / h : 1;
+  const sx = (2 * x / w - 1) * tanHalf * aspect, sy = (1 - 2 * y / h) * tanHalf;
+  return normalize(add(add(v.forward, scale(v.right, sx)), scale(v.up, sy)));
+}
+
+/// The graph neighbour of `camera` whose displacement is best aligned with the world direction d
+/// (angle below 60°, as walking), or −1: player::neighbour_toward (double-click to step).
+export function neighbourToward(cams, camera, d) {
+  if (!cams || !cams.neighbours || camera < 0 || camera >= cams.count) return -1;
+  const lenD = norm(d);
+  if (!(lenD > 0)) return -1;
+  const here = positionOf(cams, camera);
+  let best = -1, bestCos = 0.5;
+  for (let s = 0; s < 6; s++) {
+    const id = cams.neighbours[6 * camera + s];
+    if (id < 0 || id >= cams.count || id === camera) continue;
+    const step = sub(positionOf(cams, id), here);
+    const len = norm(step);
+    if (!(len > 0)) continue;
+    const c = dot(step, d) / (len * lenD);
+    if (c > bestCos) { bestCos = c; best = id; }
+  }
+  return best;
+}
+
+/// The world direction of the strongest signal in an equirectangular frame (luma: W × H bytes, rows
+/// from the top) seen from a camera with frame `cam`, or null: player::strongest_signal_direction, line
+/// for line — the solid-angle weighted mean direction of the pixels in the top 2 % of luma and at least
+/// 16 levels above the median, weighted by how far above the median; null when nothing stands out or
+/// the bright pixels surround the camera evenly.
+export function strongestSignalDirection(luma, W, H, cam) {
+  if (W < 2 || H < 2 || luma.length < W * H) return null;
+  const hist = new Float64Array(256);
+  let total = 0;
+  for (let y = 0; y < H; y++) {
+    const w = Math.cos((0.5 - (y + 0.5) / H) * Math.PI);
+    for (let x = 0; x < W; x++) hist[luma[y * W + x]] += w;
+    total += w * W;
+  }
+  let median = 0, top = 255, acc = 0;
+  for (let v = 0; v < 256; v++) {
+    acc += hist[v];
+    if (acc < 0.5 * total) median = v + 1;
+    if (acc < 0.98 * total) top = v + 1;
+  }
+  const threshold = Math.max(top, median + 16);
+  if (threshold > 255) return null;
+  let sum = [0, 0, 0], weight = 0;
+  for (let y = 0; y < H; y++) {
+    const lat = (0.5 - (y + 0.5) / H) * Math.PI, cl = Math.cos(lat), sl = Math.sin(lat);
+    for (let x = 0; x < W; x++) {
+      const l = luma[y * W + x];
+      if (l < threshold) continue;
+      const lon = (2 * (x + 0.5) / W - 1) * Math.PI;
+      const w = (l - median) * cl;
+      sum = add(sum, scale(add(add(scale(cam.forward, cl * Math.cos(lon)), scale(cam.right, cl * Math.sin(lon))), scale(cam.up, sl)), w));
+      weight += w;
+    }
+  }
+  if (!(weight > 0) || norm(sum) < 0.2 * weight) return null;
+  return normalize(sum);
+}

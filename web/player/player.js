@@ -8,7 +8,8 @@ import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
 import { parseKeyTable, bindingOf, helpRows, operationOf } from "./keys.js";
-import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf } from "./look.js";
+import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf,
+         lookTowards, cutoutDirection, neighbourToward, strongestSignalDirection } from "./look.js";
 import { LookView, drawOrientationMarks } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
 
@@ -644,6 +645,44 @@ function setLook(l) {
   S.look = clamped(l);
   S.lookDirty = true;
 }
+/// Double-click in a walkable 360° database: one step toward the clicked point of the cut-out (Shift:
+/// away from it), keeping the world view direction — the desktop's step_toward_click.
+function stepTowardClick(x, y, w, h, back) {
+  const from = S.camera, cam = basisOfCamera(S.cams, from);
+  const d = cutoutDirection(cam, S.look, x, y, w, h);
+  const to = neighbourToward(S.cams, from, back ? d.map((v) => -v) : d);
+  if (to < 0) { notify(back ? "no camera behind that way" : "no camera that way"); return false; }
+  S.look = lookAfterWalk(S.cams, from, to, S.look);
+  S.lookDirty = true;
+  trail.clear();
+  return select(to, S.task, back ? "step_back" : "step_toward");
+}
+let faceCanvas = null;
+/// C: turns the 360° view toward the strongest signal of the frame on screen (the desktop's
+/// face_the_action), read from the decoded frame drawn into a canvas of at most 512 columns.
+function faceTheAction() {
+  const vf = S.shownKey && cache.map.get(S.shownKey);
+  if (!S.rig.equirect || !vf || !S.cams) {
+    notify("C turns a 360-degree view toward the strongest signal; this database has fixed views");
+    return;
+  }
+  const fw = vf.displayWidth ?? vf.width, fh = vf.displayHeight ?? vf.height;
+  const W = Math.min(512, fw), H = Math.max(2, Math.round((fh * W) / fw));
+  faceCanvas = faceCanvas ?? document.createElement("canvas");
+  faceCanvas.width = W;
+  faceCanvas.height = H;
+  const g = faceCanvas.getContext("2d", { willReadFrequently: true });
+  g.drawImage(vf, 0, 0, W, H);
+  const px = g.getImageData(0, 0, W, H).data, luma = new Uint8Array(W * H);
+  // Video-range luma (16..235), as the desktop reads the decoded frame's Y plane: the rule's "16 levels
+  // above the median" means the same there and here.
+  for (let i = 0; i < W * H; i++) luma[i] = Math.round(16 + (219 / 255) * (0.299 * px[4 * i] + 0.587 * px[4 * i + 1] + 0.114 * px[4 * i + 2]));
+  const cam = basisOfCamera(S.cams, S.camera);
+  const d = strongestSignalDirection(luma, W, H, cam);
+  if (!d) { notify("nothing stands out in this frame to turn to"); return; }
+  setLook(lookTowards(cam, d, S.look.fov));
+  notify(`facing the strongest signal: ${lookText(S.look)}`);
+}
 /// Speed factor, as player::Engine::set_speed (×¼..×8), keeping the playhead where it is.
 function setSpeed(v) {
   const f = currentFrame();
@@ -714,6 +753,7 @@ const OPS = {
   fullscreen: () => (document.fullscreenElement ? document.exitFullscreen() : document.getElementById("stage").requestFullscreen()).catch((e) => notify(`full screen: ${e.message}`)),
   screenshot: () => download((surface === "look" ? lookCanvas : canvas).toDataURL("image/png"), `panoptes-c${S.camera}-t${S.task}-f${currentFrame()}.png`),
   help: () => document.getElementById("help").classList.toggle("hidden"),
+  face_action: () => faceTheAction(),
   toggle_hud: () => { S.hudHidden = !S.hudHidden; for (const id of ["hud", "minimap", "legend"]) document.getElementById(id).classList.toggle("off", S.hudHidden); },
 };
 for (let k = 1; k <= 9; k++) OPS[`task_${k}`] = () => select(S.camera, k - 1, `task_${k}`);
@@ -784,6 +824,15 @@ lookCanvas.addEventListener("pointermove", (e) => {
   lookLast = [e.clientX, e.clientY];
   drawNowIfReady();
 });
+lookCanvas.addEventListener("dblclick", (e) => {
+  if (!S.db || !S.cams || !S.rig.walkable) return;
+  e.preventDefault();
+  inputEventTime = e.timeStamp;
+  const r = lookCanvas.getBoundingClientRect();
+  stepTowardClick(e.clientX - r.left, e.clientY - r.top, r.width, r.height, e.shiftKey);
+  inputEventTime = 0;
+  drawNowIfReady();
+});
 const endLook = () => { lookLast = null; };
 lookCanvas.addEventListener("pointerup", endLook);
 lookCanvas.addEventListener("pointercancel", endLook);
@@ -793,7 +842,8 @@ function showHelp() {
   const el = document.getElementById("help");
   if (!S.keys) return;
 
-  const mouse = S.rig.equirect ? "<b>drag</b>: look around · <b>wheel</b>: field of view" : "<b>drag</b>: rotate to the nearest camera · <b>wheel</b>: magnify";
+  const mouse = S.rig.equirect ? "<b>drag</b>: look around · <b>wheel</b>: field of view" +
+    (S.rig.walkable ? " · <b>double-click</b>: step toward that point (Shift: away from it)" : "") : "<b>drag</b>: rotate to the nearest camera · <b>wheel</b>: magnify";
   const esc = (t) => t.replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" })[c]);
   el.innerHTML = mouse + " · " + helpRows(S.keys, S.mode, NOT_HERE).map((r) => `<b>${esc(r.keys)}</b>: ${esc(r.text)}`).join(" · ");
 }
