@@ -1,6 +1,7 @@
 #include "camera/volume_rigs.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -33,6 +34,48 @@ void label(RigCamera& c, const Rig& rig, const SkyFrame& frame) {
 }
 
 }  // namespace
+
+Rig make_shell_interior_rig(const Domain& domain, int n_rings, int n_per_ring, std::vector<double> radii,
+                            double fov_y_degrees, UpAxis up_axis) {
+  domain.validate();
+  if (n_rings < 1 || n_per_ring < 1)
+    throw Error("shell-interior rig: " + std::to_string(n_rings) + " rings of " + std::to_string(n_per_ring) +
+                " cameras; expected at least 1 of each");
+  if (radii.empty()) radii = {kDefaultInShellRadius};
+  if ((long long)n_rings * n_per_ring * (long long)radii.size() > kMaxInsideCameras)
+    throw Error("shell-interior rig: more than " + std::to_string(kMaxInsideCameras) + " cameras");
+  std::sort(radii.begin(), radii.end(), std::greater<>());
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    if (!(radii[k] > 0 && radii[k] <= 1))
+      throw Error("shell-interior rig: radius " + std::to_string(radii[k]) +
+                  "; expected 0 < radius <= 1 (a fraction of the domain's inscribed radius)");
+    if (k && radii[k] == radii[k - 1]) throw Error("shell-interior rig: radius " + std::to_string(radii[k]) + " given twice");
+  }
+  const double fov = checked_fov(fov_y_degrees);
+  const SkyFrame frame = SkyFrame::of(up_axis);
+  const double inscribed = 0.5 * std::min({domain.extent.x, domain.extent.y, domain.extent.z});
+  Rig rig;
+  rig.center = domain.center();
+  rig.up_axis = up_axis;
+  rig.shell_count = int(radii.size());
+  const std::vector<PatternPoint> pattern = latlon_pattern(n_rings, n_per_ring, false);
+  for (std::size_t k = 0; k < radii.size(); ++k)
+    for (const PatternPoint& p : pattern) {
+      const Vec3 radial = normalize(frame.to_world(p.direction));
+      // The ring's tangent towards increasing longitude: sky × radial, never zero (no poles).
+      const Vec3 east = normalize(cross(frame.sky, radial));
+      RigCamera c;
+      c.position = rig.center + radial * (radii[k] * inscribed);
+      c.look_at = c.position + east * inscribed;
+      c.up = radial;
+      c.fov_y_degrees = fov;
+      c.patch = "inshell";
+      c.shell = int(k);
+      label(c, rig, frame);
+      rig.cameras.push_back(std::move(c));
+    }
+  return rig;
+}
 
 Rig make_lattice_rig(const Domain& domain, std::array<int, 3> n, double margin, double fov_y_degrees, UpAxis up_axis) {
   domain.validate();

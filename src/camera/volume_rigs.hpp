@@ -11,6 +11,7 @@
 // Path cameras: in = next point of the path, out = previous one; no sideways moves.
 #include <array>
 #include <string>
+#include <vector>
 
 #include "camera/navigation.hpp"
 #include "camera/rig.hpp"
@@ -29,6 +30,21 @@ inline int lattice_id(const std::array<int, 3>& n, int i, int j, int k) { return
 /// rig.lattice = {nx, ny, nz}; patch "lattice". Throws panoptes::Error on bad counts or margin.
 Rig make_lattice_rig(const Domain& domain, std::array<int, 3> n, double margin, double fov_y_degrees = 0,
                      UpAxis up_axis = UpAxis::z_up);
+
+/// Default radius of shell-interior rigs, in units of the domain's inscribed radius (half its smallest
+/// extent, a shell grid's outer radius): the middle of a shell whose inner radius is 0.35 of its outer.
+inline constexpr double kDefaultInShellRadius = 0.675;
+
+/// Cameras inside a spherical shell centred in the domain (issue 33): on each sphere of `radii` (in
+/// units of the domain's inscribed radius = half its smallest extent; sorted from the largest = shell
+/// 0), n_rings latitude rings at colatitudes 180°·(i+1)/(n_rings+1) of n_per_ring cameras each, at
+/// longitudes −180° + 360°·j/n_per_ring (the latlon pattern without poles, in the sky frame of
+/// `up_axis`). Each camera looks along its ring towards the local east and its up is the local radial
+/// direction (outwards), so the top of every image faces the outer surface and the bottom the core,
+/// wherever the camera sits. Field of view `fov_y_degrees` (0 = 90°). Patch "inshell"; the generic
+/// navigation graph. Throws panoptes::Error on counts < 1 or radii outside (0, 1].
+Rig make_shell_interior_rig(const Domain& domain, int n_rings, int n_per_ring, std::vector<double> radii,
+                            double fov_y_degrees = 0, UpAxis up_axis = UpAxis::z_up);
 
 /// Cameras at the points of a polyline read from a text file (`x y z` per line, world coordinates,
 /// '#' starts a comment, blanks or commas separate numbers): camera k sits at point k and looks towards

@@ -129,3 +129,56 @@ TEST(PathRig, CamerasLookAlongThePathAndWalkInOut) {
   EXPECT_THROW(make_rig("path:" + file.string(), kDomain), FileError);
   std::filesystem::remove(file);
 }
+
+// Issue 33: rings inside a spherical shell. Every camera sits between the inner and the outer radius,
+// its image's up (after the Camera's orthogonalization) is the local radial direction and it looks
+// along its ring, for both up axes; the spec round-trips and refuses radii outside the shell.
+TEST(ShellInteriorRig, CamerasBetweenTheRadiiWithTheRadialDirectionUp) {
+  const Domain shell{{-1, -1, -1}, {2, 2, 2}};  // a shell grid's bounding box: outer radius 1
+  for (UpAxis up_axis : {UpAxis::z_up, UpAxis::z_down}) {
+    RigSpec spec = RigSpec::parse("inshell:3x8@0.5,0.8");
+    spec.up_axis = up_axis;
+    const Rig rig = make_rig(spec, shell);
+    ASSERT_EQ(rig.size(), 2 * 3 * 8);
+    EXPECT_EQ(rig.shell_count, 2);
+    EXPECT_EQ(rig.spec, "inshell:3x8@0.8,0.5");
+    for (int id = 0; id < rig.size(); ++id) {
+      const RigCamera& rc = rig.cameras[std::size_t(id)];
+      const Vec3 radial = normalize(rc.position - rig.center);
+      EXPECT_NEAR(norm(rc.position - rig.center), rc.shell == 0 ? 0.8 : 0.5, 1e-12) << id;
+      EXPECT_EQ(rc.patch, "inshell");
+      const Camera cam = rig.camera(id, 64, 32, Projection::equirectangular);
+      // Up is exactly radial, and the view is tangential (perpendicular to it).
+      EXPECT_NEAR(dot(cam.up(), radial), 1.0, 1e-9) << "camera " << id;
+      EXPECT_NEAR(dot(cam.forward(), radial), 0.0, 1e-9) << "camera " << id;
+      // Along the ring: the forward direction has no component along the sky axis.
+      const Vec3 sky = SkyFrame::of(up_axis).sky;
+      EXPECT_NEAR(dot(cam.forward(), sky), 0.0, 1e-9) << "camera " << id;
+    }
+    // Cameras on the southern rings have their up pointing away from the sky: radial, not the sky.
+    const RigCamera& south = rig.cameras[std::size_t(2 * 8)];  // shell 0, last ring
+    EXPECT_LT(dot(normalize(south.position - rig.center), SkyFrame::of(up_axis).sky), -0.5);
+    EXPECT_LT(dot(rig.camera(2 * 8, 64, 64).up(), SkyFrame::of(up_axis).sky), -0.5);
+  }
+}
+
+TEST(ShellInteriorRig, DefaultsAndErrors) {
+  const RigSpec d = RigSpec::parse("inshell");
+  EXPECT_EQ(d.kind, RigSpec::Kind::inshell);
+  EXPECT_EQ(d.rows, 4);
+  EXPECT_EQ(d.columns, 12);
+  ASSERT_EQ(d.radii.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.radii[0], kDefaultInShellRadius);
+  EXPECT_EQ(RigSpec::parse(d.to_string()).to_string(), d.to_string());
+  EXPECT_EQ(d.cameras_per_shell(), 48);
+  const Rig rig = make_rig(d, Domain{{0, 0, 0}, {4, 6, 8}});  // inscribed radius 2 (half the smallest extent)
+  EXPECT_NEAR(rig.cameras[0].radius, 2 * kDefaultInShellRadius, 1e-12);
+  EXPECT_THROW(RigSpec::parse("inshell:3x8@1.5"), Error);
+  EXPECT_THROW(RigSpec::parse("inshell:0x8"), Error);
+  EXPECT_THROW(RigSpec::parse("shells:inshell@0.5"), Error);
+  try {
+    RigSpec::parse("inshell:3x8@1.5");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("inshell radius 1.5 is outside the shell"), std::string::npos) << e.what();
+  }
+}
