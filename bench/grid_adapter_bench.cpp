@@ -24,7 +24,7 @@ using namespace panoptes;
 namespace {
 
 grid::GridDescription shell_grid(int nr) {
-  std::vector<double> r(std::size_t(nr));
+  std::vector<double> r(static_cast<std::size_t>(nr));
   for (int i = 0; i < nr; ++i) r[std::size_t(i)] = 0.35 + 0.65 * i / (nr - 1);
   return grid::GridDescription::yinyang_standard(r, 2 * nr, 6 * nr);
 }
