@@ -141,7 +141,7 @@ TEST(ShellInteriorRig, CamerasBetweenTheRadiiWithTheRadialDirectionUp) {
     const Rig rig = make_rig(spec, shell);
     ASSERT_EQ(rig.size(), 2 * 3 * 8);
     EXPECT_EQ(rig.shell_count, 2);
-    EXPECT_EQ(rig.spec, "inshell:3x8@0.8,0.5");
+    EXPECT_EQ(rig.spec, "inshell:3x8@0.5,0.8");  // as given; shell 0 is still the largest radius (below)
     for (int id = 0; id < rig.size(); ++id) {
       const RigCamera& rc = rig.cameras[std::size_t(id)];
       const Vec3 radial = normalize(rc.position - rig.center);

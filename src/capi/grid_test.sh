@@ -27,6 +27,11 @@ os.chdir(f"{work}/capi")
 grid_reference.render(lib, open(config).read(), "yinyang", coords, snapshots, points=48)
 worst, frames = grid_reference.compare(f"{work}/capi/db", f"{work}/fortran/db")
 print(f"fortran vs C API: {frames} frames, largest difference {worst}/255")
+import panoptes
+db = panoptes.open(f"{work}/fortran/db")
+bright = max(int(db.frame(c, 0, f).max()) for c in range(db.camera_count) for f in range(db.frame_count))
+print(f"brightest pixel {bright}/255 (the shell is drawn, not an empty frame)")
+assert bright > 40
 sys.exit(0 if worst == 0 else 1)
 PY
 

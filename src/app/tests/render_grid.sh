@@ -77,7 +77,7 @@ refuse() {  # expected-text toml volume [extra args]
 }
 sed 's/"r.npy"/"r_bad.npy"/' "$tmp/shell.toml" > "$tmp/bad_r.toml"
 refuse "r coordinates are not strictly increasing: r[1] = 0.5, r[2] = 0.5" "$tmp/bad_r.toml" "$tmp/shell_0.npy"
-refuse "array of shape (36, 18, 8); expected (36, 16, 8)" "$tmp/yy.toml" "$tmp/shell_0.npy"
+refuse "array of shape (36, 16, 8); expected (36, 18, 8), the grid's (n2, n1, n0) points" "$tmp/shell.toml" "$tmp/yy_one_patch.npy"
 refuse "expected (2, 36, 16, 8), a Yin-Yang volume (2 patches" "$tmp/yy.toml" "$tmp/yy_one_patch.npy"
 sed 's/"yy_theta.npy"/"yy_theta_narrow.npy"/' "$tmp/yy.toml" > "$tmp/narrow.toml"
 refuse "leave a gap" "$tmp/narrow.toml" "$tmp/yy.npy"
