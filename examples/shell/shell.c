@@ -58,8 +58,8 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   const char* config = argc > 1 ? argv[1] : "outside.toml";
-  const int steps = argc > 2 ? atoi(argv[2]) : 40;
-  const int nr = argc > 3 ? atoi(argv[3]) : 32;
+  const int steps = argc > 2 ? atoi(argv[2]) : 24;
+  const int nr = argc > 3 ? atoi(argv[3]) : 24;
   if (steps < 1 || nr < 4 || nr > 512) {
     if (rank == 0) fprintf(stderr, "shell: usage: shell CONFIG [steps >= 1] [nr in 4..512]\n");
     MPI_Abort(MPI_COMM_WORLD, 2);
