@@ -204,6 +204,38 @@ NavigationGraph build_path_graph(const Rig& rig) {
   return g;
 }
 
+NavigationGraph build_shell_interior_graph(const Rig& rig) {
+  const RigSpec spec = RigSpec::parse(rig.spec);
+  const int rings = spec.rows, per_ring = spec.columns, per_shell = rings * per_ring;
+  if (spec.kind != RigSpec::Kind::inshell || (long long)per_shell * rig.shell_count != rig.size())
+    throw Error("shell-interior graph: rig \"" + rig.spec + "\" with " + std::to_string(rig.size()) +
+                " cameras is not an inshell rig");
+  NavigationGraph g;
+  g.neighbours.resize(std::size_t(rig.size()));
+  for (int id = 0; id < rig.size(); ++id) {
+    const int shell = id / per_shell, ring = id % per_shell / per_ring, col = id % per_ring;
+    const int base = shell * per_shell + ring * per_ring;
+    Neighbours& n = g.neighbours[std::size_t(id)];
+    if (per_ring > 1) {
+      n.in = base + (col + 1) % per_ring;
+      n.out = base + (col + per_ring - 1) % per_ring;
+    }
+    n.up = shell > 0 ? id - per_shell : -1;
+    n.down = shell + 1 < rig.shell_count ? id + per_shell : -1;
+    // Rings run north to south; which of them is on the image's right depends on the up axis: ask the
+    // camera's own image plane.
+    const int north = ring > 0 ? id - per_ring : -1, south = ring + 1 < rings ? id + per_ring : -1;
+    const RigCamera& rc = rig.cameras[std::size_t(id)];
+    const Camera cam(rc.position, rc.look_at, rc.up, rc.fov_y_degrees, 1, 1);
+    const Vec3 radial = normalize(rc.position - rig.center), sky = SkyFrame::of(rig.up_axis).sky;
+    const Vec3 southward = radial * dot(sky, radial) - sky;  // the local tangent away from the sky
+    const bool south_is_right = dot(cam.right(), southward) > 0;
+    n.right = south_is_right ? south : north;
+    n.left = south_is_right ? north : south;
+  }
+  return g;
+}
+
 Move lattice_move_towards(const Vec3& direction, UpAxis up_axis) {
   const Vec3 l = SkyFrame::of(up_axis).to_local(direction);
   const double ax = std::abs(l.x), ay = std::abs(l.y), az = std::abs(l.z);

@@ -57,6 +57,11 @@ Rig read_path_rig(const std::string& path, const Domain& domain, double fov_y_de
 NavigationGraph build_lattice_graph(const Rig& rig);
 /// The path graph: in = next, out = previous.
 NavigationGraph build_path_graph(const Rig& rig);
+/// The graph of an `inshell` rig (make_shell_interior_rig; rig.spec starts with "inshell"): in / out =
+/// the next / previous camera along the ring (forward: every camera looks along its ring), right /
+/// left = the neighbouring ring on the image's right / left side (same longitude), up / down = the next
+/// shell outwards / inwards (same ring and longitude); −1 at the first and last ring and shell.
+NavigationGraph build_shell_interior_graph(const Rig& rig);
 
 /// The lattice move whose world axis is closest to `direction` (forward walking): Move::in for north,
 /// Move::out for south, right/left for east/west, up/down for sky/ground. Ties go to the horizontal axes.

@@ -182,3 +182,40 @@ TEST(ShellInteriorRig, DefaultsAndErrors) {
     EXPECT_NE(std::string(e.what()).find("inshell radius 1.5 is outside the shell"), std::string::npos) << e.what();
   }
 }
+
+// The inshell graph: forward walks along the ring (the way each camera looks), right/left to the ring
+// on the image's right/left, up/down between shells; every move reverses and every camera is reachable.
+TEST(ShellInteriorRig, GraphWalksAlongRingsAcrossRingsAndBetweenShells) {
+  const Domain shell{{-1, -1, -1}, {2, 2, 2}};
+  for (UpAxis up_axis : {UpAxis::z_up, UpAxis::z_down}) {
+    RigSpec spec = RigSpec::parse("inshell:3x8@0.5,0.8");
+    spec.up_axis = up_axis;
+    const Rig rig = make_rig(spec, shell);
+    const NavigationGraph g = build_navigation_graph(rig);
+    ASSERT_EQ(g.neighbours.size(), std::size_t(rig.size()));
+    for (int id = 0; id < rig.size(); ++id) {
+      const Neighbours& n = g.neighbours[std::size_t(id)];
+      const Camera cam = rig.camera(id, 64, 64);
+      const Vec3 p = rig.cameras[std::size_t(id)].position;
+      ASSERT_GE(n.in, 0);
+      EXPECT_GT(dot(rig.cameras[std::size_t(n.in)].position - p, cam.forward()), 0) << id;
+      EXPECT_EQ(g.neighbours[std::size_t(n.in)].out, id);
+      for (auto [a, b] : {std::pair{n.right, Move::left}, std::pair{n.left, Move::right}, std::pair{n.up, Move::down},
+                          std::pair{n.down, Move::up}})
+        if (a >= 0) { EXPECT_EQ(g.neighbours[std::size_t(a)][b], id) << id; }
+      if (n.right >= 0) { EXPECT_GT(dot(rig.cameras[std::size_t(n.right)].position - p, cam.right()), 0) << id; }
+      if (n.left >= 0) { EXPECT_LT(dot(rig.cameras[std::size_t(n.left)].position - p, cam.right()), 0) << id; }
+      if (n.up >= 0) { EXPECT_GT(norm(rig.cameras[std::size_t(n.up)].position - rig.center), norm(p - rig.center)) << id; }
+    }
+    // Everything reachable from camera 0.
+    std::vector<int> seen(std::size_t(rig.size()), 0), stack{0};
+    seen[0] = 1;
+    while (!stack.empty()) {
+      const Neighbours n = g.neighbours[std::size_t(stack.back())];
+      stack.pop_back();
+      for (int next : {n.right, n.left, n.up, n.down, n.in, n.out})
+        if (next >= 0 && !seen[std::size_t(next)]) seen[std::size_t(next)] = 1, stack.push_back(next);
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), rig.size());
+  }
+}
