@@ -41,8 +41,8 @@ inline constexpr double kDefaultInShellRadius = 0.675;
 /// longitudes −180° + 360°·j/n_per_ring (the latlon pattern without poles, in the sky frame of
 /// `up_axis`). Each camera looks along its ring towards the local east and its up is the local radial
 /// direction (outwards), so the top of every image faces the outer surface and the bottom the core,
-/// wherever the camera sits. Field of view `fov_y_degrees` (0 = 90°). Patch "inshell"; the generic
-/// navigation graph. Throws panoptes::Error on counts < 1 or radii outside (0, 1].
+/// wherever the camera sits. Field of view `fov_y_degrees` (0 = 90°). Patch "inshell"; its own
+/// navigation graph (build_shell_interior_graph). Throws panoptes::Error on counts < 1 or radii outside (0, 1].
 Rig make_shell_interior_rig(const Domain& domain, int n_rings, int n_per_ring, std::vector<double> radii,
                             double fov_y_degrees = 0, UpAxis up_axis = UpAxis::z_up);
 
