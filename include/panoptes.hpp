@@ -23,6 +23,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "panoptes.h"
 
@@ -64,6 +65,27 @@ class Session {
   /// The global grid: points per axis (x, y, z), origin and spacing in world units.
   void set_grid(const std::array<int, 3>& dims, const std::array<double, 3>& origin, const std::array<double, 3>& spacing) {
     check(panoptes_set_grid(s_, dims.data(), origin.data(), spacing.data()));
+  }
+  /// Grids that are not uniform boxes (panoptes.h): per-axis coordinates, resampled in situ.
+  void set_grid_rectilinear(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z) {
+    const int dims[3] = {int(x.size()), int(y.size()), int(z.size())};
+    check(panoptes_set_grid_rectilinear(s_, dims, x.data(), y.data(), z.data()));
+  }
+  /// A spherical shell: radii, colatitudes in [0, pi] and longitudes (radians), each increasing.
+  void set_grid_spherical(const std::vector<double>& r, const std::vector<double>& theta, const std::vector<double>& phi) {
+    const int dims[3] = {int(r.size()), int(theta.size()), int(phi.size())};
+    check(panoptes_set_grid_spherical(s_, dims, r.data(), theta.data(), phi.data()));
+  }
+  /// A Yin-Yang grid: one patch's coordinates, shared by Yin (0) and Yang (1); select with set_patch.
+  void set_grid_yinyang(const std::vector<double>& r, const std::vector<double>& theta, const std::vector<double>& phi) {
+    const int dims[3] = {int(r.size()), int(theta.size()), int(phi.size())};
+    check(panoptes_set_grid_yinyang(s_, dims, r.data(), theta.data(), phi.data()));
+  }
+  /// Yin-Yang: the patch the following set_block / set_field calls describe.
+  void set_patch(int patch) { check(panoptes_set_patch(s_, patch)); }
+  /// Points along the longest axis of the uniform grid rendered (0 = automatic) and the outside value.
+  void set_resample(int longest_axis_points, double outside_value = 0.0) {
+    check(panoptes_set_resample(s_, longest_axis_points, outside_value));
   }
   /// This rank's owned points (0-based offset, extent) and the ghost layers its arrays STORE around them.
   void set_block(const std::array<int, 3>& offset, const std::array<int, 3>& extent,

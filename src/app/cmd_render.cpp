@@ -16,6 +16,7 @@
 #include <exception>
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -24,6 +25,7 @@
 #include <omp.h>
 
 #include "app/command.hpp"
+#include "app/render_grid.hpp"
 #include "app/volume_file.hpp"
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
@@ -62,6 +64,7 @@ struct Args {
   std::string up_axis = "z_up";
   std::string projection = "perspective";
   bool quiet = false;
+  std::string grid_file;  // --grid: a non-uniform grid (app/render_grid.hpp)
 };
 
 // Quotes a command-line word for a POSIX shell when it needs it, so the recorded line can be run again.
@@ -95,6 +98,7 @@ std::string recorded_command_line(const Args& a) {
   cl += " --reference " + a.reference;
   if (!a.spacing.empty()) cl += " --spacing " + shell_word(a.spacing);
   if (!a.origin.empty()) cl += " --origin " + shell_word(a.origin);
+  if (!a.grid_file.empty()) cl += " --grid " + shell_word(a.grid_file);
   cl += " --background " + shell_word(a.background);
   if (a.no_outline) cl += " --no-outline";
   if (a.crf >= 0) cl += " --crf " + std::to_string(a.crf);
@@ -224,9 +228,22 @@ void run(const Args& a, const std::string& command_line) {
     check_memory(read, available_memory(), 1, "reading " + files[0], "pass --force");
   }
 
+  // --grid: the volumes hold values at the points of a non-uniform grid, resampled by the in-situ grid
+  // stage onto a uniform grid over its bounding box (one process: every patch is one whole block).
+  std::optional<app::RenderGrid> source;
+  std::unique_ptr<insitu::GridAdapter> adapter;
+  if (!a.grid_file.empty()) {
+    if (!a.spacing.empty() || !a.origin.empty())
+      throw Error("--grid places the points itself; --spacing and --origin are for uniform volumes");
+    source = app::read_render_grid(a.grid_file);
+    std::vector<insitu::GridBlock> blocks;
+    for (int p = 0; p < source->source.patches(); ++p) blocks.push_back(insitu::GridBlock::whole(source->source, p));
+    adapter = std::make_unique<insitu::GridAdapter>(source->source, blocks, source->resample);
+    cfg.source_grid = source->source.summary();
+  }
   // The first volume fixes the grid of the whole series.
-  app::Volume first = app::read_volume(files[0]);
-  render::GridGeometry grid{first.dims, first.origin, first.spacing};
+  app::Volume first = source ? app::Volume{} : app::read_volume(files[0]);
+  render::GridGeometry grid = adapter ? adapter->render_grid() : render::GridGeometry{first.dims, first.origin, first.spacing};
   if (!a.spacing.empty()) {
     const auto s = parse_numbers(a.spacing, 3, "--spacing");
     grid.spacing = {s[0], s[1], s[2]};
@@ -246,7 +263,7 @@ void run(const Args& a, const std::string& command_line) {
     cfg.check_memory = false;
   }
 
-  insitu::Session session(cfg, grid, insitu::LocalBlock::whole(grid));
+  insitu::Session session(cfg, grid, adapter ? adapter->render_block() : insitu::LocalBlock::whole(grid));
   const bool tty = ::isatty(STDERR_FILENO) && !a.quiet;
   const long long total = (long long)files.size() * session.camera_count() * (long long)session.task_count();
   long long done = 0;
@@ -256,6 +273,15 @@ void run(const Args& a, const std::string& command_line) {
       progress(tty, ++done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     });
   for (std::size_t f = 0; f < files.size(); ++f) {
+    if (adapter) {
+      const std::vector<float> values = app::read_grid_volume(files[f], source->source);
+      warn_if_not_finite(files[f], values);
+      std::vector<insitu::FieldInput> patches;
+      for (int p = 0; p < source->source.patches(); ++p)
+        patches.push_back({"volume", values.data() + p * source->source.points_per_patch(), insitu::ScalarType::f32, {0, 0, 0}});
+      session.snapshot(double(f), adapter->adapt(patches));
+      continue;
+    }
     app::Volume vol = f == 0 ? std::move(first) : app::read_volume(files[f]);
     warn_if_not_finite(files[f], vol.values);
     if (vol.dims != grid.dims)
@@ -320,6 +346,12 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                 "Print the TOML [[task]] tables the --task options stand for (as `panoptes run` reads them) and exit");
   sub->add_option("--spacing", args->spacing, "Grid spacing sx,sy,sz (default: from the file, or 1,1,1)");
   sub->add_option("--origin", args->origin, "Grid origin x,y,z (default: from the file, or 0,0,0)");
+  sub->add_option("--grid", args->grid_file,
+                  "TOML file of a non-uniform grid: [grid] kind = rectilinear (x, y, z) | spherical | yinyang (r, theta, "
+                  "phi), each key a 1-D .npy of coordinates (relative to the file), optional points (longest axis of "
+                  "the uniform grid rendered) and outside (value outside the domain). The volumes are .npy of the "
+                  "grid's points, shape (n2, n1, n0) (Yin-Yang: (2, n2, n1, n0), Yin then Yang); they are resampled as "
+                  "in situ (docs/instrumenting.md, Grids)");
   sub->add_option("--background", args->background, "Background colour r,g,b in [0, 1]")->capture_default_str();
   sub->add_flag("--no-outline", args->no_outline, "Do not draw the domain's outline box");
   sub->add_option("--title", args->title, "Title stored in the manifest");

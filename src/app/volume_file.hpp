@@ -78,10 +78,22 @@ inline std::string read_all(const std::string& path) {
 
 }  // namespace volume_detail
 
-/// Parses the contents of a NumPy .npy file (`path` names it in errors) holding a 3-D array of float32 or float64 (either byte order). C order
-/// (fortran_order False) with shape (nz, ny, nx) — the last axis is x, the fastest; Fortran order with
-/// shape (nx, ny, nz). Origin 0, spacing 1. Throws FileError naming the file and what is wrong.
-inline Volume parse_npy(const std::string& data, const std::string& path) {
+/// The header of a NumPy .npy file: shape, order, element type (float32/float64 only) and where the
+/// data starts. Throws FileError naming the file and what is wrong.
+struct NpyHeader {
+  std::vector<long long> shape;
+  bool fortran = false;     ///< fortran_order: the first axis is the fastest
+  bool big_endian = false;
+  std::size_t elem = 4;     ///< 4 (float32) or 8 (float64)
+  std::size_t offset = 0;   ///< of the first value in the file's contents
+  std::size_t count() const {
+    std::size_t n = 1;
+    for (long long d : shape) n *= std::size_t(d);
+    return n;
+  }
+};
+
+inline NpyHeader parse_npy_header(const std::string& data, const std::string& path) {
   using namespace volume_detail;
   if (data.size() < 10 || std::memcmp(data.data(), "\x93NUMPY", 6) != 0)
     throw FileError(path, "not a NumPy .npy file (missing the \\x93NUMPY magic)");
@@ -130,18 +142,34 @@ inline Volume parse_npy(const std::string& data, const std::string& path) {
     long long n;
     while (ss >> n) shape.push_back(n);
   }
+  NpyHeader h;
+  h.shape = shape;
+  h.fortran = fortran;
+  h.offset = header_start + header_len;
+  if (descr.size() != 3 || (descr[0] != '<' && descr[0] != '>' && descr[0] != '=' && descr[0] != '|') ||
+      (descr.substr(1) != "f4" && descr.substr(1) != "f8"))
+    throw FileError(path, "dtype '" + descr + "'; expected float32 ('<f4') or float64 ('<f8')");
+  h.big_endian = descr[0] == '>';
+  h.elem = descr[2] == '4' ? 4 : 8;
+  return h;
+}
+
+/// Parses the contents of a NumPy .npy file (`path` names it in errors) holding a 3-D array of float32 or float64 (either byte order). C order
+/// (fortran_order False) with shape (nz, ny, nx) — the last axis is x, the fastest; Fortran order with
+/// shape (nx, ny, nz). Origin 0, spacing 1. Throws FileError naming the file and what is wrong.
+inline Volume parse_npy(const std::string& data, const std::string& path) {
+  using namespace volume_detail;
+  const NpyHeader h = parse_npy_header(data, path);
+  const std::vector<long long>& shape = h.shape;
+  const bool fortran = h.fortran;
   if (shape.size() != 3) throw FileError(path, "array has " + std::to_string(shape.size()) + " dimensions; expected a 3-D volume");
   Volume v;
   const std::array<long long, 3> d = fortran ? std::array<long long, 3>{shape[0], shape[1], shape[2]}
                                              : std::array<long long, 3>{shape[2], shape[1], shape[0]};
   const std::size_t n = check_dims(path, d);
   v.dims = {int(d[0]), int(d[1]), int(d[2])};
-  const std::size_t offset = header_start + header_len;
-  if (descr.size() != 3 || (descr[0] != '<' && descr[0] != '>' && descr[0] != '=' && descr[0] != '|') ||
-      (descr.substr(1) != "f4" && descr.substr(1) != "f8"))
-    throw FileError(path, "dtype '" + descr + "'; expected float32 ('<f4') or float64 ('<f8')");
-  const bool big = descr[0] == '>';
-  const std::size_t elem = descr[2] == '4' ? 4 : 8;
+  const std::size_t offset = h.offset, elem = h.elem;
+  const bool big = h.big_endian;
   if (data.size() < offset + n * elem)
     throw FileError(path, "truncated data: " + std::to_string(data.size() - offset) + " bytes for " + std::to_string(n) +
                               " values of " + std::to_string(elem) + " bytes");

@@ -219,6 +219,7 @@ NavigationGraph build_navigation_graph(const Rig& rig, const GraphOptions& optio
                 "; expected >= 0");
   if (rig.is_lattice()) return build_lattice_graph(rig);
   if (rig.path) return build_path_graph(rig);
+  if (rig.spec.rfind("inshell", 0) == 0) return build_shell_interior_graph(rig);
   const int n = rig.size();
   NavigationGraph graph;
   graph.neighbours.resize(n);

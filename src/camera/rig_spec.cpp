@@ -24,7 +24,8 @@ constexpr std::size_t kMaxShells = 1000;
 const char* const kSyntax =
     "expected yinyang[:NTxNP], latlon[:NLATxNLON[+poles]], fibonacci[:N], file:PATH or the path of an existing "
     "camera file, optionally followed by @R1,R2,... (shell radii in bounding-sphere radii), or lattice:NXxNYxNZ[@MARGIN] "
-    "or path:FILE (cameras inside the volume)";
+    "or path:FILE (cameras inside the volume), or inshell[:NRxNP][@F1,F2,...] (rings inside a spherical shell, F in "
+    "inscribed radii)";
 
 [[noreturn]] void bad_spec(std::string_view text, const std::string& why) {
   throw Error("rig spec '" + std::string(text) + "': " + why + "; " + kSyntax);
@@ -101,7 +102,8 @@ RigSpec RigSpec::parse(std::string_view text) {
   }
   const bool shells_prefix = s.starts_with("shells:");
   if (shells_prefix) s.remove_prefix(7);
-  if (s.starts_with("file:") || !(s.starts_with("yinyang") || s.starts_with("latlon") || s.starts_with("fibonacci"))) {
+  if (s.starts_with("file:") ||
+      !(s.starts_with("yinyang") || s.starts_with("latlon") || s.starts_with("fibonacci") || s.starts_with("inshell"))) {
     if (shells_prefix) bad_spec(text, "shells need a built-in kind (file rigs carry their own shell indices)");
     spec.kind = Kind::file;
     spec.path = std::string(s.starts_with("file:") ? s.substr(5) : s);
@@ -149,6 +151,15 @@ RigSpec RigSpec::parse(std::string_view text) {
       if (spec.poles) grid.remove_suffix(6);
       parse_grid(text, grid, spec.rows, spec.columns);
     }
+  } else if (kind == "inshell") {
+    if (shells_prefix) bad_spec(text, "inshell rigs are inside the shell, not on 'shells:' around it");
+    spec.kind = Kind::inshell;
+    spec.rows = 4;
+    spec.columns = 12;
+    if (has_params) parse_grid(text, params, spec.rows, spec.columns);
+    if (text.find('@') == std::string_view::npos) spec.radii = {kDefaultInShellRadius};
+    for (double r : spec.radii)
+      if (r > 1) bad_spec(text, "inshell radius " + format_double(r) + " is outside the shell (expected 0 < F <= 1, in inscribed radii)");
   } else if (kind == "fibonacci") {
     spec.kind = Kind::fibonacci;
     spec.count = 130;
@@ -184,6 +195,7 @@ long long RigSpec::cameras_per_shell() const {
       return 2LL * rows * columns > kMaxCamerasPerShell ? 2LL * rows * columns
                                                         : (long long)yinyang_pattern(rows, columns).size();
     case Kind::latlon: return 1LL * rows * columns + (poles ? 2 : 0);
+    case Kind::inshell: return 1LL * rows * columns;
     case Kind::fibonacci: return count;
     case Kind::file: return 0;
     case Kind::lattice: return 1LL * lattice[0] * lattice[1] * lattice[2];
@@ -200,6 +212,7 @@ std::string RigSpec::to_string() const {
       s = "latlon:" + std::to_string(rows) + "x" + std::to_string(columns) + (poles ? "+poles" : "");
       break;
     case Kind::fibonacci: s = "fibonacci:" + std::to_string(count); break;
+    case Kind::inshell: s = "inshell:" + std::to_string(rows) + "x" + std::to_string(columns); break;
     case Kind::file: return "file:" + path;
     case Kind::path: return "path:" + path;
     case Kind::lattice:
@@ -232,6 +245,11 @@ Rig make_rig(const RigSpec& spec, const Domain& domain) {
     }
     case RigSpec::Kind::lattice: {
       Rig rig = make_lattice_rig(domain, spec.lattice, spec.margin, spec.fov_y_degrees, spec.up_axis);
+      rig.spec = spec.to_string();
+      return rig;
+    }
+    case RigSpec::Kind::inshell: {
+      Rig rig = make_shell_interior_rig(domain, spec.rows, spec.columns, spec.radii, spec.fov_y_degrees, spec.up_axis);
       rig.spec = spec.to_string();
       return rig;
     }

@@ -13,6 +13,9 @@
 //                              centres of the domain shrunk by the fraction M at each face, default 0);
 //                              world-axis navigation (camera/volume_rigs.hpp)
 //   path:FILE                  cameras along a polyline read from FILE (camera/volume_rigs.hpp)
+//   inshell[:NRxNP][@F1,F2,..] cameras inside a spherical shell: NR latitude rings of NP cameras (default
+//                              4x12) on spheres of radius F x the domain's inscribed radius (default
+//                              @0.675), looking along their ring, up = the local radial direction
 // Any built-in kind may end with "@R1,R2,..." — shell radii in units of the domain's bounding-sphere
 // radius (default @3); several radii repeat the pattern on shells, outermost = shell 0. A leading
 // "shells:" is accepted for readability: "shells:yinyang@1.5,2.5,4".
@@ -32,16 +35,16 @@ inline constexpr std::uint64_t kMaxRigFileBytes = 1ull << 30;
 
 /// The kind and parameters of a rig.
 struct RigSpec {
-  enum class Kind { yinyang, latlon, fibonacci, file, lattice, path };
+  enum class Kind { yinyang, latlon, fibonacci, file, lattice, path, inshell };
   Kind kind = Kind::yinyang;
-  int rows = 5;        ///< yinyang: n_theta per patch; latlon: number of rings
+  int rows = 5;        ///< yinyang: n_theta per patch; latlon, inshell: number of rings
   int columns = 13;    ///< yinyang: n_phi per patch; latlon: cameras per ring
   bool poles = false;  ///< latlon: add one camera at each pole
   int count = 130;     ///< fibonacci: number of points
   std::string path;    ///< file: the camera file; path: the polyline file
   std::array<int, 3> lattice{4, 4, 3};  ///< lattice: nodes along world x, y, z
   double margin = 0;                    ///< lattice: fraction of the extent kept free at each face
-  std::vector<double> radii{kDefaultRadius};  ///< shell radii, bounding-sphere radii (not for file)
+  std::vector<double> radii{kDefaultRadius};  ///< shell radii, bounding-sphere radii (not for file; inshell: inscribed radii)
   double fov_y_degrees = 0;                   ///< 0 = frame the domain from the outermost shell
   Vec3 up{0, 0, 0};                           ///< requested up of every camera; zero = the sky direction
   UpAxis up_axis = UpAxis::z_up;              ///< which way is up in the domain (not part of the string)

@@ -1,6 +1,7 @@
 #include "camera/volume_rigs.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -33,6 +34,48 @@ void label(RigCamera& c, const Rig& rig, const SkyFrame& frame) {
 }
 
 }  // namespace
+
+Rig make_shell_interior_rig(const Domain& domain, int n_rings, int n_per_ring, std::vector<double> radii,
+                            double fov_y_degrees, UpAxis up_axis) {
+  domain.validate();
+  if (n_rings < 1 || n_per_ring < 1)
+    throw Error("shell-interior rig: " + std::to_string(n_rings) + " rings of " + std::to_string(n_per_ring) +
+                " cameras; expected at least 1 of each");
+  if (radii.empty()) radii = {kDefaultInShellRadius};
+  if ((long long)n_rings * n_per_ring * (long long)radii.size() > kMaxInsideCameras)
+    throw Error("shell-interior rig: more than " + std::to_string(kMaxInsideCameras) + " cameras");
+  std::sort(radii.begin(), radii.end(), std::greater<>());
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    if (!(radii[k] > 0 && radii[k] <= 1))
+      throw Error("shell-interior rig: radius " + std::to_string(radii[k]) +
+                  "; expected 0 < radius <= 1 (a fraction of the domain's inscribed radius)");
+    if (k && radii[k] == radii[k - 1]) throw Error("shell-interior rig: radius " + std::to_string(radii[k]) + " given twice");
+  }
+  const double fov = checked_fov(fov_y_degrees);
+  const SkyFrame frame = SkyFrame::of(up_axis);
+  const double inscribed = 0.5 * std::min({domain.extent.x, domain.extent.y, domain.extent.z});
+  Rig rig;
+  rig.center = domain.center();
+  rig.up_axis = up_axis;
+  rig.shell_count = int(radii.size());
+  const std::vector<PatternPoint> pattern = latlon_pattern(n_rings, n_per_ring, false);
+  for (std::size_t k = 0; k < radii.size(); ++k)
+    for (const PatternPoint& p : pattern) {
+      const Vec3 radial = normalize(frame.to_world(p.direction));
+      // The ring's tangent towards increasing longitude: sky × radial, never zero (no poles).
+      const Vec3 east = normalize(cross(frame.sky, radial));
+      RigCamera c;
+      c.position = rig.center + radial * (radii[k] * inscribed);
+      c.look_at = c.position + east * inscribed;
+      c.up = radial;
+      c.fov_y_degrees = fov;
+      c.patch = "inshell";
+      c.shell = int(k);
+      label(c, rig, frame);
+      rig.cameras.push_back(std::move(c));
+    }
+  return rig;
+}
 
 Rig make_lattice_rig(const Domain& domain, std::array<int, 3> n, double margin, double fov_y_degrees, UpAxis up_axis) {
   domain.validate();
@@ -157,6 +200,38 @@ NavigationGraph build_path_graph(const Rig& rig) {
   for (int c = 0; c < rig.size(); ++c) {
     g.neighbours[std::size_t(c)].in = c + 1 < rig.size() ? c + 1 : -1;
     g.neighbours[std::size_t(c)].out = c - 1;
+  }
+  return g;
+}
+
+NavigationGraph build_shell_interior_graph(const Rig& rig) {
+  const RigSpec spec = RigSpec::parse(rig.spec);
+  const int rings = spec.rows, per_ring = spec.columns, per_shell = rings * per_ring;
+  if (spec.kind != RigSpec::Kind::inshell || (long long)per_shell * rig.shell_count != rig.size())
+    throw Error("shell-interior graph: rig \"" + rig.spec + "\" with " + std::to_string(rig.size()) +
+                " cameras is not an inshell rig");
+  NavigationGraph g;
+  g.neighbours.resize(std::size_t(rig.size()));
+  for (int id = 0; id < rig.size(); ++id) {
+    const int shell = id / per_shell, ring = id % per_shell / per_ring, col = id % per_ring;
+    const int base = shell * per_shell + ring * per_ring;
+    Neighbours& n = g.neighbours[std::size_t(id)];
+    if (per_ring > 1) {
+      n.in = base + (col + 1) % per_ring;
+      n.out = base + (col + per_ring - 1) % per_ring;
+    }
+    n.up = shell > 0 ? id - per_shell : -1;
+    n.down = shell + 1 < rig.shell_count ? id + per_shell : -1;
+    // Rings run north to south; which of them is on the image's right depends on the up axis: ask the
+    // camera's own image plane.
+    const int north = ring > 0 ? id - per_ring : -1, south = ring + 1 < rings ? id + per_ring : -1;
+    const RigCamera& rc = rig.cameras[std::size_t(id)];
+    const Camera cam(rc.position, rc.look_at, rc.up, rc.fov_y_degrees, 1, 1);
+    const Vec3 radial = normalize(rc.position - rig.center), sky = SkyFrame::of(rig.up_axis).sky;
+    const Vec3 southward = radial * dot(sky, radial) - sky;  // the local tangent away from the sky
+    const bool south_is_right = dot(cam.right(), southward) > 0;
+    n.right = south_is_right ? south : north;
+    n.left = south_is_right ? north : south;
   }
   return g;
 }

@@ -129,3 +129,93 @@ TEST(PathRig, CamerasLookAlongThePathAndWalkInOut) {
   EXPECT_THROW(make_rig("path:" + file.string(), kDomain), FileError);
   std::filesystem::remove(file);
 }
+
+// Issue 33: rings inside a spherical shell. Every camera sits between the inner and the outer radius,
+// its image's up (after the Camera's orthogonalization) is the local radial direction and it looks
+// along its ring, for both up axes; the spec round-trips and refuses radii outside the shell.
+TEST(ShellInteriorRig, CamerasBetweenTheRadiiWithTheRadialDirectionUp) {
+  const Domain shell{{-1, -1, -1}, {2, 2, 2}};  // a shell grid's bounding box: outer radius 1
+  for (UpAxis up_axis : {UpAxis::z_up, UpAxis::z_down}) {
+    RigSpec spec = RigSpec::parse("inshell:3x8@0.5,0.8");
+    spec.up_axis = up_axis;
+    const Rig rig = make_rig(spec, shell);
+    ASSERT_EQ(rig.size(), 2 * 3 * 8);
+    EXPECT_EQ(rig.shell_count, 2);
+    EXPECT_EQ(rig.spec, "inshell:3x8@0.5,0.8");  // as given; shell 0 is still the largest radius (below)
+    for (int id = 0; id < rig.size(); ++id) {
+      const RigCamera& rc = rig.cameras[std::size_t(id)];
+      const Vec3 radial = normalize(rc.position - rig.center);
+      EXPECT_NEAR(norm(rc.position - rig.center), rc.shell == 0 ? 0.8 : 0.5, 1e-12) << id;
+      EXPECT_EQ(rc.patch, "inshell");
+      const Camera cam = rig.camera(id, 64, 32, Projection::equirectangular);
+      // Up is exactly radial, and the view is tangential (perpendicular to it).
+      EXPECT_NEAR(dot(cam.up(), radial), 1.0, 1e-9) << "camera " << id;
+      EXPECT_NEAR(dot(cam.forward(), radial), 0.0, 1e-9) << "camera " << id;
+      // Along the ring: the forward direction has no component along the sky axis.
+      const Vec3 sky = SkyFrame::of(up_axis).sky;
+      EXPECT_NEAR(dot(cam.forward(), sky), 0.0, 1e-9) << "camera " << id;
+    }
+    // Cameras on the southern rings have their up pointing away from the sky: radial, not the sky.
+    const RigCamera& south = rig.cameras[std::size_t(2 * 8)];  // shell 0, last ring
+    EXPECT_LT(dot(normalize(south.position - rig.center), SkyFrame::of(up_axis).sky), -0.5);
+    EXPECT_LT(dot(rig.camera(2 * 8, 64, 64).up(), SkyFrame::of(up_axis).sky), -0.5);
+  }
+}
+
+TEST(ShellInteriorRig, DefaultsAndErrors) {
+  const RigSpec d = RigSpec::parse("inshell");
+  EXPECT_EQ(d.kind, RigSpec::Kind::inshell);
+  EXPECT_EQ(d.rows, 4);
+  EXPECT_EQ(d.columns, 12);
+  ASSERT_EQ(d.radii.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.radii[0], kDefaultInShellRadius);
+  EXPECT_EQ(RigSpec::parse(d.to_string()).to_string(), d.to_string());
+  EXPECT_EQ(d.cameras_per_shell(), 48);
+  const Rig rig = make_rig(d, Domain{{0, 0, 0}, {4, 6, 8}});  // inscribed radius 2 (half the smallest extent)
+  EXPECT_NEAR(rig.cameras[0].radius, 2 * kDefaultInShellRadius, 1e-12);
+  EXPECT_THROW(RigSpec::parse("inshell:3x8@1.5"), Error);
+  EXPECT_THROW(RigSpec::parse("inshell:0x8"), Error);
+  EXPECT_THROW(RigSpec::parse("shells:inshell@0.5"), Error);
+  try {
+    RigSpec::parse("inshell:3x8@1.5");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("inshell radius 1.5 is outside the shell"), std::string::npos) << e.what();
+  }
+}
+
+// The inshell graph: forward walks along the ring (the way each camera looks), right/left to the ring
+// on the image's right/left, up/down between shells; every move reverses and every camera is reachable.
+TEST(ShellInteriorRig, GraphWalksAlongRingsAcrossRingsAndBetweenShells) {
+  const Domain shell{{-1, -1, -1}, {2, 2, 2}};
+  for (UpAxis up_axis : {UpAxis::z_up, UpAxis::z_down}) {
+    RigSpec spec = RigSpec::parse("inshell:3x8@0.5,0.8");
+    spec.up_axis = up_axis;
+    const Rig rig = make_rig(spec, shell);
+    const NavigationGraph g = build_navigation_graph(rig);
+    ASSERT_EQ(g.neighbours.size(), std::size_t(rig.size()));
+    for (int id = 0; id < rig.size(); ++id) {
+      const Neighbours& n = g.neighbours[std::size_t(id)];
+      const Camera cam = rig.camera(id, 64, 64);
+      const Vec3 p = rig.cameras[std::size_t(id)].position;
+      ASSERT_GE(n.in, 0);
+      EXPECT_GT(dot(rig.cameras[std::size_t(n.in)].position - p, cam.forward()), 0) << id;
+      EXPECT_EQ(g.neighbours[std::size_t(n.in)].out, id);
+      for (auto [a, b] : {std::pair{n.right, Move::left}, std::pair{n.left, Move::right}, std::pair{n.up, Move::down},
+                          std::pair{n.down, Move::up}})
+        if (a >= 0) { EXPECT_EQ(g.neighbours[std::size_t(a)][b], id) << id; }
+      if (n.right >= 0) { EXPECT_GT(dot(rig.cameras[std::size_t(n.right)].position - p, cam.right()), 0) << id; }
+      if (n.left >= 0) { EXPECT_LT(dot(rig.cameras[std::size_t(n.left)].position - p, cam.right()), 0) << id; }
+      if (n.up >= 0) { EXPECT_GT(norm(rig.cameras[std::size_t(n.up)].position - rig.center), norm(p - rig.center)) << id; }
+    }
+    // Everything reachable from camera 0.
+    std::vector<int> seen(std::size_t(rig.size()), 0), stack{0};
+    seen[0] = 1;
+    while (!stack.empty()) {
+      const Neighbours n = g.neighbours[std::size_t(stack.back())];
+      stack.pop_back();
+      for (int next : {n.right, n.left, n.up, n.down, n.in, n.out})
+        if (next >= 0 && !seen[std::size_t(next)]) seen[std::size_t(next)] = 1, stack.push_back(next);
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), rig.size());
+  }
+}

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "panoptes.h"
+#include "panoptes.hpp"
 
 namespace {
 
@@ -134,6 +135,26 @@ TEST_F(CapiGrid, OverlappingBlocksAreNamed) {
   EXPECT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_ERROR_RUN);
   EXPECT_NE(std::string(panoptes_last_error()).find("outside the grid's (6, 16, 36) points"), std::string::npos)
       << panoptes_last_error();
+}
+
+// The C++ header's grid calls reach the same checks (panoptes::Error with the C API's code and message).
+TEST_F(CapiGrid, CppWrapperGridCalls) {
+  panoptes::Session viz(config((dir_ / "cpp").string()), false);
+  std::vector<double> r = r_;
+  r[3] = r[2];
+  try {
+    viz.set_grid_spherical(r, t_, p_);
+    FAIL() << "non-monotonic radii accepted";
+  } catch (const panoptes::Error& e) {
+    EXPECT_EQ(e.code(), PANOPTES_ERROR_USAGE);
+    EXPECT_NE(std::string(e.what()).find("r coordinates are not strictly increasing"), std::string::npos) << e.what();
+  }
+  viz.set_grid_yinyang(r_, t_, p_);
+  viz.set_patch(1);
+  viz.set_resample(32, 0.0);
+  EXPECT_THROW(viz.set_patch(3), panoptes::Error);
+  viz.set_grid_rectilinear(r_, t_, p_);
+  EXPECT_THROW(viz.set_patch(0), panoptes::Error);  // only Yin-Yang grids have patches
 }
 
 }  // namespace

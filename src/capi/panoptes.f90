@@ -7,6 +7,9 @@
 !   type(panoptes_t) :: viz
 !   call panoptes_open(viz, 'viz.toml', MPI_COMM_WORLD)
 !   call panoptes_grid(viz, [nx, ny, nz], [0d0, 0d0, 0d0], [h, h, h])   ! real(4) or real(8)
+!   ! or a grid that is not a uniform box (1-D coordinate arrays, real(4) or real(8); resampled in situ):
+!   !   call panoptes_grid_rectilinear(viz, x, y, z) / panoptes_grid_spherical(viz, r, theta, phi)
+!   !   call panoptes_grid_yinyang(viz, r, theta, phi); call panoptes_patch(viz, 0 or 1)
 !   call panoptes_block(viz, offset, extent, ghost_lo, ghost_hi)        ! 0-based offsets, STORED ghosts
 !   call panoptes_halo(viz, valid_lo, valid_hi)                         ! optional: ghosts kept up to date
 !   do step = ...
@@ -29,6 +32,8 @@ module panoptes
   use, intrinsic :: iso_fortran_env, only: int32, int64, real32, real64
   implicit none
   private
+  public :: panoptes_grid_rectilinear, panoptes_grid_spherical, panoptes_grid_yinyang, panoptes_patch, &
+            panoptes_resample
   public :: panoptes_t, panoptes_open, panoptes_grid, panoptes_block, panoptes_halo, panoptes_field, &
             panoptes_step, panoptes_due, panoptes_snapshot, panoptes_close, panoptes_errors, &
             panoptes_error_message
@@ -58,6 +63,35 @@ module panoptes
       type(c_ptr), value :: s
       integer(c_int), intent(in) :: dims(3)
       real(c_double), intent(in) :: origin(3), spacing(3)
+    end function
+    integer(c_int) function c_set_grid_rectilinear(s, dims, x, y, z) bind(c, name='panoptes_set_grid_rectilinear')
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: s
+      integer(c_int), intent(in) :: dims(3)
+      real(c_double), intent(in) :: x(*), y(*), z(*)
+    end function
+    integer(c_int) function c_set_grid_spherical(s, dims, r, theta, phi) bind(c, name='panoptes_set_grid_spherical')
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: s
+      integer(c_int), intent(in) :: dims(3)
+      real(c_double), intent(in) :: r(*), theta(*), phi(*)
+    end function
+    integer(c_int) function c_set_grid_yinyang(s, dims, r, theta, phi) bind(c, name='panoptes_set_grid_yinyang')
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: s
+      integer(c_int), intent(in) :: dims(3)
+      real(c_double), intent(in) :: r(*), theta(*), phi(*)
+    end function
+    integer(c_int) function c_set_patch(s, patch) bind(c, name='panoptes_set_patch')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: s
+      integer(c_int), value :: patch
+    end function
+    integer(c_int) function c_set_resample(s, points, outside) bind(c, name='panoptes_set_resample')
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: s
+      integer(c_int), value :: points
+      real(c_double), value :: outside
     end function
     integer(c_int) function c_set_block(s, offset, extent, glo, ghi) bind(c, name='panoptes_set_block')
       import :: c_int, c_ptr
@@ -121,6 +155,20 @@ module panoptes
   !> The global grid: origin and spacing real(4) or real(8).
   interface panoptes_grid
     module procedure grid_r4, grid_r8
+  end interface
+  !> A rectilinear grid: strictly increasing coordinates x(nx), y(ny), z(nz), real(4) or real(8).
+  interface panoptes_grid_rectilinear
+    module procedure rectilinear_r4, rectilinear_r8
+  end interface
+  !> A spherical shell: radii r(nr), colatitudes theta(ntheta) in [0, pi] and longitudes phi(nphi) in
+  !> radians, each strictly increasing; arrays indexed (r, theta, phi), r fastest (see panoptes.h).
+  interface panoptes_grid_spherical
+    module procedure spherical_r4, spherical_r8
+  end interface
+  !> A Yin-Yang grid: the coordinates of ONE patch (both patches share them); select a block's patch
+  !> with panoptes_patch.
+  interface panoptes_grid_yinyang
+    module procedure yinyang_r4, yinyang_r8
   end interface
   !> Binds a field: a real(4) or real(8) 3-D array (or section) INCLUDING its stored ghost layers, in the
   !> axis order `layout` (default 'xyz': first index x).
@@ -199,6 +247,83 @@ contains
     real(real64), intent(in) :: origin(3), spacing(3)
     integer, intent(out), optional :: ierr
     call check(c_set_grid(s%handle, int(dims, c_int), real(origin, c_double), real(spacing, c_double)), ierr)
+  end subroutine
+
+  ! The non-uniform grid calls share one path: coordinates as real(c_double), dims from their sizes.
+  subroutine source_grid(s, kind, a, b, c, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer, intent(in) :: kind
+    real(c_double), intent(in) :: a(:), b(:), c(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: dims(3)
+    dims = [int(size(a), c_int), int(size(b), c_int), int(size(c), c_int)]
+    select case (kind)
+    case (0)
+      call check(c_set_grid_rectilinear(s%handle, dims, a, b, c), ierr)
+    case (1)
+      call check(c_set_grid_spherical(s%handle, dims, a, b, c), ierr)
+    case default
+      call check(c_set_grid_yinyang(s%handle, dims, a, b, c), ierr)
+    end select
+  end subroutine
+
+  subroutine rectilinear_r4(s, x, y, z, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real32), intent(in) :: x(:), y(:), z(:)
+    integer, intent(out), optional :: ierr
+    call source_grid(s, 0, real(x, c_double), real(y, c_double), real(z, c_double), ierr)
+  end subroutine
+  subroutine rectilinear_r8(s, x, y, z, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real64), intent(in) :: x(:), y(:), z(:)
+    integer, intent(out), optional :: ierr
+    call source_grid(s, 0, real(x, c_double), real(y, c_double), real(z, c_double), ierr)
+  end subroutine
+  subroutine spherical_r4(s, r, theta, phi, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real32), intent(in) :: r(:), theta(:), phi(:)
+    integer, intent(out), optional :: ierr
+    call source_grid(s, 1, real(r, c_double), real(theta, c_double), real(phi, c_double), ierr)
+  end subroutine
+  subroutine spherical_r8(s, r, theta, phi, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real64), intent(in) :: r(:), theta(:), phi(:)
+    integer, intent(out), optional :: ierr
+    call source_grid(s, 1, real(r, c_double), real(theta, c_double), real(phi, c_double), ierr)
+  end subroutine
+  subroutine yinyang_r4(s, r, theta, phi, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real32), intent(in) :: r(:), theta(:), phi(:)
+    integer, intent(out), optional :: ierr
+    call source_grid(s, 2, real(r, c_double), real(theta, c_double), real(phi, c_double), ierr)
+  end subroutine
+  subroutine yinyang_r8(s, r, theta, phi, ierr)
+    type(panoptes_t), intent(in) :: s
+    real(real64), intent(in) :: r(:), theta(:), phi(:)
+    integer, intent(out), optional :: ierr
+    call source_grid(s, 2, real(r, c_double), real(theta, c_double), real(phi, c_double), ierr)
+  end subroutine
+
+  !> Yin-Yang: the patch (0 = Yin, 1 = Yang) that the following panoptes_block and panoptes_field calls
+  !> describe; a rank may hold a block of each patch.
+  subroutine panoptes_patch(s, patch, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer, intent(in) :: patch
+    integer, intent(out), optional :: ierr
+    call check(c_set_patch(s%handle, int(patch, c_int)), ierr)
+  end subroutine
+
+  !> Non-uniform grids: points along the longest axis of the uniform grid they are resampled onto
+  !> (0 = the source's largest dimension) and the value outside the grid's domain (default 0).
+  subroutine panoptes_resample(s, longest_axis_points, outside_value, ierr)
+    type(panoptes_t), intent(in) :: s
+    integer, intent(in) :: longest_axis_points
+    real(real64), intent(in), optional :: outside_value
+    integer, intent(out), optional :: ierr
+    real(c_double) :: v
+    v = 0
+    if (present(outside_value)) v = outside_value
+    call check(c_set_resample(s%handle, int(longest_axis_points, c_int), v), ierr)
   end subroutine
 
   !> This rank's owned points (0-based offset, extent) and the ghost layers its arrays STORE below / above.

@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include <array>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <optional>
@@ -14,6 +15,8 @@
 
 #include "core/error.hpp"
 #include "camera/rig_spec.hpp"
+#include "grid/grid_description.hpp"
+#include "insitu/grid_adapter.hpp"
 #include "insitu/resources.hpp"
 #include "insitu/session.hpp"
 #include "insitu/task_plan.hpp"
@@ -68,6 +71,54 @@ class PySession {
       throw Error(std::string("set_grid: ") + e.what());
     }
     grid_ = g;
+    source_.reset();
+  }
+
+  /// A grid that is not a uniform box (C API panoptes_set_grid_rectilinear / _spherical / _yinyang):
+  /// three 1-D coordinate arrays, validated here; the session resamples its fields in situ.
+  void set_source_grid(const std::string& kind, const std::vector<double>& a, const std::vector<double>& b,
+                       const std::vector<double>& c) {
+    const std::string call = "set_grid_" + kind;
+    need_no_session(call.c_str(), "grid");
+    const std::vector<double>* axes[3] = {&a, &b, &c};
+    for (int d = 0; d < 3; ++d)
+      if (axes[d]->size() < 2 || axes[d]->size() > 65535)
+        throw Error(call + ": coordinate array " + std::to_string(d) + " has " + std::to_string(axes[d]->size()) +
+                    " entries; expected 2 to 65535 points");
+    grid::GridDescription g = kind == "rectilinear" ? grid::GridDescription::rectilinear(a, b, c)
+                              : kind == "spherical" ? grid::GridDescription::spherical(a, b, c)
+                                                    : grid::GridDescription::yinyang(a, b, c);
+    try {
+      g.validate();
+    } catch (const std::exception& e) {
+      throw Error(call + ": " + e.what());
+    }
+    source_ = std::move(g);
+    grid_.reset();
+  }
+
+  /// Yin-Yang: the patch (0 = Yin, 1 = Yang) the following set_block/set_field calls describe.
+  void set_patch(int patch) {
+    need_no_session("set_patch", "blocks");
+    if (!source_ || source_->kind != grid::GridKind::yinyang)
+      throw Error("set_patch: only a Yin-Yang grid has patches (call set_grid_yinyang first)");
+    if (patch != 0 && patch != 1) throw Error("set_patch: patch " + std::to_string(patch) + "; expected 0 (Yin) or 1 (Yang)");
+    if (patch == patch_) return;
+    other_patches_[patch_] = {block_, fields_};
+    PatchState next = other_patches_[patch];
+    other_patches_.erase(patch);
+    block_ = next.block;
+    fields_ = next.fields;
+    patch_ = patch;
+  }
+
+  void set_resample(int longest_axis_points, double outside_value) {
+    need_no_session("set_resample", "resampling");
+    if (longest_axis_points != 0 && (longest_axis_points < 2 || longest_axis_points > 4096))
+      throw Error("set_resample: " + std::to_string(longest_axis_points) +
+                  " points; expected 2 to 4096 along the longest axis (0 = the source's largest dimension)");
+    if (!std::isfinite(outside_value)) throw Error("set_resample: the outside value is not finite");
+    resample_ = {longest_axis_points, float(outside_value)};
   }
 
   void set_block(const std::vector<long long>& offset, const std::vector<long long>& extent,
@@ -160,18 +211,30 @@ class PySession {
 
   insitu::Session& session() {
     if (session_) return *session_;
-    if (!grid_) throw Error("set_grid must be called before the first snapshot");
-    if (!block_) throw Error("set_block must be called before the first snapshot");
+    if (!grid_ && !source_) throw Error("set_grid (or set_grid_rectilinear, _spherical, _yinyang) must be called before the first snapshot");
+    if (!block_ && (!source_ || grid_blocks().empty())) throw Error("set_block must be called before the first snapshot");
+    if (source_) config_.source_grid = source_->summary();
     py::gil_scoped_release release;  // collective construction: other ranks may still be in Python
 #ifdef PANOPTES_HAVE_MPI
     int init = 0;
     MPI_Initialized(&init);
     if (comm_ || init) {
-      session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_, comm_ ? *comm_ : MPI_COMM_WORLD);
+      const MPI_Comm c = comm_ ? *comm_ : MPI_COMM_WORLD;
+      if (source_) {
+        adapter_ = std::make_unique<insitu::GridAdapter>(*source_, grid_blocks(), resample_, c);
+        session_ = std::make_unique<insitu::Session>(config_, adapter_->render_grid(), adapter_->render_block(), c);
+      } else {
+        session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_, c);
+      }
       return *session_;
     }
 #endif
-    session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_);
+    if (source_) {
+      adapter_ = std::make_unique<insitu::GridAdapter>(*source_, grid_blocks(), resample_);
+      session_ = std::make_unique<insitu::Session>(config_, adapter_->render_grid(), adapter_->render_block());
+    } else {
+      session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_);
+    }
     return *session_;
   }
 
@@ -216,10 +279,36 @@ class PySession {
   void need_no_session(const char* call, const char* what) const {
     if (session_) throw Error(std::string(call) + ": the " + what + " cannot change after the first snapshot");
   }
-  std::vector<insitu::FieldInput> inputs() const {
-    std::vector<insitu::FieldInput> v;
-    for (const auto& [name, f] : fields_) v.push_back(f.first);
+  using Fields = std::map<std::string, std::pair<insitu::FieldInput, py::array>>;
+  struct PatchState {
+    std::optional<insitu::LocalBlock> block;
+    Fields fields;
+  };
+  // Every patch's state, the selected one included, in patch order (non-uniform grids).
+  std::map<int, PatchState> all_patches() const {
+    std::map<int, PatchState> all = other_patches_;
+    all[patch_] = {block_, fields_};
+    return all;
+  }
+  std::vector<insitu::GridBlock> grid_blocks() const {
+    std::vector<insitu::GridBlock> v;
+    for (const auto& [patch, st] : all_patches())
+      if (st.block) v.push_back({patch, st.block->offset, st.block->extent, st.block->ghost_lo, st.block->ghost_hi});
     return v;
+  }
+  // Non-uniform grids: one input per field and block, blocks in patch order (as grid_blocks() gave
+  // them to the adapter), resampled onto this rank's slab. Collective (adapt() exchanges points).
+  std::vector<insitu::FieldInput> inputs() {
+    std::vector<insitu::FieldInput> v;
+    if (!adapter_) {
+      for (const auto& [name, f] : fields_) v.push_back(f.first);
+      return v;
+    }
+    for (const auto& [patch, st] : all_patches())
+      if (st.block)
+        for (const auto& [name, f] : st.fields) v.push_back(f.first);
+    py::gil_scoped_release release;
+    return adapter_->adapt(v);
   }
 
   insitu::SessionConfig config_;
@@ -230,7 +319,12 @@ class PySession {
 #endif
   std::optional<render::GridGeometry> grid_;
   std::optional<insitu::LocalBlock> block_;
-  std::map<std::string, std::pair<insitu::FieldInput, py::array>> fields_;
+  Fields fields_;
+  std::optional<grid::GridDescription> source_;
+  insitu::ResampleOptions resample_;
+  int patch_ = 0;
+  std::map<int, PatchState> other_patches_;
+  std::unique_ptr<insitu::GridAdapter> adapter_;
   std::unique_ptr<insitu::Session> session_;
 };
 
@@ -240,6 +334,9 @@ void bind_session(py::module_& m) {
   py::class_<PySession>(m, "Session")
       .def(py::init<std::string, bool, py::object>(), py::arg("config"), py::arg("is_file"), py::arg("comm"))
       .def("set_grid", &PySession::set_grid, py::arg("dims"), py::arg("origin"), py::arg("spacing"))
+      .def("set_source_grid", &PySession::set_source_grid, py::arg("kind"), py::arg("a"), py::arg("b"), py::arg("c"))
+      .def("set_patch", &PySession::set_patch, py::arg("patch"))
+      .def("set_resample", &PySession::set_resample, py::arg("longest_axis_points"), py::arg("outside_value"))
       .def("set_block", &PySession::set_block, py::arg("offset"), py::arg("extent"), py::arg("ghost_lo"),
            py::arg("ghost_hi"))
       .def("set_halo", &PySession::set_halo, py::arg("valid_lo"), py::arg("valid_hi"), py::arg("edges_valid"))

@@ -4,6 +4,17 @@ import os
 from . import _panoptes
 
 
+def _coordinates(*axes):
+    import numpy as np
+    out = []
+    for a in axes:
+        a = np.asarray(a, dtype=np.float64)
+        if a.ndim != 1:
+            raise _panoptes.Error(f"coordinate array of shape {a.shape}; expected a 1-D array")
+        out.append(a.tolist())
+    return out
+
+
 class Session:
     """An in-situ visualization session (the C API's panoptes_session, for Python).
 
@@ -20,6 +31,33 @@ class Session:
     def set_grid(self, dims, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)):
         """The global grid: dims = points per axis (nx, ny, nz), origin and spacing in world units."""
         self._s.set_grid([int(d) for d in dims], [float(o) for o in origin], [float(s) for s in spacing])
+
+    def set_grid_rectilinear(self, x, y, z):
+        """A rectilinear grid: 1-D arrays of strictly increasing coordinates per axis (nx, ny, nz points).
+        Its fields are resampled in situ onto a uniform grid over its bounding box (set_resample)."""
+        self._s.set_source_grid("rectilinear", *_coordinates(x, y, z))
+
+    def set_grid_spherical(self, r, theta, phi):
+        """A spherical shell (or sector): 1-D arrays of radii, colatitudes in [0, pi] from +z and longitudes
+        (radians), each strictly increasing; point (i, j, k) = (r[i], theta[j], phi[k]), so a field's
+        array has shape (nphi, ntheta, nr). Points outside the shell take the outside value (set_resample)."""
+        self._s.set_source_grid("spherical", *_coordinates(r, theta, phi))
+
+    def set_grid_yinyang(self, r, theta, phi):
+        """A Yin-Yang grid: the coordinates of one patch (as set_grid_spherical), shared by Yin (patch 0)
+        and Yang (patch 1, Yin's frame rotated by (x, y, z) -> (-x, z, y)). Select a block's patch with
+        set_patch before its set_block and set_field."""
+        self._s.set_source_grid("yinyang", *_coordinates(r, theta, phi))
+
+    def set_patch(self, patch):
+        """Yin-Yang: the patch (0 = Yin, 1 = Yang) the following set_block and set_field calls describe; a
+        process may hold a block of each."""
+        self._s.set_patch(int(patch))
+
+    def set_resample(self, longest_axis_points=0, outside_value=0.0):
+        """Non-uniform grids: points along the longest axis of the uniform grid the fields are resampled
+        onto (0 = the source's largest dimension) and the value outside the grid's domain."""
+        self._s.set_resample(int(longest_axis_points), float(outside_value))
 
     def set_block(self, offset, extent, ghost_lo=(0, 0, 0), ghost_hi=(0, 0, 0)):
         """This rank's owned points (0-based (x, y, z) offset, extent) and the ghost layers its arrays hold."""
