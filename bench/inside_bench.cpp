@@ -51,7 +51,7 @@ double process_cpu_seconds() {
 
 const bench::StandardScene& scene() { return bench::standard_scene(); }
 
-void BM_EquirectFrame(benchmark::State& state) {
+void equirect_frame(benchmark::State& state, bool full_march) {
   const auto& sc = scene();
   const bool inside = state.range(0) != 0;
   const Vec3 c = sc.grid.centre();
@@ -74,7 +74,7 @@ void BM_EquirectFrame(benchmark::State& state) {
   finish(full);
   const double cpu0 = process_cpu_seconds(), wall0 = omp_get_wtime();
   for (auto _ : state) {
-    render_brick(cam, sc.fields, tasks, out);  // the default options: what users get
+    render_brick(cam, sc.fields, tasks, out, full_march ? every_pixel : RenderOptions{});  // defaults: what users get
     finish(images);
     benchmark::DoNotOptimize(images.data());
   }
@@ -85,7 +85,12 @@ void BM_EquirectFrame(benchmark::State& state) {
   for (std::size_t t = 0; t < images.size(); ++t) worst = std::min(worst, psnr(images[t], full[t]));
   state.counters["psnr_db"] = std::min(worst, 999.0);  // identical images: +inf, shown as 999
 }
+void BM_EquirectFrame(benchmark::State& state) { equirect_frame(state, false); }
 BENCHMARK(BM_EquirectFrame)->ArgName("inside")->Arg(1)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The same frames by the full march (every pixel, RenderOptions::equirect_adaptive off): the renderer
+// before issue 32, measured in the same run for the before/after ratio (psnr_db is then 999).
+void BM_EquirectFrameFullMarch(benchmark::State& state) { equirect_frame(state, true); }
+BENCHMARK(BM_EquirectFrameFullMarch)->ArgName("inside")->Arg(1)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 const fs::path& lattice_db() {
   static const fs::path dir = [] {

@@ -8,6 +8,13 @@
 
 namespace panoptes::render {
 
+int equirect_row_stride(double degrees, int width) {
+  const double pixels = degrees * width / 360.0;
+  int s = 2;
+  while (2.0 * s <= pixels) s *= 2;
+  return s;
+}
+
 int equirect_column_stride(int stride, int height, int y0, int y1, int max_stride) {
   if (stride < 1 || height < 1 || y0 < 0 || y1 > height || y0 >= y1)
     throw std::invalid_argument("equirect_column_stride: stride " + std::to_string(stride) + ", rows [" +

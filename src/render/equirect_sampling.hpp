@@ -14,6 +14,11 @@ namespace panoptes::render {
 inline constexpr int kEquirectTileWidth = 64;
 inline constexpr int kEquirectTileHeight = 32;
 
+/// The coarse lattice's row spacing in pixels for a lattice about `degrees` apart on a frame `width`
+/// pixels wide (360°): the largest power of two not above degrees·width/360, at least 2. Angular, so a
+/// small frame's lattice does not skip more of the sphere than a large one's.
+int equirect_row_stride(double degrees, int width);
+
 /// The coarse lattice's column spacing for the rows [y0, y1) of an equirectangular image `height`
 /// rows tall whose rows are `stride` apart: `stride` times the largest power of two 2^k with
 /// 2^k · cos φ ≤ 1 for the row of the band nearest the equator (pixel centres, φ = (0.5 − (y + 0.5) /

@@ -23,6 +23,14 @@ double latitude_of_row(double y, int height) { return (0.5 - (y + 0.5) / height)
 
 }  // namespace
 
+TEST(EquirectSampling, RowStrideIsAnAngle) {
+  EXPECT_EQ(equirect_row_stride(1.5, 1920), 8);  // 8.0 px
+  EXPECT_EQ(equirect_row_stride(1.5, 1919), 4);  // 7.996 px
+  EXPECT_EQ(equirect_row_stride(1.5, 768), 2);   // 3.2 px
+  EXPECT_EQ(equirect_row_stride(1.5, 360), 2);   // 1.5 px: never below 2
+  EXPECT_EQ(equirect_row_stride(3.0, 3840), 32);
+}
+
 // Known answers for a 960-row frame at stride 8 (the bench's 1920x960): the band touching the equator
 // keeps the stride, a band whose equator-side row lies beyond 60° doubles it, beyond 75.5° quadruples
 // it, and the polar band stops at the cap.
@@ -119,7 +127,7 @@ TEST(EquirectSampling, FramesFromInsideMatchTheFullMarchWithin45dB) {
   const std::vector<TaskSpec> tasks = paper_tasks(views);
   const Vec3 c = grid.centre();
   const camera::Camera cams[] = {
-      camera::Camera(c, c + Vec3{0, 1, 0}, {0, 0, 1}, 60, 480, 240, camera::Projection::equirectangular),
+      camera::Camera(c, c + Vec3{0, 1, 0}, {0, 0, 1}, 60, 960, 480, camera::Projection::equirectangular),
       // Off centre, looking up at an angle: the shells cross the poles and the seam.
       camera::Camera(c + Vec3{-9, 20, 4}, c + Vec3{3, 10, 12}, {0, 0, 1}, 60, 400, 200,
                      camera::Projection::equirectangular)};
@@ -128,7 +136,7 @@ TEST(EquirectSampling, FramesFromInsideMatchTheFullMarchWithin45dB) {
     const Comparison r = compare_with_full_march(cams[ci], grid, fields, tasks);
     std::printf("camera %zu: worst %.2f dB, %.1f %% of the pixels marched\n", ci, r.worst_db, 100 * r.marched);
     EXPECT_GE(r.worst_db, 45.0);
-    EXPECT_LT(r.marched, 0.75);  // measured 66 % and 62 % (the bench's larger frame: 14 %)
+    EXPECT_LT(r.marched, 0.75);  // measured 45 % and 65 % (the bench's 1920x960 frame: 14 %)
   }
 }
 
@@ -144,4 +152,5 @@ TEST(EquirectSampling, DenseScenesAreRefinedNotBlurred) {
   const Comparison r = compare_with_full_march(cam, grid, fields, paper_tasks(views));
   std::printf("dense: worst %.2f dB, %.1f %% of the pixels marched\n", r.worst_db, 100 * r.marched);
   EXPECT_GE(r.worst_db, 45.0);
+  EXPECT_GT(r.marched, 0.8);  // measured 94.5 %; without refinement 26 %
 }

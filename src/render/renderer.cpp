@@ -116,10 +116,10 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
 
   // Equirectangular frames are sampled adaptively on the sphere (equirect_sampling.hpp) unless switched off.
   const bool sphere = opt.equirect_adaptive && cam.projection() == camera::Projection::equirectangular;
-  if (sphere && opt.equirect_stride < 2)
-    throw Error("render: equirect stride " + std::to_string(opt.equirect_stride) + "; expected >= 2");
+  if (sphere && !(opt.equirect_lattice_deg > 0 && opt.equirect_lattice_deg <= 90))
+    throw Error("render: equirect lattice " + std::to_string(opt.equirect_lattice_deg) + " degrees; expected 0 < d <= 90");
   const bool adaptive = opt.adaptive || sphere;
-  const int stride = sphere ? opt.equirect_stride : opt.adaptive_stride;
+  const int stride = sphere ? equirect_row_stride(opt.equirect_lattice_deg, W) : opt.adaptive_stride;
   const int tile_w = sphere ? kEquirectTileWidth : opt.tile, tile_h = sphere ? kEquirectTileHeight : opt.tile;
   // Tiles lie on multiples of the tile edge in image coordinates (clipped to the rect), so the
   // bricks of a decomposition cut their footprints into the same tiles where they overlap: with
