@@ -5,6 +5,8 @@
 // a camera inside the volume (its centre) and from one outside (3 bounding radii).
 //   frames_core_s   camera-frames (all 3 tasks) per core-second: frames / process CPU seconds
 //   frames_s        the same per wall-second
+//   psnr_db         the worst of the 3 task images against today's path (RenderOptions::equirect_adaptive
+//                   off: every pixel marched), rendered once before the timed loop (issue 32)
 // BM_WalkLatency: switch latency when walking through a 4x4x3 lattice of 1920x960 360° streams (stamped
 // synthetic database, gop 1 as in situ) at 30 fps with prefetch, 120 walks (one every 5th frame) along a
 // pseudo-random route, paused or playing; the window draws the cut-out from the cached frame, so the
@@ -18,13 +20,16 @@
 #include <omp.h>
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <thread>
 #include <vector>
 
+#include "core/image.hpp"
 #include "player/engine.hpp"
 #include "player/look.hpp"
 #include "render/renderer.hpp"
@@ -46,7 +51,7 @@ double process_cpu_seconds() {
 
 const bench::StandardScene& scene() { return bench::standard_scene(); }
 
-void BM_EquirectFrame(benchmark::State& state) {
+void equirect_frame(benchmark::State& state, bool full_march) {
   const auto& sc = scene();
   const bool inside = state.range(0) != 0;
   const Vec3 c = sc.grid.centre();
@@ -58,16 +63,34 @@ void BM_EquirectFrame(benchmark::State& state) {
       TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
                         TransferFunction::preset("s-wave"), ValueWindow::absolute(0, 1))};
   std::vector<PartialImage> out(tasks.size());
+  const auto finish = [&](std::vector<Image>& images) {
+    images.clear();
+    for (const PartialImage& o : out) images.push_back(finish_image(o, cam, sc.grid, {0, 0, 0}, OutlineStyle{false}));
+  };
+  std::vector<Image> full, images;
+  RenderOptions every_pixel;
+  every_pixel.equirect_adaptive = false;  // the renderer before issue 32's sampling on the sphere
+  render_brick(cam, sc.fields, tasks, out, every_pixel);
+  finish(full);
   const double cpu0 = process_cpu_seconds(), wall0 = omp_get_wtime();
   for (auto _ : state) {
-    render_brick(cam, sc.fields, tasks, out);
-    for (const PartialImage& o : out) benchmark::DoNotOptimize(finish_image(o, cam, sc.grid, {0, 0, 0}, OutlineStyle{false}));
+    render_brick(cam, sc.fields, tasks, out, full_march ? every_pixel : RenderOptions{});  // defaults: what users get
+    finish(images);
+    benchmark::DoNotOptimize(images.data());
   }
   const double frames = double(state.iterations());
   state.counters["frames_core_s"] = frames / (process_cpu_seconds() - cpu0);
   state.counters["frames_s"] = frames / (omp_get_wtime() - wall0);
+  double worst = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < images.size(); ++t) worst = std::min(worst, psnr(images[t], full[t]));
+  state.counters["psnr_db"] = std::min(worst, 999.0);  // identical images: +inf, shown as 999
 }
+void BM_EquirectFrame(benchmark::State& state) { equirect_frame(state, false); }
 BENCHMARK(BM_EquirectFrame)->ArgName("inside")->Arg(1)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The same frames by the full march (every pixel, RenderOptions::equirect_adaptive off): the renderer
+// before issue 32, measured in the same run for the before/after ratio (psnr_db is then 999).
+void BM_EquirectFrameFullMarch(benchmark::State& state) { equirect_frame(state, true); }
+BENCHMARK(BM_EquirectFrameFullMarch)->ArgName("inside")->Arg(1)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 const fs::path& lattice_db() {
   static const fs::path dir = [] {

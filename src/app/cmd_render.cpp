@@ -204,6 +204,7 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   if (a.crf >= 0) cfg.video.crf = a.crf;
   cfg.render.sample_distance = a.sample_distance;
   cfg.render.adaptive = a.adaptive;
+  cfg.render.equirect_adaptive = a.adaptive;  // --no-adaptive marches every pixel of 360° frames too
   cfg.percentile = a.percentile;
   cfg.running_max = a.reference == "running-max";
   cfg.check_memory = !a.force;
@@ -331,7 +332,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       ->check(CLI::Range(0.01, 16.0))->capture_default_str();
   sub->add_flag("--adaptive,!--no-adaptive", args->adaptive,
                 "Adaptive image-space sampling: march every 4th pixel and interpolate where the image is smooth "
-                "(default: on; --no-adaptive marches every pixel)");
+                "(default: on; 360° frames are sampled on the sphere: a lattice about 1.5° apart whose columns "
+                "widen toward the poles; --no-adaptive marches every pixel of every frame)");
   sub->add_option("--percentile", args->percentile,
                   "Reference for relative windows: this quantile of |v| (sampled as in situ: a lattice of about "
                   "65,536 points, at least 0.001 x the maximum)")

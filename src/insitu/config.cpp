@@ -181,7 +181,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance"});
+                                      "adaptive_tolerance", "equirect_adaptive"});
     const std::string ref = str(c, *r, "reference", "render.", "snapshot");
     if (ref != "snapshot" && ref != "running-max")
       c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\" or \"running-max\"");
@@ -196,6 +196,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     if (!(s.render.termination_alpha > 0.5f && s.render.termination_alpha <= 1.0f))
       c.fail("render.termination_alpha", "expected a value in (0.5, 1]");
     s.render.adaptive = boolean(c, *r, "adaptive", "render.", false);
+    s.render.equirect_adaptive = boolean(c, *r, "equirect_adaptive", "render.", true);
     // In the final image's units (1/255) in the file: what users see.
     const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
     if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");
@@ -287,7 +288,9 @@ const char* config_keys_help() {
             | "running-max" (running maximum over snapshots: colours comparable across frames, but
             decaying waves fade); skip_empty = true; termination_alpha = 0.998;
             adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
-            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere)
+            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere);
+            equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
+            apart whose columns widen toward the poles, whatever adaptive says; false = every pixel)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
             available: MemAvailable or the cgroup limit; false = panoptes run --force)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |

@@ -106,9 +106,12 @@ class AdaptiveTile {
   /// `follow`: the tasks refined wherever any task is (isosurfaces and slices: their thin edges may
   /// fall between four agreeing corners, and the finer lattice of the volume tasks catches many of
   /// them, as before per-task decisions); the others decide alone.
+  /// `column_stride` (0: the stride) spaces the coarse lattice's columns differently from its rows
+  /// (equirectangular frames widen them toward the poles, equirect_sampling.hpp); cells are split at
+  /// their midpoints on both axes as square ones are.
   template <class March, class Locate>
   void run(const PixelRect& tile, std::span<PartialImage> out, March&& march, Locate&& locate,
-           std::uint64_t follow = 0, const Silhouette* silhouette = nullptr) {
+           std::uint64_t follow = 0, const Silhouette* silhouette = nullptr, int column_stride = 0) {
     if (out.size() > 64) throw std::invalid_argument("AdaptiveTile: more than 64 images in one march");
     tile_ = tile;
     follow_ = follow;
@@ -122,8 +125,8 @@ class AdaptiveTile {
     // The coarse lattice: the tile's borders and the multiples of the stride between them.
     xs_.clear();
     ys_.clear();
-    lattice(tile.x0, tile.x1, xs_);
-    lattice(tile.y0, tile.y1, ys_);
+    lattice(tile.x0, tile.x1, column_stride > 0 ? column_stride : stride_, xs_);
+    lattice(tile.y0, tile.y1, stride_, ys_);
     for (int y : ys_)
       for (int x : xs_) mark_marched(x, y, all, march);
     for (std::size_t j = 0; j + 1 < ys_.size(); ++j)
@@ -133,9 +136,9 @@ class AdaptiveTile {
   }
 
  private:
-  void lattice(int a0, int a1, std::vector<int>& v) const {
+  static void lattice(int a0, int a1, int stride, std::vector<int>& v) {
     v.push_back(a0);
-    for (int a = (a0 / stride_ + 1) * stride_; a < a1 - 1; a += stride_) v.push_back(a);
+    for (int a = (a0 / stride + 1) * stride; a < a1 - 1; a += stride) v.push_back(a);
     v.push_back(a1 - 1);  // == a0 for a tile one pixel wide: cells of width 0 then cover its column
   }
   std::size_t at(int x, int y) const {

@@ -412,9 +412,15 @@ TEST(Compositing, RejectsInconsistentInput) {
 
 // Cameras inside the domain (issue 14): rays start inside a brick, and bricks lie in front of and
 // behind the eye along different rays. The march clamps each ray's entry at t = 0 and keeps the global
-// sample positions, so the bricks still composite to the single-brick image.
+// sample positions, so the bricks still composite to the single-brick image. The full march
+// (equirect_adaptive off) within 1/255; the default 360° frames, sampled adaptively on the sphere
+// (equirect_sampling.hpp), decide their refinement per brick and composite as adaptive images do
+// (Quality.AdaptiveSamplingRefinesEdgesAndCompositesAcrossBricks): within 40 dB, and every pixel's
+// depth is the full march's, bit for bit, whichever brick the eye is in or on.
 TEST(Compositing, CamerasInsideTheDomainMatchTheSingleBrickImage) {
   const Scene sc;
+  RenderOptions full;
+  full.equirect_adaptive = false;
   const camera::Camera inside[] = {
       camera::Camera({-3, 2, 1}, {10, 4, 0}, {0, 0, 1}, 90, 36, 30),
       camera::Camera({4, -6, -2}, {4, 10, -2}, {0, 0, 1}, 60, 48, 24, camera::Projection::equirectangular),
@@ -423,15 +429,31 @@ TEST(Compositing, CamerasInsideTheDomainMatchTheSingleBrickImage) {
   };
   for (std::size_t ci = 0; ci < std::size(inside); ++ci) {
     const camera::Camera& cam = inside[ci];
-    const auto ref = render_bricked(cam, sc.views, sc.tasks, {Brick::whole(sc.grid)});
+    const auto ref = render_bricked(cam, sc.views, sc.tasks, {Brick::whole(sc.grid)}, full);
+    const auto ref_sphere = render_bricked(cam, sc.views, sc.tasks, {Brick::whole(sc.grid)});
     for (int axis : {2, 0})
       for (int n : {2, 3, 4}) {
-        const auto img = render_bricked(cam, sc.views, sc.tasks, sc.slabs(axis, n));
-        const auto ordered = render_bricked(cam, sc.views, sc.tasks, sc.slabs(axis, n), {}, true);
+        const auto img = render_bricked(cam, sc.views, sc.tasks, sc.slabs(axis, n), full);
+        const auto ordered = render_bricked(cam, sc.views, sc.tasks, sc.slabs(axis, n), full, true);
+        const auto sphere = render_bricked(cam, sc.views, sc.tasks, sc.slabs(axis, n), {}, true);
         for (std::size_t t = 0; t < sc.tasks.size(); ++t) {
           EXPECT_LE(max_diff(img[t], ref[t]), 1) << "camera " << ci << ", axis " << axis << ", " << n << " bricks, task " << t;
           EXPECT_LE(max_diff(ordered[t], ref[t]), 1) << "ordered, camera " << ci << ", axis " << axis << ", " << n
                                                      << " bricks, task " << t;
+          if (cam.projection() == camera::Projection::equirectangular) {
+            EXPECT_GE(psnr(sphere[t], ref_sphere[t]), 40.0) << "sphere, camera " << ci << ", axis " << axis << ", " << n
+                                                          << " bricks, task " << t;
+          }
+        }
+        // The bricks' partial depths are the full march's (the eye-in-brick shortcut included).
+        for (const Brick& b : sc.slabs(axis, n)) {
+          std::vector<PreparedField> fields;
+          for (const FieldView& f : sc.views) fields.emplace_back(f.subview(b));
+          std::vector<PartialImage> a(sc.tasks.size()), d(sc.tasks.size());
+          render_brick(cam, fields, sc.tasks, a);
+          render_brick(cam, fields, sc.tasks, d, full);
+          for (std::size_t t = 0; t < sc.tasks.size(); ++t)
+            ASSERT_TRUE(a[t].depth == d[t].depth) << "camera " << ci << ", axis " << axis << ", " << n << " bricks, task " << t;
         }
       }
   }

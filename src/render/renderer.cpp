@@ -5,6 +5,7 @@
 // (march_plan.hpp), slices intersected, and adaptive sampling (adaptive_sampling.hpp). The rooms
 // of the march are listed in docs/rendering.md.
 #include "render/adaptive_sampling.hpp"
+#include "render/equirect_sampling.hpp"
 #include "render/march_plan.hpp"
 #include "render/ray_march.hpp"
 #include "render/sample_blocks.hpp"
@@ -113,13 +114,19 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   rect = out.empty() ? PixelRect{} : out[0].rect;
   if (tasks.empty()) return stats;
 
-  const int tile = opt.tile;
+  // Equirectangular frames are sampled adaptively on the sphere (equirect_sampling.hpp) unless switched off.
+  const bool sphere = opt.equirect_adaptive && cam.projection() == camera::Projection::equirectangular;
+  if (sphere && !(opt.equirect_lattice_deg > 0 && opt.equirect_lattice_deg <= 90))
+    throw Error("render: equirect lattice " + std::to_string(opt.equirect_lattice_deg) + " degrees; expected 0 < d <= 90");
+  const bool adaptive = opt.adaptive || sphere;
+  const int stride = sphere ? equirect_row_stride(opt.equirect_lattice_deg, W) : opt.adaptive_stride;
+  const int tile_w = sphere ? kEquirectTileWidth : opt.tile, tile_h = sphere ? kEquirectTileHeight : opt.tile;
   // Tiles lie on multiples of the tile edge in image coordinates (clipped to the rect), so the
   // bricks of a decomposition cut their footprints into the same tiles where they overlap: with
   // adaptive sampling their lattices, and so most refinement decisions, then coincide.
-  const int tx_first = rect.x0 / tile, ty_first = rect.y0 / tile;
-  const int ntx = rect.empty() ? 0 : (rect.x1 - 1) / tile - tx_first + 1;
-  const int nty = rect.empty() ? 0 : (rect.y1 - 1) / tile - ty_first + 1;
+  const int tx_first = rect.x0 / tile_w, ty_first = rect.y0 / tile_h;
+  const int ntx = rect.empty() ? 0 : (rect.x1 - 1) / tile_w - tx_first + 1;
+  const int nty = rect.empty() ? 0 : (rect.y1 - 1) / tile_h - ty_first + 1;
   const int K = int(tasks.size());
   const double glo[3] = {0, 0, 0};
   const double ghi[3] = {double(S.grid.dims[0] - 1), double(S.grid.dims[1] - 1), double(S.grid.dims[2] - 1)};
@@ -127,7 +134,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   const double bhi[3] = {double(S.brick.hi[0]), double(S.brick.hi[1]), double(S.brick.hi[2])};
   if (opt.adaptive && opt.adaptive_stride < 2)
     throw Error("render: adaptive stride " + std::to_string(opt.adaptive_stride) + "; expected >= 2");
-  if (opt.adaptive && !(opt.adaptive_tolerance >= 0))
+  if (adaptive && !(opt.adaptive_tolerance >= 0))
     throw Error("render: adaptive tolerance " + std::to_string(opt.adaptive_tolerance) + "; expected >= 0");
   std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0, n_interpolated = 0;
   const std::uint64_t all_tasks = K == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << K) - 1;
@@ -194,6 +201,10 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     if (!planar) r.face = 0;
     return true;
   };
+  // An eye strictly inside the brick: every ray meets it at t = 0 (depth 0, no face), as locate() finds
+  // with its slab tests, which an interpolated pixel of a 360° frame from inside would spend most on.
+  bool eye_in_brick = true;
+  for (int a = 0; a < 3; ++a) eye_in_brick = eye_in_brick && O_index[a] > blo[a] && O_index[a] < bhi[a];
   // The entry depth of pixel (x, y) whose ray is known to enter through plane `face` (as locate()
   // reported for the corners of its adaptive cell): that plane's term of the slab test, bit for bit.
   auto face_depth = [&](int x, int y, std::uint8_t face) {
@@ -247,13 +258,13 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
 #pragma omp parallel reduction(+ : n_rays, n_eff, n_marched, n_interpolated)
   {
     alignas(64) float acc[kMaxTasksPerMarch][4];
-    AdaptiveTile refiner(opt.adaptive_stride, opt.adaptive_tolerance);
+    AdaptiveTile refiner(stride, opt.adaptive_tolerance);
 #pragma omp for schedule(dynamic, 1)
     for (int ti = 0; ti < ntx * nty; ++ti) {
-      const int tx0 = std::max(rect.x0, (tx_first + ti % ntx) * tile), ty0 = std::max(rect.y0, (ty_first + ti / ntx) * tile);
-      const int tx1 = std::min((tx_first + ti % ntx + 1) * tile, rect.x1), ty1 = std::min((ty_first + ti / ntx + 1) * tile, rect.y1);
+      const int tx0 = std::max(rect.x0, (tx_first + ti % ntx) * tile_w), ty0 = std::max(rect.y0, (ty_first + ti / ntx) * tile_h);
+      const int tx1 = std::min((tx_first + ti % ntx + 1) * tile_w, rect.x1), ty1 = std::min((ty_first + ti / ntx + 1) * tile_h, rect.y1);
       PixelRay r;
-      if (!opt.adaptive) {
+      if (!adaptive) {
         for (int y = ty0; y < ty1; ++y)
           for (int x = tx0; x < tx1; ++x) {
             if (!locate(x, y, r)) {
@@ -275,11 +286,14 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
         return std::uint8_t(0);
       };
       auto depth_of = [&](int x, int y, std::uint8_t face) {
+        if (eye_in_brick) return 0.0f;  // what locate() gives every ray from there, without the slab tests
         if (face) return face_depth(x, y, face);
         return locate(x, y, r) ? r.depth : PartialImage::kNoDepth;
       };
       const std::uint64_t before = refiner.interpolated();
-      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks, silhouette.empty() ? nullptr : &silhouette);
+      const int columns = sphere ? equirect_column_stride(stride, H, ty0, ty1, kEquirectTileWidth / 2) : 0;
+      refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks, silhouette.empty() ? nullptr : &silhouette,
+                  columns);
       n_interpolated += refiner.interpolated() - before;
     }
   }
