@@ -323,7 +323,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance"});
+                                      "adaptive_tolerance", "iso_antialias"});
     const std::string ref = str(c, *r, "reference", "render.", "snapshot");
     if (ref != "snapshot" && ref != "running-max")
       c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\" or \"running-max\"");
@@ -342,6 +342,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
     if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");
     s.render.adaptive_tolerance = float(tol / 255);
+    s.render.iso_antialias = boolean(c, *r, "iso_antialias", "render.", true);
   }
   if (const auto* r = table(c, root, "resources")) {
     only_keys(c, *r, "resources", {"check_memory"});
@@ -429,7 +430,9 @@ const char* config_keys_help() {
             | "running-max" (running maximum over snapshots: colours comparable across frames, but
             decaying waves fade); skip_empty = true; termination_alpha = 0.998;
             adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
-            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere)
+            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere);
+            iso_antialias = true (isosurface silhouettes get partial coverage from rays that graze or
+            nearly miss them: no stair steps; false = every pixel hit or missed, as before)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
             available: MemAvailable or the cgroup limit; false = panoptes run --force)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "render/compositing_kernels.hpp"
+#include "render/iso_edges.hpp"
 #include "render/iso_shading.hpp"
 #include "render/march_runs.hpp"
 #include "render/sample_blocks.hpp"
@@ -434,6 +435,10 @@ class RayMarch {
         case MarchKind::iso: {
           const float* v = vb[T.s1];
           const int l0 = (prev_valid >> T.s1 & 1) ? 0 : 1;
+          if (S.iso_aa_pitch > 0) {
+            stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, l0 == 0, tr_stop, a);
+            break;
+          }
           // Lanes whose segment (sample l − 1 … l) changes sign, found for the whole block at once.
           unsigned cross = 0;
 #ifdef PANOPTES_RENDER_AVX2

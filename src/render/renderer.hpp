@@ -32,6 +32,11 @@ struct RenderOptions {
   bool adaptive = false;
   int adaptive_stride = 4;               ///< coarse lattice spacing in pixels (>= 2), refined by halves
   float adaptive_tolerance = 4.0f / 255;  ///< largest corner range interpolated (4/255: Round 4 of docs/rendering.md)
+  /// Isosurface anti-aliasing (render/iso_edges.hpp): rays that graze or nearly miss a surface
+  /// give it partial coverage (box filter of one pixel), so silhouettes are not stair-stepped.
+  /// Off in the library (images stay those of the reference renderer); the product's
+  /// configurations switch it on ([render] iso_antialias, default true).
+  bool iso_antialias = false;
 };
 
 /// Counters of one render_brick() call.

@@ -1,0 +1,135 @@
+#include "render/iso_edges.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/iso_shading.hpp"
+
+namespace panoptes::render::march {
+
+double pixel_pitch(const camera::Camera& cam) {
+  const double x = 0.5 * cam.width(), y = 0.5 * cam.height();
+  const Vec3 a = normalize(cam.ray(x, y).direction), b = normalize(cam.ray(x, y + 1).direction);
+  return std::acos(std::clamp(dot(a, b), -1.0, 1.0));
+}
+
+namespace {
+
+// Whether a near miss at index position p (value iso + sv, gradient g, |g| = gn) has the surface in
+// its own grid cell or a neighbour: one Newton step towards the surface lands in a cell whose corners
+// bracket the isovalue. Every macro-cell containing p then contains the isovalue (their min/max
+// include a one-point margin), so every brick decomposition marches the sample: the event is seen
+// alike by all of them (without this check a near miss in a cell skipped by one decomposition
+// changed a pixel by 2/255).
+bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double p[3], double sv, const double g[3],
+                  double gn) {
+  int c[3];
+  for (int a = 0; a < 3; ++a) {
+    const double q = p[a] - sv * g[a] / (gn * gn) / S.spacing[a];  // g per world unit, p in index units
+    c[a] = int(std::floor(q));
+    const int own = int(std::floor(p[a]));
+    if (std::abs(c[a] - own) > 1 || c[a] < f.ilo[a] || c[a] > f.ihi[a]) return false;
+  }
+  const float* d = f.data + (f.off0 + c[0] * f.sx + c[1] * f.sy + c[2] * f.sz);
+  float lo = d[0], hi = d[0];
+  for (int corner = 1; corner < 8; ++corner) {
+    const float v = d[(corner & 1 ? f.sx : 0) + (corner & 2 ? f.sy : 0) + (corner & 4 ? f.sz : 0)];
+    lo = std::min(lo, v), hi = std::max(hi, v);
+  }
+  return lo <= iso && iso <= hi;
+}
+
+}  // namespace
+
+int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
+                       const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
+                       float tr_stop, float* a) {
+  const double dt = S.dt, pitch = S.iso_aa_pitch;
+  const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
+  const float iso = T.iso;
+  // How far (in samples) a grazing ray's vertex may lie from its crossing: the chord of a sphere of
+  // radius R at depth x is 2·√(2Rx), ~4 voxels for R = 16 voxels at x = 1/8 voxel.
+  const double max_reach = 4.0 * S.grid.voxel() / dt;
+  // s(j) = f − iso at sample k0 − 1 + j; j = n + 1 (the sample after the block) only on demand.
+  float after = 0;
+  bool have_after = false;
+  auto s = [&](int j) -> float {
+    if (j <= n) return v[j] - iso;
+    if (!have_after) {
+      const float fk = float(k0 + n);  // the march's float positions (as interp_block's)
+      after = interp_clamped(f, P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
+      have_after = true;
+    }
+    return after - iso;
+  };
+  // Composites one event of coverage alpha with shading rgb; true when the task is done.
+  auto add = [&](const float rgb[4], double alpha) {
+    const float T0 = a[3], w = float(T0 * alpha);
+    for (int c = 0; c < 3; ++c) a[c] += w * rgb[c];
+    a[3] = alpha >= 1 ? 0.0f : float(T0 * (1 - alpha));
+    return a[3] <= tr_stop;
+  };
+  for (int j = prev ? 1 : 2; j <= n; ++j) {
+    const float sp = s(j - 1), sc = s(j);
+    const bool cross = (sp < 0) != (sc < 0);
+    if (!cross && !(std::abs(sc) < std::abs(sp))) continue;  // not a crossing, |s| not falling
+    const float sn = s(j + 1);
+    if (!cross && ((sn < 0) != (sc < 0) || std::abs(sc) > std::abs(sn))) continue;  // not a local minimum of |s|
+    // The parabola through samples j − 1, j, j + 1 (u = −1, 0, 1): its vertex u_v and value s_v.
+    const double b = 0.5 * (double(sn) - double(sp)), c2 = 0.5 * (double(sn) - 2.0 * double(sc) + double(sp));
+    const double uv = c2 != 0 ? -b / (2 * c2) : INFINITY;
+    const double sv = c2 != 0 ? double(sc) - b * b / (4 * c2) : double(sc);
+    const std::int64_t k = k0 - 1 + j;
+    alignas(16) float rgb[4];
+    double g[3], gn = 0;
+    if (cross) {
+      // The hit: linear estimate and one regula-falsi step, as without anti-aliasing.
+      double ta = t0 + double(k - 1) * dt, tb = ta + dt;
+      double dpa = sp, dpb = sc;
+      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+      else tb = th, dpb = vh;
+      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
+      gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+      double alpha = 1;
+      // A grazing ray: the parabola has a second root close by (its vertex on the other side of
+      // zero than its curvature, within max_reach of the crossing), so the ray leaves the surface
+      // again soon. Its depth |s_v| / |∇f| at the vertex sets the coverage. The entry (vertex ahead)
+      // takes all of it; the exit (vertex behind) adds nothing: the pair covers `cover`, and a
+      // predicted exit that does not come leaves the entry's coverage rather than a hole.
+      const double uc = -1 + double(sp) / (double(sp) - double(sc));  // the crossing in u
+      if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th > 0) {
+        const double cover = 0.5 + std::abs(sv) / gn / (th * pitch);
+        if (cover < 1) alpha = uv > uc ? cover : 0.0;
+      }
+      if (alpha <= 0) continue;
+      if (add(rgb, alpha)) return j - 1;
+      continue;
+    }
+    // A local minimum of |s|: the ray passes near the surface (or pierces a sliver between samples).
+    if (!(std::abs(uv) <= 1)) continue;
+    const double tv = t0 + (double(k) + uv) * dt;
+    if (!(tv > 0)) continue;
+    const double pv[3] = {O[0] + tv * D[0], O[1] + tv * D[1], O[2] + tv * D[2]};
+    shade_hit(f, S.grid.dims, S.spacing, pv, dir, T.colour, rgb, g);
+    gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (!(gn > 0)) continue;
+    if (!near_surface(f, S, iso, pv, sv, g, gn)) continue;
+    const double x = std::abs(sv) / gn, footprint = tv * pitch;
+    double cover;
+    if ((sv < 0) != (sc < 0)) {
+      cover = std::min(1.0, 0.5 + x / footprint);  // both crossings in one event
+    } else {
+      if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
+      cover = 0.5 - x / footprint;
+      if (cover <= 0) continue;
+    }
+    if (add(rgb, cover)) return j - 1;
+  }
+  return -1;
+}
+
+}  // namespace panoptes::render::march
