@@ -1,6 +1,7 @@
 #include "render/iso_edges.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "render/iso_shading.hpp"
@@ -69,17 +70,69 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     a[3] = alpha >= 1 ? 0.0f : float(T0 * (1 - alpha));
     return a[3] <= tr_stop;
   };
-  for (int j = prev ? 1 : 2; j <= n; ++j) {
+  // Candidate lanes (bit j − 1 for sample j): crossings and local minima of |s|, for the whole block
+  // at once; the last lane's minimum needs the sample after the block, fetched only if it passes
+  // the cell test below.
+  unsigned cand = 0;
+#ifdef PANOPTES_RENDER_AVX2
+  {
+    const __m256 isov = _mm256_set1_ps(iso), sign = _mm256_set1_ps(-0.0f);
+    const __m256 a0 = _mm256_sub_ps(_mm256_loadu_ps(v), isov), b0 = _mm256_sub_ps(_mm256_loadu_ps(v + 1), isov),
+                 c0 = _mm256_sub_ps(_mm256_loadu_ps(v + 2), isov);
+    const __m256 aa = _mm256_andnot_ps(sign, a0), ab = _mm256_andnot_ps(sign, b0), ac = _mm256_andnot_ps(sign, c0);
+    const __m256 zero = _mm256_setzero_ps();
+    const __m256 na = _mm256_cmp_ps(a0, zero, _CMP_LT_OQ), nb = _mm256_cmp_ps(b0, zero, _CMP_LT_OQ),
+                 nc = _mm256_cmp_ps(c0, zero, _CMP_LT_OQ);
+    const __m256 cross = _mm256_xor_ps(na, nb);
+    const __m256 minimum = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ab, aa, _CMP_LT_OQ), _mm256_cmp_ps(ab, ac, _CMP_LE_OQ)),
+                                         _mm256_andnot_ps(_mm256_xor_ps(nb, nc), _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+    cand = unsigned(_mm256_movemask_ps(_mm256_or_ps(cross, minimum)));
+  }
+#else
+  for (int j = 1; j <= kBlock; ++j) {
+    const float sp = v[j - 1] - iso, sc = v[j] - iso, sn = v[j + 1] - iso;
+    const bool cross = (sp < 0) != (sc < 0);
+    const bool minimum = std::abs(sc) < std::abs(sp) && std::abs(sc) <= std::abs(sn) && (sc < 0) == (sn < 0);
+    cand |= unsigned(cross || minimum) << (j - 1);
+  }
+#endif
+  {  // lane n: its successor is not in v
+    const float sp = v[n - 1] - iso, sc = v[n] - iso;
+    const bool maybe = (sp < 0) != (sc < 0) || std::abs(sc) < std::abs(sp);
+    cand = (cand & ((1u << (n - 1)) - 1)) | (unsigned(maybe) << (n - 1));
+  }
+  if (!prev) cand &= ~1u;
+  const float hmin = float(std::min({S.spacing[0], S.spacing[1], S.spacing[2]}));
+  for (; cand; cand &= cand - 1) {
+    const int j = std::countr_zero(cand) + 1;
     const float sp = s(j - 1), sc = s(j);
     const bool cross = (sp < 0) != (sc < 0);
-    if (!cross && !(std::abs(sc) < std::abs(sp))) continue;  // not a crossing, |s| not falling
+    const std::int64_t k = k0 - 1 + j;
+    float cell_range = 0;
+    if (!cross) {
+      // A near miss needs the surface within half a voxel: in this grid cell, |∇f| per voxel is at
+      // most √3 × the corners' range r, so |s| > r (a factor 2 of margin) cannot be one. 8 loads
+      // instead of a gradient for most local minima of a wavy field.
+      const float fk = float(k);
+      const float x = std::clamp(P.bx + fk * P.sx, f.plo[0], f.phi[0]), y = std::clamp(P.by + fk * P.sy, f.plo[1], f.phi[1]),
+                  z = std::clamp(P.bz + fk * P.sz, f.plo[2], f.phi[2]);
+      const int ci = std::min(std::max(int(x), f.ilo[0]), f.ihi[0]), cj = std::min(std::max(int(y), f.ilo[1]), f.ihi[1]),
+                ck = std::min(std::max(int(z), f.ilo[2]), f.ihi[2]);
+      const float* d = f.data + (f.off0 + ci * f.sx + cj * f.sy + ck * f.sz);
+      float lo = d[0], hi = d[0];
+      for (int corner = 1; corner < 8; ++corner) {
+        const float w = d[(corner & 1 ? f.sx : 0) + (corner & 2 ? f.sy : 0) + (corner & 4 ? f.sz : 0)];
+        lo = std::min(lo, w), hi = std::max(hi, w);
+      }
+      cell_range = hi - lo;
+      if (!(std::abs(sc) <= cell_range)) continue;
+    }
     const float sn = s(j + 1);
     if (!cross && ((sn < 0) != (sc < 0) || std::abs(sc) > std::abs(sn))) continue;  // not a local minimum of |s|
     // The parabola through samples j − 1, j, j + 1 (u = −1, 0, 1): its vertex u_v and value s_v.
     const double b = 0.5 * (double(sn) - double(sp)), c2 = 0.5 * (double(sn) - 2.0 * double(sc) + double(sp));
     const double uv = c2 != 0 ? -b / (2 * c2) : INFINITY;
     const double sv = c2 != 0 ? double(sc) - b * b / (4 * c2) : double(sc);
-    const std::int64_t k = k0 - 1 + j;
     alignas(16) float rgb[4];
     double g[3], gn = 0;
     if (cross) {
@@ -113,6 +166,9 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (!(std::abs(uv) <= 1)) continue;
     const double tv = t0 + (double(k) + uv) * dt;
     if (!(tv > 0)) continue;
+    // With |∇f| ≤ √3·r / h the distance is at least |s_v|·h / (√3·r): beyond half the footprint and
+    // on the same side, no coverage (no gradient needed).
+    if ((sv < 0) == (sc < 0) && std::abs(sv) * hmin > 0.87 * cell_range * tv * pitch) continue;
     const double pv[3] = {O[0] + tv * D[0], O[1] + tv * D[1], O[2] + tv * D[2]};
     shade_hit(f, S.grid.dims, S.spacing, pv, dir, T.colour, rgb, g);
     gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
