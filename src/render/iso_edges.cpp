@@ -151,8 +151,9 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       // A grazing ray: the parabola has a second root close by (its vertex on the other side of
       // zero than its curvature, within max_reach of the crossing), so the ray leaves the surface
       // again soon. Its depth |s_v| / |∇f| at the vertex sets the coverage. The entry (vertex ahead)
-      // takes all of it; the exit (vertex behind) adds nothing: the pair covers `cover`, and a
-      // predicted exit that does not come leaves the entry's coverage rather than a hole.
+      // takes all of it; the exit (vertex behind) adds nothing, so the pair covers `cover`. (Letting
+      // an exit with nothing before it on the ray count broke compositing: the entry may lie in the
+      // brick in front.)
       const double uc = -1 + double(sp) / (double(sp) - double(sc));  // the crossing in u
       if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th > 0) {
         const double cover = 0.5 + std::abs(sv) / gn / (th * pitch);
@@ -162,27 +163,42 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       if (add(rgb, alpha)) return j - 1;
       continue;
     }
-    // A local minimum of |s|: the ray passes near the surface (or pierces a sliver between samples).
+    // A local minimum of |s|: the ray passes near the surface, or pierces a sliver of it between
+    // two samples (the saw teeth of grazing views: whether a sample fell inside the sliver decided
+    // hit or miss). The field at the parabola's vertex tells which.
     if (!(std::abs(uv) <= 1)) continue;
     const double tv = t0 + (double(k) + uv) * dt;
     if (!(tv > 0)) continue;
-    // With |∇f| ≤ √3·r / h the distance is at least |s_v|·h / (√3·r): beyond half the footprint and
-    // on the same side, no coverage (no gradient needed).
-    if ((sv < 0) == (sc < 0) && std::abs(sv) * hmin > 0.87 * cell_range * tv * pitch) continue;
     const double pv[3] = {O[0] + tv * D[0], O[1] + tv * D[1], O[2] + tv * D[2]};
+    const double s_v = double(interp_clamped(f, pv[0], pv[1], pv[2]) - iso);
+    if ((s_v < 0) != (sc < 0)) {
+      // A sliver: the entry lies between the last sample before the vertex and the vertex.
+      double ta = t0 + double(uv < 0 ? k - 1 : k) * dt, tb = tv;
+      double dpa = uv < 0 ? sp : sc, dpb = s_v;
+      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+      else tb = th, dpb = vh;
+      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
+      gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+      // Its depth is at least |s_v| / |∇f|: coverage of the pair in one event.
+      const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_v) / gn / (th * pitch) : 1.0;
+      if (add(rgb, std::min(1.0, cover))) return j - 1;
+      continue;
+    }
+    // A near miss. With |∇f| ≤ √3·r / h the distance is at least |s_v|·h / (√3·r): beyond half the
+    // footprint, no coverage (no gradient needed).
+    if (std::abs(s_v) * hmin > 0.87 * cell_range * tv * pitch) continue;
     shade_hit(f, S.grid.dims, S.spacing, pv, dir, T.colour, rgb, g);
     gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
     if (!(gn > 0)) continue;
-    if (!near_surface(f, S, iso, pv, sv, g, gn)) continue;
-    const double x = std::abs(sv) / gn, footprint = tv * pitch;
-    double cover;
-    if ((sv < 0) != (sc < 0)) {
-      cover = std::min(1.0, 0.5 + x / footprint);  // both crossings in one event
-    } else {
-      if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
-      cover = 0.5 - x / footprint;
-      if (cover <= 0) continue;
-    }
+    if (!near_surface(f, S, iso, pv, s_v, g, gn)) continue;
+    const double x = std::abs(s_v) / gn, footprint = tv * pitch;
+    if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
+    const double cover = 0.5 - x / footprint;
+    if (cover <= 0) continue;
     if (add(rgb, cover)) return j - 1;
   }
   return -1;

@@ -23,9 +23,11 @@ double pixel_pitch(const camera::Camera& cam);
 ///   tells whether the ray grazes the surface and how deep (|s| at the vertex / |∇f|, world units);
 ///   coverage c = 0.5 + depth / footprint (box filter), each of the two crossings of a grazing ray
 ///   gets α = 1 − √(1 − c) so both together cover c; a crossing with c ≥ 1 is opaque (the old hit).
-/// - a near miss at sample k (|s| a local minimum, no sign change): coverage 0.5 − distance /
-///   footprint, for distances up to half a voxel (the macro-cells' one-point margin keeps such
-///   samples in active cells in every brick decomposition).
+/// - a local minimum of |s| at sample k (no sign change): the field at the parabola's vertex, one
+///   extra sample, tells a sliver pierced between two samples (a hit, found by regula falsi towards
+///   the vertex: the saw teeth of grazing views came from missing those) from a near miss, which
+///   gets coverage 0.5 − distance / footprint for distances up to half a voxel where a Newton step
+///   lands in a grid cell that brackets the isovalue (so every brick decomposition marches it).
 /// Accumulates into a (colour premultiplied, a[3] = transmittance). Returns the lane (0 … n − 1)
 /// where the task became opaque, or −1.
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
