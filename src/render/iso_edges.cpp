@@ -44,7 +44,7 @@ bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double
 
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
                        const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       float tr_stop, float* a) {
+                       std::int64_t k_last, double t_exit, float tr_stop, float* a) {
   const double dt = S.dt, pitch = S.iso_aa_pitch;
   const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
   const float iso = T.iso;
@@ -155,7 +155,10 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       // an exit with nothing before it on the ray count broke compositing: the entry may lie in the
       // brick in front.)
       const double uc = -1 + double(sp) / (double(sp) - double(sc));  // the crossing in u
-      if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th > 0) {
+      // Only where a pixel is a sizeable part of a voxel (>= 1/4): in views magnified beyond that
+      // (inside the data, near the camera) a fit across a crease of the trilinear field could
+      // predict an exit that never comes, and the ray would see the dark behind (dotted lines).
+      if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th * pitch >= 0.25 * hmin) {
         const double cover = 0.5 + std::abs(sv) / gn / (th * pitch);
         if (cover < 1) alpha = uv > uc ? cover : 0.0;
       }
@@ -166,15 +169,38 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     // A local minimum of |s|: the ray passes near the surface, or pierces a sliver of it between
     // two samples (the saw teeth of grazing views: whether a sample fell inside the sliver decided
     // hit or miss). The field at the parabola's vertex tells which.
-    if (!(std::abs(uv) <= 1)) continue;
-    const double tv = t0 + (double(k) + uv) * dt;
-    if (!(tv > 0)) continue;
-    const double pv[3] = {O[0] + tv * D[0], O[1] + tv * D[1], O[2] + tv * D[2]};
-    const double s_v = double(interp_clamped(f, pv[0], pv[1], pv[2]) - iso);
-    if ((s_v < 0) != (sc < 0)) {
-      // A sliver: the entry lies between the last sample before the vertex and the vertex.
-      double ta = t0 + double(uv < 0 ? k - 1 : k) * dt, tb = tv;
-      double dpa = uv < 0 ? sp : sc, dpb = s_v;
+    // Up to three parabolic steps on the bracket (u = −1, 0, 1 around sample k) towards the minimum
+    // of |s|; a value of the other sign is a sliver, whose entry lies between the last point
+    // before it (same sign) and it.
+    double ua = -1, ub = 0, uz = 1, fa = sp, fb = sc, fz = sn;
+    bool pierced = false;
+    double u_in = 0, s_in = 0, u_out = 0, s_out = 0;
+    for (int it = 0; it < 3 && !pierced; ++it) {
+      const double p = (ub - ua) * (ub - ua) * (fb - fz) - (ub - uz) * (ub - uz) * (fb - fa);
+      const double q = (ub - ua) * (fb - fz) - (ub - uz) * (fb - fa);
+      double u = q != 0 ? ub - 0.5 * p / q : ub;
+      if (!(u > ua && u < uz) || std::abs(u - ub) < 1e-3) u = ub - ua > uz - ub ? 0.5 * (ua + ub) : 0.5 * (ub + uz);
+      const double tu = t0 + (double(k) + u) * dt;
+      const double su = double(interp_clamped(f, O[0] + tu * D[0], O[1] + tu * D[1], O[2] + tu * D[2]) - iso);
+      if ((su < 0) != (sc < 0)) {
+        pierced = true;
+        u_out = u, s_out = su;
+        if (u > ub) u_in = ub, s_in = fb;
+        else u_in = ua, s_in = fa;
+      } else if (std::abs(su) < std::abs(fb)) {
+        if (u > ub) ua = ub, fa = fb;
+        else uz = ub, fz = fb;
+        ub = u, fb = su;
+      } else if (u > ub) {
+        uz = u, fz = su;
+      } else {
+        ua = u, fa = su;
+      }
+    }
+    if (pierced) {
+      // A sliver: the entry by regula falsi between u_in and u_out.
+      double ta = t0 + (double(k) + u_in) * dt, tb = t0 + (double(k) + u_out) * dt;
+      double dpa = s_in, dpb = s_out;
       double th = ta + (tb - ta) * (dpa / (dpa - dpb));
       const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
       if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
@@ -183,11 +209,14 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
       shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-      // Its depth is at least |s_v| / |∇f|: coverage of the pair in one event.
-      const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_v) / gn / (th * pitch) : 1.0;
+      // Its depth is at least |s| at the point found / |∇f|: coverage of the pair in one event.
+      const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_out) / gn / (th * pitch) : 1.0;
       if (add(rgb, std::min(1.0, cover))) return j - 1;
       continue;
     }
+    const double tv = t0 + (double(k) + ub) * dt, s_v = fb;
+    if (!(tv > 0)) continue;
+    const double pv[3] = {O[0] + tv * D[0], O[1] + tv * D[1], O[2] + tv * D[2]};
     // A near miss. With |∇f| ≤ √3·r / h the distance is at least |s_v|·h / (√3·r): beyond half the
     // footprint, no coverage (no gradient needed).
     if (std::abs(s_v) * hmin > 0.87 * cell_range * tv * pitch) continue;
@@ -200,6 +229,25 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     const double cover = 0.5 - x / footprint;
     if (cover <= 0) continue;
     if (add(rgb, cover)) return j - 1;
+  }
+  if (k0 + n - 1 == k_last && t_exit > t0 + double(k_last) * dt) {
+    // The ray's last stretch in the domain, after its last sample.
+    const float sl = s(n);
+    double ta = t0 + double(k_last) * dt, tb = t_exit;
+    const double se = interp_clamped(f, O[0] + tb * D[0], O[1] + tb * D[1], O[2] + tb * D[2]) - iso;
+    if ((se < 0) != (sl < 0)) {
+      double dpa = sl, dpb = se;
+      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+      else tb = th, dpb = vh;
+      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+      alignas(16) float rgb[4];
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb);
+      add(rgb, 1.0);
+      return n - 1;
+    }
   }
   return -1;
 }

@@ -28,10 +28,13 @@ double pixel_pitch(const camera::Camera& cam);
 ///   the vertex: the saw teeth of grazing views came from missing those) from a near miss, which
 ///   gets coverage 0.5 − distance / footprint for distances up to half a voxel where a Newton step
 ///   lands in a grid cell that brackets the isovalue (so every brick decomposition marches it).
+/// - the stretch between the ray's last sample in the domain (k_last) and where it leaves the domain
+///   (t_exit): a crossing there is a hit (a surface clipped by the domain's face showed saw teeth of
+///   the sample spacing along its cut edge).
 /// Accumulates into a (colour premultiplied, a[3] = transmittance). Returns the lane (0 … n − 1)
 /// where the task became opaque, or −1.
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
                        const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       float tr_stop, float* a);
+                       std::int64_t k_last, double t_exit, float tr_stop, float* a);
 
 }  // namespace panoptes::render::march
