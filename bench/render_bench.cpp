@@ -158,6 +158,31 @@ void BM_PaperTasksRig(benchmark::State& state) {
 }
 BENCHMARK(BM_PaperTasksRig)->ArgName("cameras")->Arg(4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Isosurface anti-aliasing (RenderOptions::iso_antialias, issue 32): two fronts (p at 0.3, s at 0.3)
+// with it off and on, from outside (kMain, 920x896) and from inside the domain (a 1920x960
+// equirectangular frame at a point between the sources, the lattice rigs' view). Counter
+// cpu_s_frame: process CPU-seconds per frame (robust on a shared machine).
+void BM_Isosurfaces(benchmark::State& state) {
+  const auto& sc = scene();
+  RenderOptions opt;
+  opt.iso_antialias = state.range(0) != 0;
+  const bool inside = state.range(1) != 0;
+  const camera::Camera cam = inside ? camera::Camera({110, 290, 70}, {128, 180, 90}, {0, 0, 1}, 60, 1920, 960,
+                                                     camera::Projection::equirectangular)
+                                    : kMain;
+  const std::vector<TaskSpec> tasks{TaskSpec::isosurface(0, 0.3f, {1, 0.65f, 0.3f}),
+                                    TaskSpec::isosurface(1, 0.3f, {0.55f, 0.9f, 0.55f})};
+  std::vector<PartialImage> out(tasks.size());
+  RenderStats total;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) total = add(total, render_brick(cam, sc.fields, tasks, out, opt));
+  const double cpu = process_cpu_seconds() - cpu0;
+  report(state, total, total.seconds, cpu);
+  state.counters["cpu_s_frame"] = cpu / double(state.iterations());
+}
+BENCHMARK(BM_Isosurfaces)->ArgNames({"aa", "inside"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})
+    ->Iterations(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_PrepareFields(benchmark::State& state) {
   const auto& sc = scene();
   for (auto _ : state) {

@@ -181,7 +181,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance", "equirect_adaptive"});
+                                      "adaptive_tolerance", "equirect_adaptive", "iso_antialias"});
     const std::string ref = str(c, *r, "reference", "render.", "snapshot");
     if (ref != "snapshot" && ref != "running-max")
       c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\" or \"running-max\"");
@@ -201,6 +201,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
     if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");
     s.render.adaptive_tolerance = float(tol / 255);
+    s.render.iso_antialias = boolean(c, *r, "iso_antialias", "render.", true);
   }
   if (const auto* r = table(c, root, "resources")) {
     only_keys(c, *r, "resources", {"check_memory"});
@@ -291,6 +292,8 @@ const char* config_keys_help() {
             corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
             apart whose columns widen toward the poles, whatever adaptive says; false = every pixel)
+            iso_antialias = true (isosurface silhouettes get partial coverage from rays that graze or
+            nearly miss them: no stair steps; false = every pixel hit or missed, as before)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
             available: MemAvailable or the cgroup limit; false = panoptes run --force)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |

@@ -95,7 +95,7 @@ struct SessionConfig {
   std::vector<TaskConfig> tasks;
   ScheduleConfig schedule;
   video::VideoSettings video;
-  render::RenderOptions render;
+  render::RenderOptions render{.iso_antialias = true};  ///< the product anti-aliases isosurfaces (iso_edges.hpp)
   std::array<float, 3> background{0, 0, 0};
   bool outline = true;
   bool compass = true;                ///< 360° frames: horizon, ticks and N/E/S/W (render::OutlineStyle)

@@ -166,7 +166,7 @@ int write(const std::string& dir, const std::string& layout) {
       spec = render::TaskSpec::slice(1, 0, 0.45 * (g.dims[0] - 1) * g.spacing[0], render::TransferFunction::preset("rainbow"),
                                      render::ValueWindow::absolute(-0.5, 1));
     const camera::Camera cam = rig.camera(camera, 40, 32);
-    render::render_brick(cam, fields, std::span<const render::TaskSpec>(&spec, 1), direct);
+    render::render_brick(cam, fields, std::span<const render::TaskSpec>(&spec, 1), direct, cfg.render);  // the session's options (iso_antialias)
     const Image ref = render::finish_image(direct[0], cam, g);
     int maxdiff = 0;
     for (std::size_t i = 0; i < ref.pixels.size(); ++i)

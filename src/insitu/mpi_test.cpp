@@ -112,7 +112,7 @@ int write(const std::string& dir) {
     direct.resize(1);
     const camera::Camera cam = camera::make_rig("fibonacci:5", camera::Domain{g.domain_lo(), g.domain_hi() - g.domain_lo()})
                                    .camera(camera, 48, 40);
-    render::render_brick(cam, fields, std::span<const render::TaskSpec>(&spec, 1), direct);
+    render::render_brick(cam, fields, std::span<const render::TaskSpec>(&spec, 1), direct, cfg.render);  // the session's options (iso_antialias)
     const Image ref = render::finish_image(direct[0], cam, g);
     int maxdiff = 0;
     for (std::size_t i = 0; i < ref.pixels.size(); ++i)

@@ -63,7 +63,7 @@ void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing
 // squarings. With eight isosurfaces a ray makes ~3 hits, each of which paid six scalar
 // interpolations and a libm pow.
 void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
-               const float colour[3], float* a) {
+               const float colour[3], float* a, double* gradient) {
   double q[6][3], h[3], g[3];
   gradient_points(p, dims, spacing, q, h);
 #ifdef PANOPTES_RENDER_AVX2
@@ -80,6 +80,7 @@ void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const
     _mm256_store_ps(v, trilinear8(f, px, py, pz));
     for (int ax = 0; ax < 3; ++ax) g[ax] = h[ax] > 0 ? (double(v[2 * ax + 1]) - double(v[2 * ax])) / h[ax] : 0.0;
     shade_from_gradient(g, dir, colour, true, a);
+    if (gradient) std::copy_n(g, 3, gradient);
     return;
   }
 #endif
@@ -89,6 +90,7 @@ void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const
     g[ax] = h[ax] > 0 ? (interp_clamped(f, q1[0], q1[1], q1[2]) - interp_clamped(f, q0[0], q0[1], q0[2])) / h[ax] : 0.0;
   }
   shade_from_gradient(g, dir, colour, true, a);
+  if (gradient) std::copy_n(g, 3, gradient);
 }
 
 }  // namespace march

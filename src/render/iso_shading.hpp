@@ -22,8 +22,9 @@ namespace panoptes::render::march {
 
 /// The renderer's hit shading on the march's view of a field (what shade_isosurface_hit() with
 /// renderer = true computes): the six gradient interpolations as one 8-lane gather evaluation.
+/// `gradient` (optional, 3 values) receives ∇f in field units per world unit (anti-aliasing's distances).
 void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
-               const float colour[3], float* a);
+               const float colour[3], float* a, double* gradient = nullptr);
 /// The pre-issue-10 hit shading (six scalar interpolations, std::pow): the reference renderer's.
 void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
                       const Vec3& dir, const float colour[3], float* a);

@@ -77,6 +77,8 @@ struct MarchPlan {
   std::vector<std::array<double, 6>> exceptions;  // lo xyz, hi xyz
   std::vector<int> slices;
   double dt = 0;
+  /// Isosurface anti-aliasing (iso_edges.hpp): the camera's pixel pitch in radians, 0 = off.
+  double iso_aa_pitch = 0;
   float termination = 0.998f;
   int mc = 8;
   Index3 mcount{};

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "render/compositing_kernels.hpp"
+#include "render/iso_edges.hpp"
 #include "render/iso_shading.hpp"
 #include "render/march_runs.hpp"
 #include "render/sample_blocks.hpp"
@@ -55,7 +56,7 @@ class RayMarch {
            double tg1, std::int64_t ke, std::int64_t kg_last, std::uint64_t tasks, float (*accumulators)[4],
            std::uint64_t& marched_samples)
       : S(plan), O(origin), D(direction), dir(world_dir), t0(t_0), dt(plan.dt), live(tasks), acc(accumulators),
-        marched(marched_samples) {
+        marched(marched_samples), k_last(kg_last), t_exit(tg1) {
     for (std::size_t s = 0; s < S.acc.size(); ++s) fa[s] = S.acc[s];
     // The last sample of the ray in the whole domain stands for a shorter segment.
     if (ke == kg_last) {
@@ -434,6 +435,10 @@ class RayMarch {
         case MarchKind::iso: {
           const float* v = vb[T.s1];
           const int l0 = (prev_valid >> T.s1 & 1) ? 0 : 1;
+          if (S.iso_aa_pitch > 0) {
+            stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, l0 == 0, k_last, t_exit, tr_stop, a);
+            break;
+          }
           // Lanes whose segment (sample l − 1 … l) changes sign, found for the whole block at once.
           unsigned cross = 0;
 #ifdef PANOPTES_RENDER_AVX2
@@ -498,6 +503,8 @@ class RayMarch {
   alignas(32) float vb[8][2 * kBlock];
   alignas(32) float vq[8][kBlock];
   std::uint32_t prev_valid = 0, vq_from_vb = 0;
+  const std::int64_t k_last;  // the ray's last sample in the domain, and where it leaves the domain
+  const double t_exit;        // (isosurface anti-aliasing looks at the stretch between them)
 };
 
 }  // namespace

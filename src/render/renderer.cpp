@@ -6,6 +6,7 @@
 // of the march are listed in docs/rendering.md.
 #include "render/adaptive_sampling.hpp"
 #include "render/equirect_sampling.hpp"
+#include "render/iso_edges.hpp"
 #include "render/march_plan.hpp"
 #include "render/ray_march.hpp"
 #include "render/sample_blocks.hpp"
@@ -83,7 +84,9 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     return stats;
   }
 
-  const march::MarchPlan S = march::compile_march_plan(fields, tasks, opt);
+  march::MarchPlan plan = march::compile_march_plan(fields, tasks, opt);
+  if (opt.iso_antialias && plan.iso_mask) plan.iso_aa_pitch = march::pixel_pitch(cam);
+  const march::MarchPlan& S = plan;
 
   // The brick's screen footprint.
   const int W = cam.width(), H = cam.height();

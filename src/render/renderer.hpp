@@ -44,6 +44,11 @@ struct RenderOptions {
   /// Row spacing of the equirectangular coarse lattice in degrees (the columns' at the equator): the
   /// largest power of two of pixels not above it, at least 2 (1920 px wide: 8 px; 768: 2 px).
   double equirect_lattice_deg = 1.5;
+  /// Isosurface anti-aliasing (render/iso_edges.hpp): rays that graze or nearly miss a surface
+  /// give it partial coverage (box filter of one pixel), so silhouettes are not stair-stepped.
+  /// Off in the library (images stay those of the reference renderer); the product's
+  /// configurations switch it on ([render] iso_antialias, default true).
+  bool iso_antialias = false;
 };
 
 /// Counters of one render_brick() call.

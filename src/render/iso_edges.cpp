@@ -1,0 +1,255 @@
+#include "render/iso_edges.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include "render/iso_shading.hpp"
+
+namespace panoptes::render::march {
+
+double pixel_pitch(const camera::Camera& cam) {
+  const double x = 0.5 * cam.width(), y = 0.5 * cam.height();
+  const Vec3 a = normalize(cam.ray(x, y).direction), b = normalize(cam.ray(x, y + 1).direction);
+  return std::acos(std::clamp(dot(a, b), -1.0, 1.0));
+}
+
+namespace {
+
+// Whether a near miss at index position p (value iso + sv, gradient g, |g| = gn) has the surface in
+// its own grid cell or a neighbour: one Newton step towards the surface lands in a cell whose corners
+// bracket the isovalue. Every macro-cell containing p then contains the isovalue (their min/max
+// include a one-point margin), so every brick decomposition marches the sample: the event is seen
+// alike by all of them (without this check a near miss in a cell skipped by one decomposition
+// changed a pixel by 2/255).
+bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double p[3], double sv, const double g[3],
+                  double gn) {
+  int c[3];
+  for (int a = 0; a < 3; ++a) {
+    const double q = p[a] - sv * g[a] / (gn * gn) / S.spacing[a];  // g per world unit, p in index units
+    c[a] = int(std::floor(q));
+    const int own = int(std::floor(p[a]));
+    if (std::abs(c[a] - own) > 1 || c[a] < f.ilo[a] || c[a] > f.ihi[a]) return false;
+  }
+  const float* d = f.data + (f.off0 + c[0] * f.sx + c[1] * f.sy + c[2] * f.sz);
+  float lo = d[0], hi = d[0];
+  for (int corner = 1; corner < 8; ++corner) {
+    const float v = d[(corner & 1 ? f.sx : 0) + (corner & 2 ? f.sy : 0) + (corner & 4 ? f.sz : 0)];
+    lo = std::min(lo, v), hi = std::max(hi, v);
+  }
+  return lo <= iso && iso <= hi;
+}
+
+}  // namespace
+
+int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
+                       const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
+                       std::int64_t k_last, double t_exit, float tr_stop, float* a) {
+  const double dt = S.dt, pitch = S.iso_aa_pitch;
+  const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
+  const float iso = T.iso;
+  // How far (in samples) a grazing ray's vertex may lie from its crossing: the chord of a sphere of
+  // radius R at depth x is 2·√(2Rx), ~4 voxels for R = 16 voxels at x = 1/8 voxel.
+  const double max_reach = 4.0 * S.grid.voxel() / dt;
+  // s(j) = f − iso at sample k0 − 1 + j; j = n + 1 (the sample after the block) only on demand.
+  float after = 0;
+  bool have_after = false;
+  auto s = [&](int j) -> float {
+    if (j <= n) return v[j] - iso;
+    if (!have_after) {
+      const float fk = float(k0 + n);  // the march's float positions (as interp_block's)
+      after = interp_clamped(f, P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
+      have_after = true;
+    }
+    return after - iso;
+  };
+  // Composites one event of coverage alpha with shading rgb; true when the task is done.
+  auto add = [&](const float rgb[4], double alpha) {
+    const float T0 = a[3], w = float(T0 * alpha);
+    for (int c = 0; c < 3; ++c) a[c] += w * rgb[c];
+    a[3] = alpha >= 1 ? 0.0f : float(T0 * (1 - alpha));
+    return a[3] <= tr_stop;
+  };
+  // Candidate lanes (bit j − 1 for sample j): crossings and local minima of |s|, for the whole block
+  // at once; the last lane's minimum needs the sample after the block, fetched only if it passes
+  // the cell test below.
+  unsigned cand = 0;
+#ifdef PANOPTES_RENDER_AVX2
+  {
+    const __m256 isov = _mm256_set1_ps(iso), sign = _mm256_set1_ps(-0.0f);
+    const __m256 a0 = _mm256_sub_ps(_mm256_loadu_ps(v), isov), b0 = _mm256_sub_ps(_mm256_loadu_ps(v + 1), isov),
+                 c0 = _mm256_sub_ps(_mm256_loadu_ps(v + 2), isov);
+    const __m256 aa = _mm256_andnot_ps(sign, a0), ab = _mm256_andnot_ps(sign, b0), ac = _mm256_andnot_ps(sign, c0);
+    const __m256 zero = _mm256_setzero_ps();
+    const __m256 na = _mm256_cmp_ps(a0, zero, _CMP_LT_OQ), nb = _mm256_cmp_ps(b0, zero, _CMP_LT_OQ),
+                 nc = _mm256_cmp_ps(c0, zero, _CMP_LT_OQ);
+    const __m256 cross = _mm256_xor_ps(na, nb);
+    const __m256 minimum = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ab, aa, _CMP_LT_OQ), _mm256_cmp_ps(ab, ac, _CMP_LE_OQ)),
+                                         _mm256_andnot_ps(_mm256_xor_ps(nb, nc), _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+    cand = unsigned(_mm256_movemask_ps(_mm256_or_ps(cross, minimum)));
+  }
+#else
+  for (int j = 1; j <= kBlock; ++j) {
+    const float sp = v[j - 1] - iso, sc = v[j] - iso, sn = v[j + 1] - iso;
+    const bool cross = (sp < 0) != (sc < 0);
+    const bool minimum = std::abs(sc) < std::abs(sp) && std::abs(sc) <= std::abs(sn) && (sc < 0) == (sn < 0);
+    cand |= unsigned(cross || minimum) << (j - 1);
+  }
+#endif
+  {  // lane n: its successor is not in v
+    const float sp = v[n - 1] - iso, sc = v[n] - iso;
+    const bool maybe = (sp < 0) != (sc < 0) || std::abs(sc) < std::abs(sp);
+    cand = (cand & ((1u << (n - 1)) - 1)) | (unsigned(maybe) << (n - 1));
+  }
+  if (!prev) cand &= ~1u;
+  const float hmin = float(std::min({S.spacing[0], S.spacing[1], S.spacing[2]}));
+  for (; cand; cand &= cand - 1) {
+    const int j = std::countr_zero(cand) + 1;
+    const float sp = s(j - 1), sc = s(j);
+    const bool cross = (sp < 0) != (sc < 0);
+    const std::int64_t k = k0 - 1 + j;
+    float cell_range = 0;
+    if (!cross) {
+      // A near miss needs the surface within half a voxel: in this grid cell, |∇f| per voxel is at
+      // most √3 × the corners' range r, so |s| > r (a factor 2 of margin) cannot be one. 8 loads
+      // instead of a gradient for most local minima of a wavy field.
+      const float fk = float(k);
+      const float x = std::clamp(P.bx + fk * P.sx, f.plo[0], f.phi[0]), y = std::clamp(P.by + fk * P.sy, f.plo[1], f.phi[1]),
+                  z = std::clamp(P.bz + fk * P.sz, f.plo[2], f.phi[2]);
+      const int ci = std::min(std::max(int(x), f.ilo[0]), f.ihi[0]), cj = std::min(std::max(int(y), f.ilo[1]), f.ihi[1]),
+                ck = std::min(std::max(int(z), f.ilo[2]), f.ihi[2]);
+      const float* d = f.data + (f.off0 + ci * f.sx + cj * f.sy + ck * f.sz);
+      float lo = d[0], hi = d[0];
+      for (int corner = 1; corner < 8; ++corner) {
+        const float w = d[(corner & 1 ? f.sx : 0) + (corner & 2 ? f.sy : 0) + (corner & 4 ? f.sz : 0)];
+        lo = std::min(lo, w), hi = std::max(hi, w);
+      }
+      cell_range = hi - lo;
+      if (!(std::abs(sc) <= cell_range)) continue;
+    }
+    const float sn = s(j + 1);
+    if (!cross && ((sn < 0) != (sc < 0) || std::abs(sc) > std::abs(sn))) continue;  // not a local minimum of |s|
+    // The parabola through samples j − 1, j, j + 1 (u = −1, 0, 1): its vertex u_v and value s_v.
+    const double b = 0.5 * (double(sn) - double(sp)), c2 = 0.5 * (double(sn) - 2.0 * double(sc) + double(sp));
+    const double uv = c2 != 0 ? -b / (2 * c2) : INFINITY;
+    const double sv = c2 != 0 ? double(sc) - b * b / (4 * c2) : double(sc);
+    alignas(16) float rgb[4];
+    double g[3], gn = 0;
+    if (cross) {
+      // The hit: linear estimate and one regula-falsi step, as without anti-aliasing.
+      double ta = t0 + double(k - 1) * dt, tb = ta + dt;
+      double dpa = sp, dpb = sc;
+      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+      else tb = th, dpb = vh;
+      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
+      gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+      double alpha = 1;
+      // A grazing ray: the parabola has a second root close by (its vertex on the other side of
+      // zero than its curvature, within max_reach of the crossing), so the ray leaves the surface
+      // again soon. Its depth |s_v| / |∇f| at the vertex sets the coverage. The entry (vertex ahead)
+      // takes all of it; the exit (vertex behind) adds nothing, so the pair covers `cover`. (Letting
+      // an exit with nothing before it on the ray count broke compositing: the entry may lie in the
+      // brick in front.)
+      const double uc = -1 + double(sp) / (double(sp) - double(sc));  // the crossing in u
+      // Only where a pixel is a sizeable part of a voxel (>= 1/4): in views magnified beyond that
+      // (inside the data, near the camera) a fit across a crease of the trilinear field could
+      // predict an exit that never comes, and the ray would see the dark behind (dotted lines).
+      if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th * pitch >= 0.25 * hmin) {
+        const double cover = 0.5 + std::abs(sv) / gn / (th * pitch);
+        if (cover < 1) alpha = uv > uc ? cover : 0.0;
+      }
+      if (alpha <= 0) continue;
+      if (add(rgb, alpha)) return j - 1;
+      continue;
+    }
+    // A local minimum of |s|: the ray passes near the surface, or pierces a sliver of it between
+    // two samples (the saw teeth of grazing views: whether a sample fell inside the sliver decided
+    // hit or miss). The field at the parabola's vertex tells which.
+    // Up to three parabolic steps on the bracket (u = −1, 0, 1 around sample k) towards the minimum
+    // of |s|; a value of the other sign is a sliver, whose entry lies between the last point
+    // before it (same sign) and it.
+    double ua = -1, ub = 0, uz = 1, fa = sp, fb = sc, fz = sn;
+    bool pierced = false;
+    double u_in = 0, s_in = 0, u_out = 0, s_out = 0;
+    for (int it = 0; it < 3 && !pierced; ++it) {
+      const double p = (ub - ua) * (ub - ua) * (fb - fz) - (ub - uz) * (ub - uz) * (fb - fa);
+      const double q = (ub - ua) * (fb - fz) - (ub - uz) * (fb - fa);
+      double u = q != 0 ? ub - 0.5 * p / q : ub;
+      if (!(u > ua && u < uz) || std::abs(u - ub) < 1e-3) u = ub - ua > uz - ub ? 0.5 * (ua + ub) : 0.5 * (ub + uz);
+      const double tu = t0 + (double(k) + u) * dt;
+      const double su = double(interp_clamped(f, O[0] + tu * D[0], O[1] + tu * D[1], O[2] + tu * D[2]) - iso);
+      if ((su < 0) != (sc < 0)) {
+        pierced = true;
+        u_out = u, s_out = su;
+        if (u > ub) u_in = ub, s_in = fb;
+        else u_in = ua, s_in = fa;
+      } else if (std::abs(su) < std::abs(fb)) {
+        if (u > ub) ua = ub, fa = fb;
+        else uz = ub, fz = fb;
+        ub = u, fb = su;
+      } else if (u > ub) {
+        uz = u, fz = su;
+      } else {
+        ua = u, fa = su;
+      }
+    }
+    if (pierced) {
+      // A sliver: the entry by regula falsi between u_in and u_out.
+      double ta = t0 + (double(k) + u_in) * dt, tb = t0 + (double(k) + u_out) * dt;
+      double dpa = s_in, dpb = s_out;
+      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+      else tb = th, dpb = vh;
+      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
+      gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+      // Its depth is at least |s| at the point found / |∇f|: coverage of the pair in one event.
+      const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_out) / gn / (th * pitch) : 1.0;
+      if (add(rgb, std::min(1.0, cover))) return j - 1;
+      continue;
+    }
+    const double tv = t0 + (double(k) + ub) * dt, s_v = fb;
+    if (!(tv > 0)) continue;
+    const double pv[3] = {O[0] + tv * D[0], O[1] + tv * D[1], O[2] + tv * D[2]};
+    // A near miss. With |∇f| ≤ √3·r / h the distance is at least |s_v|·h / (√3·r): beyond half the
+    // footprint, no coverage (no gradient needed).
+    if (std::abs(s_v) * hmin > 0.87 * cell_range * tv * pitch) continue;
+    shade_hit(f, S.grid.dims, S.spacing, pv, dir, T.colour, rgb, g);
+    gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (!(gn > 0)) continue;
+    if (!near_surface(f, S, iso, pv, s_v, g, gn)) continue;
+    const double x = std::abs(s_v) / gn, footprint = tv * pitch;
+    if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
+    const double cover = 0.5 - x / footprint;
+    if (cover <= 0) continue;
+    if (add(rgb, cover)) return j - 1;
+  }
+  if (k0 + n - 1 == k_last && t_exit > t0 + double(k_last) * dt) {
+    // The ray's last stretch in the domain, after its last sample.
+    const float sl = s(n);
+    double ta = t0 + double(k_last) * dt, tb = t_exit;
+    const double se = interp_clamped(f, O[0] + tb * D[0], O[1] + tb * D[1], O[2] + tb * D[2]) - iso;
+    if ((se < 0) != (sl < 0)) {
+      double dpa = sl, dpb = se;
+      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
+      else tb = th, dpb = vh;
+      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
+      alignas(16) float rgb[4];
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb);
+      add(rgb, 1.0);
+      return n - 1;
+    }
+  }
+  return -1;
+}
+
+}  // namespace panoptes::render::march
