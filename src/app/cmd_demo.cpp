@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (both together first, then p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: 276 CPU-seconds (user + system) for the whole demo at 400x390 with OpenMP waiting passively, 2026-11-27 05:18 UTC on the shared 2-core machine (AMD EPYC) at load 13-16, where its wall time (31 min) says nothing; render took 80 % of it, encode 14 %, composite 4 %, simulation 1 %. Its idle wall time is not measured yet (scripts/firstcontact).
+# Measured: 139 s wall for the whole demo at 400x390 as scripts/demo runs it (OpenMP waiting passively), 2026-11-27 05:43 UTC in scripts/firstcontact on the shared 2-core machine (AMD EPYC) at load 1.9-4.1, not idle; 276 CPU-seconds (user + system) in a run at load 13-16 (05:18 UTC), of which render 80 %, encode 14 %, composite 4 %, simulation 1 %.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
