@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (both together first, then p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: about 2.6 min (158 s wall, 306 CPU-seconds), 2026-11-25 22:00 UTC on the idle 2-core machine (AMD EPYC): the whole demo as scripts/demo runs it (OpenMP waiting passively), of which render 129 s, encode 20 s, composite 8 s, simulation 1 s.
+# Measured: 139 s wall for the whole demo at 400x390 as scripts/demo runs it (OpenMP waiting passively), 2026-11-27 05:43 UTC in scripts/firstcontact on the shared 2-core machine (AMD EPYC) at load 1.9-4.1, not idle; 276 CPU-seconds (user + system) in a run at load 13-16 (05:18 UTC), of which render 80 %, encode 14 %, composite 4 %, simulation 1 %.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
@@ -65,9 +65,9 @@ duration = 4.0
 dir = "panoptes_demo"
 title = "Seismic waves from a thrust earthquake (panoptes demo)"
 
-[image]                # the paper's 920x896 aspect at 512 pixels high
-width = 528
-height = 512
+[image]                # the paper's 920x896 aspect at 390 pixels high: 2.5-3 pixels per voxel of this grid. 528x512
+width = 400            # showed the same picture (smooth fields, no finer detail) for 1.5x the CPU: 12 of the 48
+height = 390           # snapshots took 115 CPU-s against 77 at 400x390 (2026-11-27, load 15, panoptes run)
 
 [rig]
 spec = "yinyang"       # the paper's 130 cameras: 5 x 13 cells per patch
@@ -151,7 +151,7 @@ const char* kOverheadNote =
     "  (the demo's grid, 64x128x40, is small so that the demo runs in minutes: its simulation is cheap and this\n"
     "  ratio large. At the paper's 256x512x160 grid, panoptes run examples/paper.toml (60 snapshots, 390 movies\n"
     "  of 920x896) took 27.7 min on 2 cores, visualization 6.1x the simulation: docs/rendering.md, round 6.)\n"
-    "  Why the movies outweigh the raw fields here: movies grow with cameras x pixels (390 pictures of 528x512\n"
+    "  Why the movies outweigh the raw fields here: movies grow with cameras x pixels (390 pictures of 400x390\n"
     "  per snapshot), raw fields with the grid (2 x 0.33 M voxels here). At the paper's size the same 390\n"
     "  movies took 624 MB against 10.1 GB of raw phi_p, phi_s: 6.2 % (measured 2026-11-25, docs/rendering.md);\n"
     "  the larger the simulation, the smaller that share.";
@@ -164,7 +164,7 @@ CommandRegistration reg([](CLI::App& root) {
       "Run the built-in seismic demo with in-situ visualization: a thrust earthquake in a layered crust seen "
       "by the paper's 130 Yin-Yang cameras x 3 tasks (p+s: p-waves orange and s-waves green together, then "
       "each alone) = 390 movies, "
-      "48 snapshots of 528x512 pixels (also under mpirun -np N). Measured: " + measured_time() +
+      "48 snapshots of 400x390 pixels (also under mpirun -np N). Measured: " + measured_time() +
       " Then: panoptes play DIR.");
   sub->add_option("--out", opt->out, "Database directory")->capture_default_str();
   opt->out = "panoptes_demo";

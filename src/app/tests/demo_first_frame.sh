@@ -24,7 +24,7 @@ for frame in 0 1; do
     "$bin" play db --headless --script s.txt --task "$task" --paused --frames-out "f$frame-$task" > /dev/null
   done
 done
-pixels=$((6 * 528 * 512))
+pixels=$((6 * 400 * 390))
 for task in p+s p-wave; do
   read -r _ lit0 _ < <("$share" "f0-$task"/*.png)
   read -r _ lit1 _ < <("$share" "f1-$task"/*.png)
