@@ -11,7 +11,7 @@
 
 namespace panoptes::app {
 
-namespace {
+namespace cmd_demo {  // named, not anonymous: the unity build joins the command units
 
 const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, sized to run in minutes on a 2-core machine.
 # A double-couple (thrust) earthquake in a three-layer crust; 130 Yin-Yang cameras x 3 tasks

@@ -10,7 +10,7 @@
 #include "cinema/export.hpp"
 #include "store/database.hpp"
 
-namespace {
+namespace cmd_export_cinema {  // named, not anonymous: the unity build joins the command units
 
 struct Args {
   std::string db, out, frames, format = "png";

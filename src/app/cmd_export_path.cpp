@@ -13,7 +13,7 @@
 #include "player/look.hpp"
 #include "video/movie_writer.hpp"
 
-namespace {
+namespace cmd_export_path {  // named, not anonymous: the unity build joins the command units
 
 struct ExportArgs {
   std::string db, script, out;

@@ -10,7 +10,7 @@
 #include "web/server.hpp"
 #include "web/site_export.hpp"
 
-namespace {
+namespace cmd_export_web {  // named, not anonymous: the unity build joins the command units
 
 struct Args {
   std::string db, out;

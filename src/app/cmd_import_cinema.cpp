@@ -11,7 +11,7 @@
 #include "app/command.hpp"
 #include "cinema/import.hpp"
 
-namespace {
+namespace cmd_import_cinema {  // named, not anonymous: the unity build joins the command units
 
 struct Args {
   std::string in, out, group_by, title, angles, azimuth_zero;

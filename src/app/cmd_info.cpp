@@ -14,7 +14,7 @@
 #include "core/error.hpp"
 #include "store/database.hpp"
 
-namespace {
+namespace cmd_info {  // named, not anonymous: the unity build joins the command units
 
 namespace fs = std::filesystem;
 using namespace panoptes;

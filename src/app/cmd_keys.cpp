@@ -11,7 +11,7 @@
 #include "player/keys.hpp"
 #include "player/keys_json.hpp"
 
-namespace {
+namespace cmd_keys {  // named, not anonymous: the unity build joins the command units
 
 using panoptes::player::KeyBinding;
 using panoptes::player::ViewMode;

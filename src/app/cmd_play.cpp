@@ -16,7 +16,7 @@
 #include "ui/window_app.hpp"
 #endif
 
-namespace {
+namespace cmd_play {  // named, not anonymous: the unity build joins the command units
 
 struct PlayArgs {
   std::string db;

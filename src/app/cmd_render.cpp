@@ -40,7 +40,7 @@
 #include "store/database.hpp"
 #include "video/writer_memory.hpp"
 
-namespace {
+namespace cmd_render {  // named, not anonymous: the unity build joins the command units
 
 using namespace panoptes;
 

@@ -17,7 +17,7 @@
 #include "camera/rig_stats.hpp"
 #include "core/error.hpp"
 
-namespace {
+namespace cmd_rig {  // named, not anonymous: the unity build joins the command units
 
 using namespace panoptes;
 using namespace panoptes::camera;

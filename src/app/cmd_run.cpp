@@ -253,7 +253,7 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   }
 }
 
-namespace {
+namespace cmd_run {  // named, not anonymous: the unity build joins the command units
 
 CommandRegistration reg([](CLI::App& root) {
   auto config = std::make_shared<std::string>();

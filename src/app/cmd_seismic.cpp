@@ -20,7 +20,7 @@
 #endif
 #include <omp.h>
 
-namespace {
+namespace cmd_seismic {  // named, not anonymous: the unity build joins the command units
 
 using MpiScope = panoptes::app::MpiScope;
 

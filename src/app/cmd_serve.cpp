@@ -17,7 +17,7 @@
 #include "core/error.hpp"
 #include "web/server.hpp"
 
-namespace {
+namespace cmd_serve {  // named, not anonymous: the unity build joins the command units
 
 // How long Ctrl+C waits for the server's threads before the process ends without them: longer than
 // the server's timeouts (5 s), so a normal stop always ends by itself.

@@ -18,7 +18,7 @@
 #include "video/writer_memory.hpp"
 #include "store/synthetic.hpp"
 
-namespace {
+namespace cmd_synth_db {  // named, not anonymous: the unity build joins the command units
 
 struct Args {
   std::string out;

@@ -8,7 +8,7 @@ extern "C" {
 #include "app/command.hpp"
 #include "core/version.hpp"
 
-namespace {
+namespace cmd_version {  // named, not anonymous: the unity build joins the command units
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
   auto* sub = root.add_subcommand("version", "Print the Panoptes version and the versions of its libraries");
   sub->callback([] {

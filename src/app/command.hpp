@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <source_location>
 
 namespace panoptes::app {
 
@@ -11,8 +12,10 @@ namespace panoptes::app {
 using CommandSetup = std::function<void(CLI::App& root)>;
 
 /// Registers a subcommand at static-initialization time: `static CommandRegistration r([](CLI::App& root){...});`
+/// `where` (the registering file) orders the subcommands in --help whatever the order of static
+/// initialization, which a unity build of the command units changes.
 struct CommandRegistration {
-  explicit CommandRegistration(CommandSetup setup);
+  explicit CommandRegistration(CommandSetup setup, std::source_location where = std::source_location::current());
 };
 
 /// Runs every registered setup on root (in name order of registration files).

@@ -13,16 +13,24 @@
 
 namespace panoptes::app {
 namespace {
-std::vector<CommandSetup>& registry() {
-  static std::vector<CommandSetup> r;
+struct Registered {
+  std::string file;
+  CommandSetup setup;
+};
+std::vector<Registered>& registry() {
+  static std::vector<Registered> r;
   return r;
 }
 }  // namespace
 
-CommandRegistration::CommandRegistration(CommandSetup setup) { registry().push_back(std::move(setup)); }
+CommandRegistration::CommandRegistration(CommandSetup setup, std::source_location where) {
+  registry().push_back({where.file_name(), std::move(setup)});
+}
 
 void add_registered_commands(CLI::App& root) {
-  for (auto& setup : registry()) setup(root);
+  std::stable_sort(registry().begin(), registry().end(),
+                   [](const Registered& a, const Registered& b) { return a.file < b.file; });
+  for (auto& r : registry()) r.setup(root);
 }
 
 int& exit_code() {
