@@ -12,6 +12,7 @@ import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lo
          lookTowards, cutoutDirection, neighbourToward, strongestSignalDirection } from "./look.js";
 import { LookView, drawOrientationMarks } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
+import { SphereMap } from "./sphere_map.js";
 
 const params = new URLSearchParams(location.search);
 const base = new URL(".", location.href).href.split("?")[0];
@@ -539,80 +540,26 @@ function updateHud(frame) {
 }
 let lastHud = "", lastLegend = "";
 
-// ---- mini-map: cameras by longitude (x) and latitude (y); click picks the nearest -------------
-function mapXY(i) {
-  const w = minimap.width, h = minimap.height;
-  return [((S.cams.lon_deg[i] + 180) / 360) * w, ((90 - S.cams.lat_deg[i]) / 180) * h];
-}
-// The dots of every camera are drawn once per shell into an offscreen canvas (10^6 cameras would
-// otherwise be 10^6 fillRects per drawn frame); each frame copies it and marks the neighbours and
-// the current camera.
-let mapBackground = null, mapBackgroundShell = null;
+// ---- mini-map: sphere_map.js around the data, lattice_map.js inside it; a click picks a camera ----
 function drawMinimap() {
   if (!S.cams) return;
+  const nb = COLUMNS.map((d) => graphNeighbour(S.camera, d));
   if (S.latticeMap) {
-    const nb = COLUMNS.map((d) => graphNeighbour(S.camera, d)).filter((i) => i >= 0);
     const fovH = (2 * Math.atan(Math.tan((S.look.fov * Math.PI) / 360) * (lookCanvas.width / lookCanvas.height)) * 180) / Math.PI;
-    S.latticeMap.draw(mapCtx, minimap.width, minimap.height, S.camera, nb, viewDirection(S.cams, S.camera, S.rig.equirect ? S.look : { yaw: 0, pitch: 0, fov: 90 }), S.rig.equirect ? fovH : 0);
+    S.latticeMap.draw(mapCtx, minimap.width, minimap.height, S.camera, nb.filter((i) => i >= 0), viewDirection(S.cams, S.camera, S.rig.equirect ? S.look : { yaw: 0, pitch: 0, fov: 90 }), S.rig.equirect ? fovH : 0);
     return;
   }
-  const w = minimap.width, h = minimap.height, n = S.cams.count;
-  const shell = S.cams.shell[S.camera];
-  const radius = n > 2000 ? 1 : n > 300 ? 2 : 3;
-  if (!mapBackground || mapBackgroundShell !== shell) {
-    mapBackground = document.createElement("canvas");
-    mapBackground.width = w;
-    mapBackground.height = h;
-    const g = mapBackground.getContext("2d");
-    g.fillStyle = "rgba(10,14,22,0.85)";
-    g.fillRect(0, 0, w, h);
-    g.strokeStyle = "#334";
-    g.beginPath();
-    g.moveTo(0, h / 2); g.lineTo(w, h / 2); g.moveTo(w / 2, 0); g.lineTo(w / 2, h);
-    g.stroke();
-    for (const other of [true, false]) {  // other shells first, under the current one
-      g.fillStyle = other ? "#445" : "#9aa";
-      for (let i = 0; i < n; i++) {
-        if ((S.cams.shell[i] !== shell) !== other) continue;
-        const [x, y] = mapXY(i);
-        g.fillRect(x - radius / 2, y - radius / 2, radius, radius);
-      }
-    }
-    mapBackgroundShell = shell;
-  }
-  mapCtx.clearRect(0, 0, w, h);
-  mapCtx.drawImage(mapBackground, 0, 0);
-  mapCtx.fillStyle = "#6cf";
-  for (const d of COLUMNS) {
-    const i = graphNeighbour(S.camera, d);
-    if (i < 0 || S.cams.shell[i] !== shell) continue;
-    const [x, y] = mapXY(i);
-    mapCtx.fillRect(x - radius / 2, y - radius / 2, radius, radius);
-  }
-  const [x, y] = mapXY(S.camera);
-  mapCtx.strokeStyle = "#ff4";
-  mapCtx.lineWidth = 2;
-  mapCtx.beginPath();
-  mapCtx.arc(x, y, 6, 0, 2 * Math.PI);
-  mapCtx.stroke();
+  S.sphereMap ??= new SphereMap(S.cams);
+  S.sphereMap.draw(mapCtx, minimap.width, minimap.height, S.camera, nb);
 }
 minimap.addEventListener("click", (e) => {
+  if (!S.cams) return;
   const r = minimap.getBoundingClientRect();
   const px = ((e.clientX - r.left) / r.width) * minimap.width, py = ((e.clientY - r.top) / r.height) * minimap.height;
-  let best = -1, bestD = Infinity;
-  if (!S.cams) return;
   inputEventTime = e.timeStamp;
-  if (S.latticeMap) {
-    const c = S.latticeMap.pick(px, py, minimap.width, minimap.height, S.camera);
-    if (c >= 0 && c !== S.camera) { trail.clear(); select(c, S.task, "minimap"); }
-    return;
-  }
-  for (let i = 0; i < S.cams.count; i++) {
-    const [x, y] = mapXY(i);
-    const d = (x - px) ** 2 + (y - py) ** 2;
-    if (d < bestD) { bestD = d; best = i; }
-  }
-  if (best >= 0 && best !== S.camera) { trail.clear(); select(best, S.task, "minimap"); }
+  const c = S.latticeMap ? S.latticeMap.pick(px, py, minimap.width, minimap.height, S.camera)
+                         : (S.sphereMap ??= new SphereMap(S.cams)).pick(px, py, minimap.width, minimap.height);
+  if (c >= 0 && c !== S.camera) { trail.clear(); select(c, S.task, "minimap"); }
 });
 
 // ---- keys, wheel, drag --------------------------------------------------------------------------
@@ -980,12 +927,14 @@ async function main() {
         if (cams.count !== db.cameras.count) throw new Error(`${cams.count} cameras, the manifest says ${db.cameras.count}`);
         S.cameraTableMs = { started: tStart, loaded: t0, parsed: performance.now(), bytes: buf.byteLength };
         S.cams = cams;
+        S.sphereMap = null;
         setupMinimap();
         drawMinimap();
       })
       .catch((e) => { S.message = `${url}: ${e.message}`; });
   } else {
     S.cams = camerasFromJson(db.cameras, db.graph);
+    S.sphereMap = null;
     setupMinimap();
   }
   // A database still being written grows: re-read its manifest every 2 s and re-open the streams
