@@ -97,7 +97,9 @@ def _along(values, axis, n, rtol):
     """values: (n2, n1, n0) of one coordinate; its line along `axis` if it depends on that index only."""
     line = np.moveaxis(values, axis, -1).reshape(-1, n)
     ref = line[0]
-    scale = max(float(np.abs(ref).max()), 1e-300)
+    if not np.all(np.isfinite(line)):  # e.g. theta at r = 0
+        return None, float("inf")
+    scale = max(float(np.abs(line).max()), 1e-30)
     worst = float(np.abs(line - ref).max()) / scale
     return ref.copy() if worst <= rtol else None, worst
 
@@ -130,7 +132,12 @@ def read(path, array=None):
     path = os.fspath(path)
     data = _reader(path)
     _, numpy_support = _vtk()
-    dims = tuple(int(d) for d in data.GetDimensions())
+    dims = [0, 0, 0]
+    try:
+        data.GetDimensions(dims)  # vtkImageData (the no-argument form is deprecated there since VTK 9.3)
+    except TypeError:
+        dims = data.GetDimensions()  # rectilinear and structured grids
+    dims = tuple(int(d) for d in dims)
     if min(dims) < 2:
         raise ValueError(f"{path}: dimensions {dims[0]}x{dims[1]}x{dims[2]}: a volume needs at least 2 points per axis")
     name, a, names = _point_array(path, data, array)

@@ -1,7 +1,7 @@
 """Grids beyond boxes across MPI ranks through mpi4py (issue 33): for a rectilinear grid split along z, a
 spherical shell split along phi and a Yin-Yang grid with one patch per rank, two ranks write one database
 through panoptes.Session; rank 0 then writes the same fields alone (COMM_SELF, every block in one process)
-and checks that the two databases hold the same frames.
+and checks that the two databases hold the same frames (bitwise, or within 45 dB as the C++ grid MPI tests).
     mpiexec -n 2 /usr/bin/python3 mpi_grid.py OUT_DIR"""
 import shutil
 import sys
@@ -79,18 +79,26 @@ def main():
             run(MPI.COMM_SELF, kind, out / kind / "one_rank")
             a, b = panoptes.open(out / kind / "two_ranks"), panoptes.open(out / kind / "one_rank")
             assert a.status == "complete" and a.frame_count == len(TIMES) and a.provenance["extra"]["mpi_ranks"] == "2"
-            worst, identical, lit = 0, 0, 0
+            worst, identical, lit, sq, n = 0, 0, 0, 0.0, 0
             frames = [(c, f) for c in range(a.camera_count) for f in range(a.frame_count)]
             for c, f in frames:
                 pa, pb = a.frame(c, 0, f).astype(int), b.frame(c, 0, f).astype(int)
                 diff = int(np.abs(pa - pb).max())
                 worst, identical, lit = max(worst, diff), identical + (diff == 0), max(lit, int(pb.max()))
+                sq, n = sq + float(((pa - pb) ** 2).sum()), n + pa.size
+            psnr = float("inf") if sq == 0 else 10 * np.log10(255.0 ** 2 / (sq / n))
             print(f"mpi_grid: {kind}: 2 ranks vs 1 rank, {len(frames)} frames, {identical} bitwise identical, "
-                  f"max pixel difference {worst}")
+                  f"max pixel difference {worst}, PSNR {psnr:.1f} dB")
             assert lit > 40, f"{kind}: nothing visible (brightest pixel {lit})"
-            assert worst <= 3, (kind, worst)
+            # As insitu.grid_*_rank_independence: bitwise, or within 45 dB (bricks composite in another order).
+            assert psnr >= 45, (kind, psnr)
         world.Barrier()
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except BaseException:
+        import traceback
+        traceback.print_exc()
+        MPI.COMM_WORLD.Abort(1)  # the other rank waits in a collective call: end both now
