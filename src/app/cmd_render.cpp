@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <memory>
 #include <optional>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,6 +28,7 @@
 #include "app/volume_file.hpp"
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
+#include "core/dims_text.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
 #include "core/file_read.hpp"
@@ -175,13 +175,11 @@ void progress(bool tty, long long done, long long total, double elapsed) {
 
 // The session configuration `render`'s options stand for (the grid comes from the first volume).
 insitu::SessionConfig session_config(const Args& a, const std::string& first_file, const std::string& command_line) {
-  std::smatch m;
-  static const std::regex size_re(R"((\d{1,5})x(\d{1,5}))");
-  if (!std::regex_match(a.size, m, size_re))
-    throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 920x896");
+  const auto size = parse_dims_text(a.size, 2, 5);
+  if (!size) throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 920x896");
   insitu::SessionConfig cfg;
-  cfg.width = std::stoi(m[1]);
-  cfg.height = std::stoi(m[2]);
+  cfg.width = (*size)[0];
+  cfg.height = (*size)[1];
   if (cfg.width < 2 || cfg.height < 2 || cfg.width > insitu::kMaxImageSide || cfg.height > insitu::kMaxImageSide)
     throw Error("--size \"" + a.size + "\": expected 2.." + std::to_string(insitu::kMaxImageSide) + " pixels per side");
   const auto bg = parse_numbers(a.background, 3, "--background");

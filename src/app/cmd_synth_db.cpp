@@ -7,11 +7,11 @@
 #include <climits>
 #include <thread>
 #include <cstdio>
-#include <regex>
 #include <memory>
 #include <string>
 
 #include "app/command.hpp"
+#include "core/dims_text.hpp"
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
 #include "core/memory.hpp"
@@ -33,23 +33,20 @@ struct Args {
 
 void run(const Args& a, const std::string& command_line) {
   using namespace panoptes;
-  std::smatch m;
-  static const std::regex size_re(R"((\d{1,6})x(\d{1,6}))");
-  if (!std::regex_match(a.size, m, size_re))
-    throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 64x64 or 920x896");
+  const auto size = parse_dims_text(a.size, 2, 6);
+  if (!size) throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 64x64 or 920x896");
   store::SyntheticOptions o;
   o.cameras = a.cameras;
   o.tasks = a.tasks;
   o.frames = a.frames;
-  o.width = std::stoi(m[1]);
-  o.height = std::stoi(m[2]);
+  o.width = (*size)[0];
+  o.height = (*size)[1];
   o.overwrite = a.overwrite;
   if (!a.lattice.empty()) {
-    static const std::regex lattice_re(R"((\d{1,4})x(\d{1,4})x(\d{1,4}))");
-    std::smatch l;
-    if (!std::regex_match(a.lattice, l, lattice_re) || std::stoi(l[1]) < 1 || std::stoi(l[2]) < 1 || std::stoi(l[3]) < 1)
+    const auto l = parse_dims_text(a.lattice, 3, 4);
+    if (!l || (*l)[0] < 1 || (*l)[1] < 1 || (*l)[2] < 1)
       throw Error("--lattice \"" + a.lattice + "\": expected NXxNYxNZ with positive counts, e.g. 4x4x3");
-    o.lattice = {std::stoi(l[1]), std::stoi(l[2]), std::stoi(l[3])};
+    o.lattice = {(*l)[0], (*l)[1], (*l)[2]};
   }
   o.projection = a.projection;
   o.threads = a.threads;

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <regex>
+#include <optional>
 #include <sstream>
 
 #include "core/echo.hpp"
@@ -27,6 +27,30 @@ bool MediumBlock::attenuating() const {
     if (std::isfinite(q)) return true;
   return false;
 }
+
+namespace {
+
+// The value of 'key' in a .npy header (a Python dict literal): a quoted string without its quotes, a
+// parenthesized tuple without its parentheses, or a bare word (True/False). By hand, not <regex>:
+// std::regex cost ~5 CPU-s of compiling this unit (issue 34: a new user's first build).
+std::optional<std::string> npy_header_value(const std::string& header, const std::string& key) {
+  const std::size_t k = header.find("'" + key + "'");
+  if (k == std::string::npos) return std::nullopt;
+  std::size_t i = header.find_first_not_of(" \t", k + key.size() + 2);
+  if (i == std::string::npos || header[i] != ':') return std::nullopt;
+  i = header.find_first_not_of(" \t", i + 1);
+  if (i == std::string::npos) return std::nullopt;
+  const char open = header[i];
+  if (open == '\'' || open == '(') {
+    const std::size_t end = header.find(open == '(' ? ')' : '\'', i + 1);
+    if (end == std::string::npos) return std::nullopt;
+    return header.substr(i + 1, end - i - 1);
+  }
+  const std::size_t end = header.find_first_of(", }", i);
+  return header.substr(i, end == std::string::npos ? std::string::npos : end - i);
+}
+
+}  // namespace
 
 std::vector<float> read_npy_planes(const std::string& path, int nx, int ny, int nz, int k_begin, int k_end) {
   // A FIFO or device named as a medium file must be refused, not block the run (or read forever).
@@ -53,18 +77,18 @@ std::vector<float> read_npy_planes(const std::string& path, int nx, int ny, int 
   std::string header(header_len, '\0');
   if (!in.read(header.data(), header_len)) throw FileError(path, "truncated .npy header");
   const auto data_start = static_cast<std::streamoff>(in.tellg());
-  std::smatch m;
-  if (!std::regex_search(header, m, std::regex(R"('descr'\s*:\s*'([^']*)')")))
-    throw FileError(path, ".npy header has no 'descr'");
-  if (m[1] != "<f4") throw FileError(path, "dtype '" + echo(m[1].str()) + "' (expected float32 '<f4')");
-  if (!std::regex_search(header, m, std::regex(R"('fortran_order'\s*:\s*(True|False))")))
+  const auto descr = npy_header_value(header, "descr");
+  if (!descr) throw FileError(path, ".npy header has no 'descr'");
+  if (*descr != "<f4") throw FileError(path, "dtype '" + echo(*descr) + "' (expected float32 '<f4')");
+  const auto fortran = npy_header_value(header, "fortran_order");
+  if (!fortran || (*fortran != "True" && *fortran != "False"))
     throw FileError(path, ".npy header has no 'fortran_order'");
-  if (m[1] == "True") throw FileError(path, "Fortran-ordered array (expected C order, shape (nz, ny, nx))");
-  if (!std::regex_search(header, m, std::regex(R"('shape'\s*:\s*\(([^)]*)\))")))
-    throw FileError(path, ".npy header has no 'shape'");
+  if (*fortran == "True") throw FileError(path, "Fortran-ordered array (expected C order, shape (nz, ny, nx))");
+  const auto shape_text = npy_header_value(header, "shape");
+  if (!shape_text) throw FileError(path, ".npy header has no 'shape'");
   std::vector<long long> shape;
   {
-    std::string s = m[1];
+    const std::string& s = *shape_text;
     std::stringstream ss(s);
     std::string tok;
     while (std::getline(ss, tok, ',')) {
@@ -74,7 +98,7 @@ std::vector<float> read_npy_planes(const std::string& path, int nx, int ny, int 
   }
   const std::string want = "(" + std::to_string(nz) + ", " + std::to_string(ny) + ", " + std::to_string(nx) + ")";
   if (shape.size() != 3 || shape[0] != nz || shape[1] != ny || shape[2] != nx)
-    throw FileError(path, "shape (" + echo(m[1].str()) + ") does not match the grid: expected (nz, ny, nx) = " + want);
+    throw FileError(path, "shape (" + echo(*shape_text) + ") does not match the grid: expected (nz, ny, nx) = " + want);
   const std::size_t plane = std::size_t(nx) * ny;
   in.seekg(0, std::ios::end);
   const auto size = static_cast<std::streamoff>(in.tellg());
