@@ -2,8 +2,7 @@
 // over `panoptes serve` or a static export. Decoding: WebCodecs + mp4box.js (movies.js). Prefetch:
 // the current stream and every neighbour are kept decoded a few frames past the playhead, in step
 // with playback (pump() below), so a switch finds its frame decoded.
-import { FrameCache, Stream, traffic, marks, mark } from "./movies.js";
-import { readStamp, stampBlock, STAMP_COLUMNS, STAMP_ROWS } from "./stamp.js";
+import { FrameCache, Stream, traffic, mark } from "./movies.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
@@ -13,6 +12,7 @@ import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lo
 import { LookView, drawOrientationMarks } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
 import { SphereMap } from "./sphere_map.js";
+import { installTestApi } from "./test_api.js";
 
 const params = new URLSearchParams(location.search);
 const base = new URL(".", location.href).href.split("?")[0];
@@ -956,74 +956,7 @@ async function main() {
   }, 2000);
 }
 
-let pixelHashCanvas = null;
-/// For tests and the benchmark (headless Chromium through puppeteer).
-window.panoptes = {
-  state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, frames: S.db ? S.db.frames : 0, playing: S.playing, zoom: S.zoom,
-                  speed: S.speed, fps: S.fps, direction: S.dir, loop: S.loop, look: { ...S.look }, rig: S.rig, surface, hudHidden: S.hudHidden }),
-  /// The key table as loaded (null before or when keys.json failed) and why it failed.
-  keys: () => (S.keys ? S.keys.rows : null),
-  /// The key table's mode in use: sphere, panorama or lattice.
-  mode: () => S.mode,
-  keysError: () => S.keysError ?? null,
-  /// Sets the 360° look {yaw, pitch, fov} (clamped as the desktop).
-  setLook: (l) => setLook({ ...S.look, ...l }),
-  /// The camera a walk ("forward", "back", "left", "right", "up", "down") leads to from here, or -1.
-  walkTarget: (w) => walkTarget(S.cams, S.camera, S.look, w),
-  message: () => S.message,
-  pause: () => setPlaying(false),
-  shown: () => S.shown,
-  switches: () => S.switches,
-  traffic: () => ({ ...traffic }),
-  firstFrameMs: () => S.firstFrameMs,
-  /// The steps to the first frame (ms since navigation start): scripts, database.json, index, init, ...
-  marks: () => ({ ...marks }),
-  /// When the camera table was in and parsed (performance.now() ms) and its size; null before.
-  cameraTable: () => S.cameraTableMs ?? null,
-  /// Camera c's neighbour in a direction ("left", ...), -1 if none or the cameras are not loaded yet.
-  neighbour: (c, direction) => graphNeighbour(c, direction),
-  camerasLoaded: () => S.cams !== null,
-  options,
-  /// A stream's state: status, decoder state, fragments whose compressed samples are in memory.
-  streamInfo: (camera, task) => {
-    const st = streams.get(`${camera}/${task}`);
-    return st ? { status: st.status, decoder: st.decoder ? st.decoder.state : "none", samples: st.samples.size } : null;
-  },
-  /// The stamp in the canvas pixels (zoom 1 only), or null.
-  readStamp: () => {
-    const w = canvas.width, h = canvas.height, b = stampBlock(w, h);
-    let g = ctx;
-    if (surface === "look") {  // the cut-out does not show the stamp: read the decoded frame it shows
-      const vf = S.shownKey && cache.map.get(S.shownKey);
-      if (!vf) return null;
-      const scratch = document.createElement("canvas");
-      scratch.width = w;
-      scratch.height = h;
-      g = scratch.getContext("2d");
-      g.drawImage(vf, 0, 0, w, h);
-    }
-    const img = g.getImageData(0, 0, STAMP_COLUMNS * b, STAMP_ROWS * b);
-    return readStamp(img.data, img.width, w, h);
-  },
-  /// A hash of the shown canvas's pixels (the latency benchmark polls it for the change).
-  pixelHash: () => {
-    const c = surface === "look" ? lookCanvas : canvas;
-    const scratch = pixelHashCanvas ?? (pixelHashCanvas = document.createElement("canvas"));
-    scratch.width = 64;
-    scratch.height = 32;
-    const g = scratch.getContext("2d", { willReadFrequently: true });
-    g.drawImage(c, 0, 0, 64, 32);
-    const d = g.getImageData(0, 0, 64, 32).data;
-    let hsh = 2166136261;
-    for (let i = 0; i < d.length; i++) hsh = Math.imul(hsh ^ d[i], 16777619);
-    return hsh >>> 0;
-  },
-  select: (camera, task) => select(camera, task, "api"),
-  /// The decoded frames of (camera, task) in the frame cache, ascending.
-  cachedFrames: (camera, task) => [...cache.map.keys()].filter((k) => k.startsWith(`${camera}/${task}/`))
-    .map((k) => Number(k.split("/")[2])).sort((a, b) => a - b),
-  cameraDirections: () => Array.from(dirs()),
-  dragDirection: () => drag.dir,
-};
+installTestApi({ S, streams, cache, options, drag, canvas, ctx, lookCanvas, surface: () => surface, currentFrame, setLook,
+                 setPlaying, select, graphNeighbour, dirs });
 
 main().catch((e) => { statusLine.textContent = `error: ${e.message}`; });
