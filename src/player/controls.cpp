@@ -68,6 +68,13 @@ std::string_view operation_name(Action a, ViewMode mode) {
 }
 
 std::string_view description(const KeyBinding& b, ViewMode mode) {
+  // Z and X keep their engine action inside a lattice or along a path, where the graph's in/out
+  // neighbours are not camera shells: the lattice's next camera north / south (a world axis, whatever
+  // the view), a path's next / previous camera.
+  if (mode == ViewMode::lattice && b.action == Action::shell_in)
+    return "step north (the world's axis, whatever the view); along a path: the next camera";
+  if (mode == ViewMode::lattice && b.action == Action::shell_out)
+    return "step south; along a path: the previous camera";
   switch (operation(b.action, mode)) {
     case Operation::none: return "";
     case Operation::engine:

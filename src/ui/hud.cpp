@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "player/controls.hpp"
 #include "player/keys.hpp"
 #include "player/legend.hpp"
 #include "player/look.hpp"
@@ -290,42 +291,24 @@ HelpMode help_mode(const store::Manifest& m) {
 }
 
 namespace {
-// What a key does in a 360° database where the window reinterprets it (window_app.cpp); empty = as in
-// the key table.
-std::string_view description_in(HelpMode mode, player::Action a, std::string_view table) {
-  using player::Action;
-  if (mode == HelpMode::walk) {
-    switch (a) {
-      case Action::camera_up: return "walk forward, toward where you look";
-      case Action::camera_down: return "walk back";
-      case Action::camera_left: return "walk left (relative to the view)";
-      case Action::camera_right: return "walk right";
-      case Action::axis_up: return "walk up, toward the sky";
-      case Action::axis_down: return "walk down";
-      case Action::shell_in: return "step along the rig's 'in' link";
-      case Action::shell_out: return "step along the rig's 'out' link";
-      default: break;
-    }
+player::ViewMode view_mode_of(HelpMode mode) {
+  switch (mode) {
+    case HelpMode::rig: return player::ViewMode::sphere;
+    case HelpMode::look: return player::ViewMode::panorama;
+    case HelpMode::walk: return player::ViewMode::lattice;
   }
-  if (mode != HelpMode::rig) {
-    switch (a) {
-      case Action::zoom_in: return "narrower field of view (also the mouse wheel)";
-      case Action::zoom_out: return "wider field of view";
-      case Action::zoom_reset: return "field of view 90 degrees";
-      default: break;
-    }
-  } else if (a == Action::face_action) {
-    return "(360-degree databases only) turn toward the strongest signal";
-  }
-  return table;
+  return player::ViewMode::sphere;
 }
 }  // namespace
 
 std::vector<HelpRow> help_rows(HelpMode mode) {
   std::vector<HelpRow> rows;
   for (const auto& kb : player::key_bindings()) {
+    // The wording of the one key table (player/controls: what `panoptes keys --mode` and the browser
+    // show); a key that does nothing in this mode (A inside a lattice) has no row.
     player::KeyBinding b = kb;
-    b.description = description_in(mode, b.action, b.description);
+    b.description = player::description(kb, view_mode_of(mode));
+    if (b.description.empty()) continue;
     // The nine digit keys are one row, numbered as the HUD numbers tasks.
     if (b.action >= player::Action::task_1 && b.action <= player::Action::task_9) {
       if (b.action == player::Action::task_1) rows.push_back({"1 .. 9", "select task 1 .. 9 (numbered as in the HUD)"});

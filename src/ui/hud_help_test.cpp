@@ -70,7 +70,11 @@ TEST(HudHelp, WordedForTheDatabaseAtHand) {
   EXPECT_NE(walk.find("PageUp: walk up"), std::string::npos) << walk;
   EXPECT_NE(walk.find("field of view"), std::string::npos);
   EXPECT_EQ(walk.find("rotate"), std::string::npos) << walk;
-  EXPECT_EQ(walk.find("magnif"), std::string::npos) << walk;
+  EXPECT_EQ(walk.find("magnify around the cursor"), std::string::npos) << walk;
+  EXPECT_EQ(walk.find("A: "), std::string::npos) << "A does nothing inside a lattice: no row";
+  // Z / X step along the lattice's north axis (a path's order): inside, there are no camera shells.
+  EXPECT_NE(walk.find("Z: step north"), std::string::npos) << walk;
+  EXPECT_EQ(walk.find("camera shell"), std::string::npos) << walk;
   EXPECT_NE(look.find("look around"), std::string::npos);
   EXPECT_NE(look.find("rotate: camera"), std::string::npos) << "a 360° sphere rig still rotates with the arrows";
   EXPECT_NE(rig.find("Up: rotate"), std::string::npos);
