@@ -140,7 +140,8 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       // Numbered from 1, as the digit keys select them.
       ImGui::Text("task %d of %d: %s%s%s", sel.task + 1, int(m.tasks.size()), task.name.c_str(),
                   params.empty() ? "" : "   ", params.c_str());
-      if (info.active_axis >= 0 && info.active_axis < int(m.axes.size()))
+      // Inside a lattice or along a path PgUp/PgDn walk up and down: no axis to step there.
+      if (help_mode_ != HelpMode::walk && info.active_axis >= 0 && info.active_axis < int(m.axes.size()))
         ImGui::Text("PgUp/PgDn axis: %s", m.axes[std::size_t(info.active_axis)].name.c_str());
       if (info.recording) {
         ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
