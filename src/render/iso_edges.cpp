@@ -103,6 +103,16 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
   }
   if (!prev) cand &= ~1u;
   const float hmin = float(std::min({S.spacing[0], S.spacing[1], S.spacing[2]}));
+  // The hit on a bracket [ta, tb] whose field values minus the isovalue (sa, sb) differ in sign: the
+  // linear estimate and one regula-falsi step.
+  const auto refine_hit = [&](double ta, double tb, double sa, double sb) {
+    double th = ta + (tb - ta) * (sa / (sa - sb));
+    const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
+    if ((vh < 0) == (sa < 0)) ta = th, sa = vh;
+    else tb = th, sb = vh;
+    if (sa != sb) th = ta + (tb - ta) * (sa / (sa - sb));
+    return th;
+  };
   for (; cand; cand &= cand - 1) {
     const int j = std::countr_zero(cand) + 1;
     const float sp = s(j - 1), sc = s(j);
@@ -137,13 +147,8 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     double g[3], gn = 0;
     if (cross) {
       // The hit: linear estimate and one regula-falsi step, as without anti-aliasing.
-      double ta = t0 + double(k - 1) * dt, tb = ta + dt;
-      double dpa = sp, dpb = sc;
-      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
-      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
-      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
-      else tb = th, dpb = vh;
-      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double ta = t0 + double(k - 1) * dt;
+      const double th = refine_hit(ta, ta + dt, sp, sc);
       const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
       shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
@@ -199,13 +204,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     }
     if (pierced) {
       // A sliver: the entry by regula falsi between u_in and u_out.
-      double ta = t0 + (double(k) + u_in) * dt, tb = t0 + (double(k) + u_out) * dt;
-      double dpa = s_in, dpb = s_out;
-      double th = ta + (tb - ta) * (dpa / (dpa - dpb));
-      const double vh = interp_clamped(f, O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]) - iso;
-      if ((vh < 0) == (dpa < 0)) ta = th, dpa = vh;
-      else tb = th, dpb = vh;
-      if (dpa != dpb) th = ta + (tb - ta) * (dpa / (dpa - dpb));
+      const double th = refine_hit(t0 + (double(k) + u_in) * dt, t0 + (double(k) + u_out) * dt, s_in, s_out);
       const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
       shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
