@@ -17,19 +17,7 @@ trap cleanup EXIT
 "$panoptes" synth-db "$tmp/db" --lattice 3x3x3 --projection equirectangular --tasks 2 --frames 24 --size 256x128 --gop 4 >/dev/null
 # A sphere rig (perspective, navigation graph) for the same key script through both players.
 "$panoptes" synth-db "$tmp/sphere" --cameras 12 --tasks 3 --frames 8 --size 96x64 --gop 4 >/dev/null
-# serve_db DB LOG: starts `panoptes serve DB` and prints its URL once it listens.
-serve_db() {
-  : > "$2"
-  "$panoptes" serve "$1" --port 0 --quiet > "$2" 2>&1 &
-  pids+=($!)
-  local u=""
-  for _ in $(seq 100); do
-    u=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$2")
-    [ -n "$u" ] && { echo "$u"; return 0; }
-    sleep 0.1
-  done
-  echo "serve $1 did not start:" >&2; cat "$2" >&2; return 1
-}
+. "$here/serve_db.sh"  # serve_db DB LOG
 url=$(serve_db "$tmp/db" "$tmp/serve.log")
 sphere_url=$(serve_db "$tmp/sphere" "$tmp/sphere.log")
 export NODE_PATH=$node_modules

@@ -29,18 +29,7 @@ printf 't=%s end\n' "$(awk "BEGIN{print ${#keys[@]} / 10 + 0.3}")" >> s.txt
 start() { [ "$1" = lattice ] && echo 13 || echo 5; }  # the lattice's centre camera; any sphere camera
 rows() { /usr/bin/python3 -c 'import json, sys; [print(r["camera"], r["task"], r["frame"]) for r in map(json.loads, open(sys.argv[1]))]' "$1"; }
 
-serve_db() {
-  : > "$2"
-  "$panoptes" serve "$1" --port 0 --quiet > "$2" 2>&1 &
-  pids+=($!)
-  local u=""
-  for _ in $(seq 100); do
-    u=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$2")
-    [ -n "$u" ] && { echo "$u"; return 0; }
-    sleep 0.1
-  done
-  echo "serve $1 did not start:" >&2; cat "$2" >&2; return 1
-}
+. "$here/serve_db.sh"  # serve_db DB LOG
 
 python_leg() {  # DB START OUT
   PYTHONPATH="$build/python" /usr/bin/python3 - "$@" "${keys[@]}" <<'PY'
