@@ -100,14 +100,20 @@ export function walkTarget(cams, camera, look, walk, minCos = 0.5) {
   const view = lookBasis(cam, look);
   const d = { forward: view.forward, back: scale(view.forward, -1), right: view.right, left: scale(view.right, -1),
               up: cam.up, down: scale(cam.up, -1) }[walk];
-  let best = -1, bestCos = minCos;  // cos 60°: never walk sideways when nothing lies ahead
+  return bestAligned(cams, camera, here, d, 1, minCos);  // cos 60°: never walk sideways when nothing lies ahead
+}
+
+/// The graph neighbour of `camera` (at `here`) whose displacement makes the largest cosine above minCos
+/// with d (of length lenD), or −1.
+function bestAligned(cams, camera, here, d, lenD, minCos) {
+  let best = -1, bestCos = minCos;
   for (let s = 0; s < 6; s++) {
     const id = cams.neighbours[6 * camera + s];
     if (id < 0 || id >= cams.count || id === camera) continue;
     const step = sub(positionOf(cams, id), here);
     const len = norm(step);
     if (!(len > 0)) continue;
-    const c = dot(step, d) / len;
+    const c = dot(step, d) / (len * lenD);
     if (c > bestCos) { bestCos = c; best = id; }
   }
   return best;
@@ -149,18 +155,7 @@ export function neighbourToward(cams, camera, d) {
   if (!cams || !cams.neighbours || camera < 0 || camera >= cams.count) return -1;
   const lenD = norm(d);
   if (!(lenD > 0)) return -1;
-  const here = positionOf(cams, camera);
-  let best = -1, bestCos = 0.5;
-  for (let s = 0; s < 6; s++) {
-    const id = cams.neighbours[6 * camera + s];
-    if (id < 0 || id >= cams.count || id === camera) continue;
-    const step = sub(positionOf(cams, id), here);
-    const len = norm(step);
-    if (!(len > 0)) continue;
-    const c = dot(step, d) / (len * lenD);
-    if (c > bestCos) { bestCos = c; best = id; }
-  }
-  return best;
+  return bestAligned(cams, camera, positionOf(cams, camera), d, lenD, 0.5);
 }
 
 /// The world direction of the strongest signal in an equirectangular frame (luma: W × H bytes, rows
