@@ -6,8 +6,11 @@
 option(PANOPTES_PCH "Precompile the heavy third-party headers (CLI11, nlohmann-json, GoogleTest) per target" ON)
 
 # Called once, after every module's directory is added: the targets and which heavy headers they use.
+# With unity builds (PANOPTES_UNITY) the libraries and the program parse these headers once per batch
+# anyway: measured on 2 idle cores (2026-11-27), the program's fresh build took 150.7 s with these
+# precompiled headers and 150.1 s without, so they are only used when unity builds are off.
 function(panoptes_precompile_headers)
-  if(NOT PANOPTES_PCH OR PANOPTES_FUZZ)
+  if(NOT PANOPTES_PCH OR PANOPTES_FUZZ OR PANOPTES_UNITY)
     return()
   endif()
   # The modules whose sources include the manifest (store/manifest.hpp includes nlohmann/json.hpp) or

@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (both together first, then p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: 139 s wall for the whole demo at 400x390 as scripts/demo runs it (OpenMP waiting passively), 2026-11-27 05:43 UTC in scripts/firstcontact on the shared 2-core machine (AMD EPYC) at load 1.9-4.1, not idle; 276 CPU-seconds (user + system) in a run at load 13-16 (05:18 UTC), of which render 80 %, encode 14 %, composite 4 %, simulation 1 %.
+# Measured: 115 s wall for the whole demo (40 snapshots at 400x390) as scripts/demo runs it (OpenMP waiting passively), 2026-11-27 10:32 UTC on the shared 2-core machine (AMD EPYC) with nothing else running (load 2.0, its own); 221 CPU-seconds (user + system), of which render 79 %, encode 14 %, composite 5 %, simulation 1.5 %.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
@@ -79,13 +79,13 @@ up_axis = "z_down"     # z is depth: the sky is -z (poles, latitudes, image up a
 # projection = "equirectangular"
 
 [schedule]
-every_steps = 10       # 48 snapshots
+every_steps = 12       # 40 snapshots
 
 [video]                # intra-only: the player's fastest random access, ~1 MB per open writer (P-frames keep a
 gop = 1                # 3 MB encoder per writer; their size gain is unmeasured: docs/insitu.md); crf 23: -14 %, 45 dB
 crf = 23
 preset = "superfast"
-playback_fps = 10      # the player shows the 48 snapshots in ~5 s (the movies themselves are 30 fps)
+playback_fps = 10      # the player shows the 40 snapshots in 4 s (the movies themselves are 30 fps)
 
 [render]               # 1.0 voxel: the largest step whose frames look like 0.5 voxel's. Measured on the demo's
 sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) against 0.5, with the windows below
@@ -164,7 +164,7 @@ CommandRegistration reg([](CLI::App& root) {
       "Run the built-in seismic demo with in-situ visualization: a thrust earthquake in a layered crust seen "
       "by the paper's 130 Yin-Yang cameras x 3 tasks (p+s: p-waves orange and s-waves green together, then "
       "each alone) = 390 movies, "
-      "48 snapshots of 400x390 pixels (also under mpirun -np N). Measured: " + measured_time() +
+      "40 snapshots of 400x390 pixels (also under mpirun -np N). Measured: " + measured_time() +
       " Then: panoptes play DIR.");
   sub->add_option("--out", opt->out, "Database directory")->capture_default_str();
   opt->out = "panoptes_demo";

@@ -1,4 +1,5 @@
 #include "camera/framing.hpp"
+#include "camera/angles.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -7,10 +8,6 @@
 #include "core/error.hpp"
 
 namespace panoptes::camera {
-
-namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
-}
 
 void Domain::validate() const {
   for (int i = 0; i < 3; ++i)

@@ -1,4 +1,5 @@
 #include "camera/navigation.hpp"
+#include "camera/angles.hpp"
 
 #include <algorithm>
 #include <array>
@@ -11,11 +12,6 @@
 #include "core/error.hpp"
 
 namespace panoptes::camera {
-
-namespace {
-constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
-}  // namespace
 
 int Neighbours::operator[](Move m) const {
   switch (m) {

@@ -1,4 +1,5 @@
 #include "camera/rig.hpp"
+#include "camera/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,8 +13,6 @@
 namespace panoptes::camera {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 
 Vec3 from_spherical(double colatitude, double longitude) {
   const double s = std::sin(colatitude);

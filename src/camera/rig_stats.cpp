@@ -1,4 +1,5 @@
 #include "camera/rig_stats.hpp"
+#include "camera/angles.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,8 +10,6 @@
 namespace panoptes::camera {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 
 // Angle from u to its nearest point other than `self` (π if none), by a growing cap.
 double nearest_other(const SphereIndex& index, const Vec3& u, int self) {

@@ -1,4 +1,5 @@
 #include "camera/sphere_index.hpp"
+#include "camera/angles.hpp"
 
 #include <numbers>
 #include <string>
@@ -6,10 +7,6 @@
 #include "core/error.hpp"
 
 namespace panoptes::camera {
-
-namespace {
-constexpr double kPi = std::numbers::pi;
-}
 
 int SphereIndex::band_of(double colatitude) const {
   return std::clamp(int(colatitude / band_height_), 0, bands_ - 1);

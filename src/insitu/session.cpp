@@ -22,6 +22,7 @@
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
 #include "core/log.hpp"
+#include "core/number_text.hpp"
 #include "insitu/halo.hpp"
 #include "insitu/output.hpp"
 #include "insitu/resources.hpp"
@@ -61,12 +62,6 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 using halo::Box;
 using halo::BlockInfo;
 using halo::intersect;
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 std::int64_t peak_rss() {
   rusage u{};
@@ -201,7 +196,7 @@ void Session::Impl::init() {
                       spec.cameras_per_shell() * (long long)spec.radii.size() >= kReportRigCameras;
   auto stage = [&](const std::string& what) {
     if (report)
-      log::info("session: " + what + " (" + fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) +
+      log::info("session: " + what + " (" + number_text(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) +
                 " s)");
   };
   stage("building the rig " + cfg.rig);
@@ -656,8 +651,8 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   // database already holds is not written twice (the same time on every rank: the same decision).
   if (m.repeated(time)) {
     if (m.rank == 0)
-      log::info(m.cfg.output_dir + ": snapshot at time " + fmt(time) + " skipped: the resumed database already holds "
-                "snapshots up to time " + fmt(m.last_time));
+      log::info(m.cfg.output_dir + ": snapshot at time " + number_text(time) + " skipped: the resumed database already holds "
+                "snapshots up to time " + number_text(m.last_time));
     return;
   }
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)

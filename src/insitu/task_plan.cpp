@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/number_text.hpp"
 #include "core/toml_keys.hpp"
 
 namespace panoptes::insitu {
@@ -26,12 +27,6 @@ nlohmann::json transfer_json(const render::TransferFunction& tf) {
   for (const auto& p : tf.colour) colour.push_back({v(p.x), v(p.colour.r), v(p.colour.g), v(p.colour.b)});
   for (const auto& p : tf.opacity) extinction.push_back({v(p.x), v(p.extinction)});
   return {{"colour", std::move(colour)}, {"extinction", std::move(extinction)}, {"absolute_value", tf.absolute_value}};
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 render::ValueWindow window_of(const WindowConfig& w) {
@@ -212,7 +207,7 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
     if (n > 1) axes_.push_back({axis_name, axis_values, ""});
     for (std::size_t i = 0; i < n; ++i) {
       PlannedTask t;
-      t.entry.name = n > 1 ? tc.name + " " + fmt(axis_values[i]) : tc.name;
+      t.entry.name = n > 1 ? tc.name + " " + number_text(axis_values[i]) : tc.name;
       t.entry.fields = tc.fields;
       if (n > 1) t.entry.axes = {{axis_name, int(i)}};
       switch (tc.kind) {
