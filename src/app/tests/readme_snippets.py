@@ -5,7 +5,7 @@ Usage: readme_snippets.py README.md PANOPTES_BINARY WORKDIR
 Shell blocks (```sh) run command by command (a trailing backslash joins lines, '#' starts a comment),
 Python blocks (```python) as one script each, in WORKDIR where `panoptes` is on PATH and these stand-ins
 exist (README's commands name them):
-  out/demo      the demo itself (`panoptes demo`'s configuration: Yin-Yang cameras x the same 3 tasks x 48
+  out/demo      the demo itself (`panoptes demo`'s configuration: Yin-Yang cameras x the same 3 tasks x 40
                 snapshots) on a smaller grid, with 16 cameras of 48x40 pictures so it takes seconds
   path.txt      a script of timed commands as README describes it
   paraview.cdb  a Cinema Spec D database (exported from the small demo)
@@ -132,7 +132,7 @@ def prepare(work, panoptes, repo, env):
         f.write(small)
     seconds = run(["panoptes", "run", "small_demo.toml", "--out", "out/demo", "-q"], work, env, "the small demo")
     print(f"prepared out/demo (the demo's configuration on a 24x48x16 grid, 16 cameras, 48x40 pictures) in {seconds:.1f} s")
-    run(["panoptes", "export-cinema", "out/demo", "paraview.cdb", "--frames", "0,47"], work, env, "paraview.cdb")
+    run(["panoptes", "export-cinema", "out/demo", "paraview.cdb", "--frames", "0,39"], work, env, "paraview.cdb")
     import numpy as np
     for i in range(1):
         z, y, x = np.mgrid[0:12, 0:16, 0:20].astype(np.float32)
