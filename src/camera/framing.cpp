@@ -1,10 +1,9 @@
 #include "camera/framing.hpp"
-#include "camera/angles.hpp"
 
 #include <cmath>
-#include <numbers>
 #include <string>
 
+#include "camera/angles.hpp"
 #include "core/error.hpp"
 
 namespace panoptes::camera {

@@ -1,13 +1,12 @@
 #include "camera/navigation.hpp"
-#include "camera/angles.hpp"
 
 #include <algorithm>
 #include <array>
 #include <limits>
 #include <cmath>
-#include <numbers>
 #include <string>
 
+#include "camera/angles.hpp"
 #include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 

@@ -1,12 +1,11 @@
 #include "camera/rig.hpp"
-#include "camera/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <numbers>
 #include <string>
 
+#include "camera/angles.hpp"
 #include "camera/sphere_index.hpp"
 #include "core/error.hpp"
 

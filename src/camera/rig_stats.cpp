@@ -1,11 +1,11 @@
 #include "camera/rig_stats.hpp"
-#include "camera/angles.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
 #include <utility>
+
+#include "camera/angles.hpp"
 
 namespace panoptes::camera {
 

@@ -1,9 +1,8 @@
 #include "camera/sphere_index.hpp"
-#include "camera/angles.hpp"
 
-#include <numbers>
 #include <string>
 
+#include "camera/angles.hpp"
 #include "core/error.hpp"
 
 namespace panoptes::camera {
