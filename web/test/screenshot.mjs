@@ -1,9 +1,10 @@
 // Screenshot of the web player for docs/web.md:
 //   node web/test/screenshot.mjs URL OUT.png CHROMIUM NODE_MODULES   (URL of `panoptes serve out/demo`)
 import { createRequire } from "node:module";
+import { resolve } from "node:path";
 
 const [url, out, chromium, nodeModules] = process.argv.slice(2);
-const puppeteer = createRequire(nodeModules + "/")("puppeteer-core");
+const puppeteer = createRequire(resolve(nodeModules) + "/")("puppeteer-core");  // NODE_MODULES may be relative
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox"] });
 const page = await browser.newPage();
 await page.setViewport({ width: 1000, height: 860 });

@@ -2,9 +2,10 @@
 //   node web/test/screenshot_look.mjs URL OUT.png CHROMIUM NODE_MODULES "QUERY" [KEYS...]
 // e.g. QUERY "?play=0&camera=4&frame=16&yaw=-40&pitch=-10", KEYS ArrowUp (each pressed, then paused).
 import { createRequire } from "node:module";
+import { resolve } from "node:path";
 
 const [url, out, chromium, nodeModules, query = "", ...keys] = process.argv.slice(2);
-const puppeteer = createRequire(nodeModules + "/")("puppeteer-core");
+const puppeteer = createRequire(resolve(nodeModules) + "/")("puppeteer-core");  // NODE_MODULES may be relative
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true,
   args: ["--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"] });
 const page = await browser.newPage();
