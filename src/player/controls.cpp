@@ -92,6 +92,27 @@ std::string_view description(const KeyBinding& b, ViewMode mode) {
   return "";
 }
 
+bool usable(Action a, ViewMode mode, const store::Manifest& m) {
+  const Operation op = operation(a, mode);
+  if (op == Operation::none) return false;
+  if (op != Operation::engine && op != Operation::front_end) return true;
+  const auto any_neighbour = [&](int store::Neighbours::*slot) {
+    if (m.graph.empty()) return true;  // no navigation data: the engine may still find one
+    for (const auto& n : m.graph.neighbours)
+      if (n.*slot >= 0) return true;
+    return false;
+  };
+  switch (a) {
+    case Action::axis_up:
+    case Action::axis_down:
+    case Action::next_axis: return !m.axes.empty();
+    case Action::shell_in: return any_neighbour(&store::Neighbours::in);
+    case Action::shell_out: return any_neighbour(&store::Neighbours::out);
+    case Action::face_action: return mode != ViewMode::sphere;
+    default: return true;
+  }
+}
+
 bool is_walk(Operation op) { return op >= Operation::walk_forward && op <= Operation::walk_down; }
 
 Walk walk_of(Operation op) {

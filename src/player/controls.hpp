@@ -49,6 +49,11 @@ std::string_view operation_name(Action action, ViewMode mode);
 /// The help line of a key binding as it acts in `mode` (the binding's own description unless the mode
 /// changes what it does, e.g. Up walks forward in a lattice); empty when the key does nothing there.
 std::string_view description(const KeyBinding& binding, ViewMode mode);
+/// Whether `action` can change anything in this database as `mode` dispatches it: false where the
+/// operation is none, for the parameter-axis keys of a database without parameter axes, for Z / X where
+/// no camera of the navigation graph has a closer / farther neighbour, and for C on perspective frames
+/// (there it only says that the views are fixed). The help overlays (window, browser) list usable keys.
+bool usable(Action action, ViewMode mode, const store::Manifest& manifest);
 /// True for the walk_* operations.
 bool is_walk(Operation op);
 /// The Walk of a walk_* operation.

@@ -1,5 +1,6 @@
 #include "player/keys_json.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <string>
 #include <vector>
@@ -103,6 +104,18 @@ nlohmann::json keys_json(const store::Manifest* manifest) {
   }
   j["bindings"] = std::move(bindings);
   j["actions"] = std::move(actions);
+  if (manifest) {
+    // The actions that can change nothing in this database (usable()): the browser's help leaves them
+    // out, as the window's does.
+    const ViewMode mode = view_mode(*manifest);
+    json unusable = json::array();
+    for (const KeyBinding& b : key_bindings()) {
+      const std::string name(to_string(b.action));
+      if (!usable(b.action, mode, *manifest) && std::find(unusable.begin(), unusable.end(), name) == unusable.end())
+        unusable.push_back(name);
+    }
+    j["unusable"] = std::move(unusable);
+  }
 
   j["walk"] = {
       {"slots", {"left", "right", "up", "down", "in", "out"}},

@@ -64,7 +64,7 @@ std::vector<Vec3> minimap_directions(const store::Manifest& manifest) {
   return dirs;
 }
 
-Hud::Hud(const store::Manifest& manifest) : help_mode_(help_mode(manifest)) {
+Hud::Hud(const store::Manifest& manifest) : help_mode_(help_mode(manifest)), help_rows_(help_rows(help_mode_, &manifest)) {
   std::vector<Vec3> dirs = minimap_directions(manifest);
   std::vector<int> shells;
   for (const auto& c : manifest.cameras) shells.push_back(c.labels.shell);
@@ -302,9 +302,10 @@ player::ViewMode view_mode_of(HelpMode mode) {
 }
 }  // namespace
 
-std::vector<HelpRow> help_rows(HelpMode mode) {
+std::vector<HelpRow> help_rows(HelpMode mode, const store::Manifest* manifest) {
   std::vector<HelpRow> rows;
   for (const auto& kb : player::key_bindings()) {
+    if (manifest && !player::usable(kb.action, view_mode_of(mode), *manifest)) continue;
     // The wording of the one key table (player/controls: what `panoptes keys --mode` and the browser
     // show); a key that does nothing in this mode (A inside a lattice) has no row.
     player::KeyBinding b = kb;
@@ -356,7 +357,7 @@ HelpLayout help_layout(int rows, float row_h, float pair_w, float avail_w, float
 }
 
 void Hud::draw_help(float vw, float vh) {
-  const std::vector<HelpRow> rows = help_rows(help_mode_);
+  const std::vector<HelpRow>& rows = help_rows_;
   const ImGuiStyle& style = ImGui::GetStyle();
   float key_w = 0, what_w = 0;
   for (const HelpRow& r : rows) {

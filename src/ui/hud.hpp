@@ -67,8 +67,10 @@ enum class HelpMode {
 /// The mode of a manifest (as the window decides: equirectangular projection, lattice or path rig).
 HelpMode help_mode(const store::Manifest& manifest);
 /// The help overlay's lines: the shared key table (player/keys.hpp) with the digit keys on one line and
-/// keys of the same action sharing a line, worded for `mode`, then the mouse gestures.
-std::vector<HelpRow> help_rows(HelpMode mode = HelpMode::rig);
+/// keys of the same action sharing a line, worded for `mode`, then the mouse gestures. With a manifest,
+/// keys that can change nothing in that database (player::usable: no parameter axes, one camera shell,
+/// C on perspective frames) are left out.
+std::vector<HelpRow> help_rows(HelpMode mode = HelpMode::rig, const store::Manifest* manifest = nullptr);
 
 /// How the help overlay is laid out: key/description column pairs side by side and the text scale.
 struct HelpLayout {
@@ -119,6 +121,7 @@ class Hud {
   void draw_help(float viewport_w, float viewport_h);
   void draw_legend(const HudInfo& info, float viewport_w, float viewport_h);
   HelpMode help_mode_ = HelpMode::rig;
+  std::vector<HelpRow> help_rows_;  // the help overlay's lines for this database
   MiniMap minimap_;
   LatticeMap lattice_map_;
   bool z_down_ = false;  ///< replaces the sphere map for rigs inside the volume (lattice, path)

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "player/keys.hpp"
+#include "store/manifest.hpp"
 #include "ui/hud.hpp"
 
 namespace panoptes::ui {
@@ -80,6 +81,28 @@ TEST(HudHelp, WordedForTheDatabaseAtHand) {
   EXPECT_NE(rig.find("Up: rotate"), std::string::npos);
   EXPECT_NE(rig.find("magnify"), std::string::npos);
   EXPECT_EQ(rig.find("walk"), std::string::npos);
+}
+
+// The demo's database (one Yin-Yang shell, no parameter axes) gets no PgUp / PgDn / A / Z / X / C rows:
+// a first-time user pressing them would see nothing happen.
+TEST(HudHelp, OnlyKeysTheDatabaseCanUse) {
+  store::Manifest m;
+  m.graph.neighbours.assign(2, store::Neighbours{.left = 1, .right = 1, .up = 1, .down = 1});
+  const auto text = [&] {
+    std::string all;
+    for (const auto& r : help_rows(HelpMode::rig, &m)) all += r.key + ": " + r.what + "\n";
+    return all;
+  };
+  std::string rig = text();
+  for (const char* key : {"PageUp: ", "PageDown: ", "A: ", "Z: ", "X: ", "C: "})
+    EXPECT_EQ(rig.find(std::string("\n") + key), std::string::npos) << key << " in\n" << rig;
+  EXPECT_NE(rig.find("Up: rotate"), std::string::npos) << rig;
+  m.axes = {store::ParameterAxis{"isovalue", {0.1, 0.2}, ""}};
+  m.graph.neighbours[0].in = 1;
+  m.graph.neighbours[1].out = 0;
+  rig = text();
+  for (const char* key : {"PageUp: ", "PageDown: ", "A: ", "Z: ", "X: "})
+    EXPECT_NE(rig.find(std::string("\n") + key), std::string::npos) << key << " missing in\n" << rig;
 }
 
 }  // namespace

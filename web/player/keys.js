@@ -23,7 +23,10 @@ export function parseKeyTable(json, source = "keys.json") {
     }
   for (const list of byKey.values()) list.sort((a, b) => (b.shift !== undefined) - (a.shift !== undefined));
   return { rows, byKey, mode: json.mode ?? null, actions: json.actions ?? {}, walk: json.walk ?? null, look: json.look ?? null,
-           playback: json.playback ?? null, numbering: json.numbering ?? null };
+           playback: json.playback ?? null, numbering: json.numbering ?? null,
+           // Actions that can change nothing in this database (C++ player::usable: no parameter axes, one
+           // camera shell, C on perspective frames): the help leaves them out, as the window's does.
+           unusable: new Set(Array.isArray(json.unusable) ? json.unusable : []) };
 }
 
 /// The binding of a keydown event (event.key among its keys, and its shift state when it names one),
@@ -47,12 +50,13 @@ const SHOWN = { Left: "←", Right: "→", Up: "↑", Down: "↓", Period: ".", 
 const shown = (k) => SHOWN[k] ?? k;
 
 /// The help rows for the mode: [{keys, text, action}], the table's order, keys of one action with the
-/// same text on one line, digit keys folded into the first. Bindings not active in the mode, or whose
-/// action this player cannot do (`unsupported`: a Set of action names), are left out.
+/// same text on one line, digit keys folded into the first. Bindings not active in the mode, whose
+/// action this player cannot do (`unsupported`: a Set of action names) or that can change nothing in
+/// the database (the table's `unusable`), are left out.
 export function helpRows(table, mode, unsupported = new Set()) {
   const out = [], byAction = new Map();
   for (const r of table.rows) {
-    if (unsupported.has(r.action) || (Array.isArray(r.modes) && !r.modes.includes(mode))) continue;
+    if (unsupported.has(r.action) || table.unusable?.has(r.action) || (Array.isArray(r.modes) && !r.modes.includes(mode))) continue;
     if (operationOf(table, r.action, mode) === null) continue;
     const d = r.description;
     const text = (d && typeof d === "object" ? d[mode] : d) ?? r.action;
