@@ -524,7 +524,12 @@ function updateHud(frame) {
     const node = S.rig.lattice ? `  lattice (${latticeNode(S.rig.lattice, c).join(", ")}) of ${S.rig.lattice.join("x")}` : "";
     const heading = ((Math.atan2(v[1], v[0]) * 180) / Math.PI + 360) % 360;  // from north (x) towards east (y)
     where = `camera ${c}${node}  at (${p.map((x) => Number(x.toPrecision(4))).join(", ")})${db.domain_units ? " " + db.domain_units : ""}  heading ${Math.round(heading) % 360}°`;
-  } else where = `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°  shell ${S.cams.shell[c]}`;
+  } else {
+    // The shell only where there are several, as the desktop HUD.
+    S.cams.shellCount ??= new Set(S.cams.shell).size;
+    where = `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°` +
+      (S.cams.shellCount > 1 ? `  shell ${S.cams.shell[c]}` : "");
+  }
   const text =
     `${timeText(db, db.times[frame] ?? frame)}  frame ${frame} of ${db.frames}  ${S.playing ? "playing" : "paused"} x${speed}${S.dir < 0 ? " reverse" : ""}${S.loop ? "" : " once"}\n` +
     where + "\n" +
