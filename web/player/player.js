@@ -527,7 +527,9 @@ function updateHud(frame) {
   } else {
     // The shell only where there are several, as the desktop HUD.
     S.cams.shellCount ??= new Set(S.cams.shell).size;
-    where = `camera ${c}  lat ${S.cams.lat_deg[c].toFixed(1)}°  lon ${S.cams.lon_deg[c].toFixed(1)}°` +
+    // Whole signed degrees, as the desktop HUD writes them (ui/hud_text's signed_degrees): "lat +36°".
+    const deg = (d) => { const r = Math.round(d); return r === 0 ? "0°" : `${r > 0 ? "+" : ""}${r}°`; };
+    where = `camera ${c}  lat ${deg(S.cams.lat_deg[c])}  lon ${deg(S.cams.lon_deg[c])}` +
       (S.cams.shellCount > 1 ? `  shell ${S.cams.shell[c]}` : "");
   }
   const text =
