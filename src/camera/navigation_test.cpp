@@ -4,8 +4,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 
+#include "camera/angles.hpp"
 #include "camera/rig_spec.hpp"
 #include "camera/rig_stats.hpp"
 #include "core/error.hpp"
@@ -14,7 +14,6 @@ using namespace panoptes;
 using namespace panoptes::camera;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 const Domain kDomain{{0, 0, 0}, {256, 512, 160}};
 
 double wrap180(double a) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "camera/angles.hpp"
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "camera/rig_stats.hpp"
@@ -17,7 +18,6 @@ using namespace panoptes;
 using namespace panoptes::camera;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 const Domain kPaperDomain{{0, 0, 0}, {256, 512, 160}};
 
 // Smallest angle between any two points (brute force, for small patterns).

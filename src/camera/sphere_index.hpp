@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "camera/angles.hpp"
 #include "core/vec3.hpp"
 
 namespace panoptes::camera {
@@ -53,7 +54,6 @@ class SphereIndex {
 template <class Fn>
 void SphereIndex::for_each_within(const Vec3& u, double radius, Fn&& fn) const {
   if (ids_.empty()) return;
-  constexpr double kPi = 3.14159265358979323846;
   const double cos_r = radius >= kPi ? -2.0 : std::cos(radius);
   auto scan_cell = [&](int cell) {
     for (int k = cell_first_[cell], e = cell_first_[cell + 1]; k < e; ++k) {
