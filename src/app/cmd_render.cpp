@@ -54,7 +54,8 @@ struct Args {
   double sample_distance = 0.5;
   bool adaptive = true;  // pays where images have more pixels than voxels across (docs/rendering.md, Round 4)
   double percentile = 0.999;
-  std::string reference = "snapshot";  // the session's default (before issue 30 render used a running maximum)
+  std::string reference = "running";  // the session's default (issue 41: colours keep their value along a movie)
+  double reference_value = 0;         // --reference fixed: the physical reference of the field
   bool print_tasks = false;
   std::string spacing, origin, background = "0,0,0";
   bool no_outline = false;
@@ -96,6 +97,7 @@ std::string recorded_command_line(const Args& a) {
   cl += a.adaptive ? " --adaptive" : " --no-adaptive";
   cl += " --percentile " + number_text(a.percentile);
   cl += " --reference " + a.reference;
+  if (a.reference_value != 0) cl += " --reference-value " + number_text(a.reference_value);
   if (!a.spacing.empty()) cl += " --spacing " + shell_word(a.spacing);
   if (!a.origin.empty()) cl += " --origin " + shell_word(a.origin);
   if (!a.grid_file.empty()) cl += " --grid " + shell_word(a.grid_file);
@@ -204,7 +206,15 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   cfg.render.adaptive = a.adaptive;
   cfg.render.equirect_adaptive = a.adaptive;  // --no-adaptive marches every pixel of 360° frames too
   cfg.percentile = a.percentile;
-  cfg.running_max = a.reference == "running-max";
+  const insitu::ReferenceMode mode = insitu::parse_reference_mode(a.reference, "--reference");
+  if (mode == insitu::ReferenceMode::fixed) {
+    if (!(a.reference_value > 0)) throw Error("--reference fixed: give the field's physical reference with --reference-value V (> 0)");
+    for (const insitu::TaskConfig& t : cfg.tasks)
+      for (const std::string& f : t.fields) cfg.field_scales[f] = {mode, a.reference_value};
+  } else {
+    if (a.reference_value != 0) throw Error("--reference-value is the value of --reference fixed (the reference is " + a.reference + ")");
+    cfg.reference = mode;
+  }
   cfg.check_memory = !a.force;
   cfg.validate();
   return cfg;
@@ -337,11 +347,14 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                   "65,536 points, at least 0.001 x the maximum)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   sub->add_option("--reference", args->reference,
-                  "Reference of relative windows: snapshot (each volume's own quantile, as `panoptes run`'s "
-                  "default) or running-max (the running maximum over the series: colours comparable along a movie, "
-                  "but decaying waves fade)")
-      ->check(CLI::IsMember({"snapshot", "running-max"}))
+                  "What relative windows are multiples of: running (the largest quantile so far: a colour keeps its "
+                  "value along the movie, decaying waves darken; as `panoptes run`'s default), snapshot (each "
+                  "volume's own quantile: every frame fills its window) or fixed (--reference-value V, a physical "
+                  "value in the field's units)")
+      ->check(CLI::IsMember({"snapshot", "running", "running-max", "fixed"}))
       ->capture_default_str();
+  sub->add_option("--reference-value", args->reference_value,
+                  "With --reference fixed: the reference in the field's units (relative windows are multiples of it)");
   sub->add_flag("--print-tasks", args->print_tasks,
                 "Print the TOML [[task]] tables the --task options stand for (as `panoptes run` reads them) and exit");
   sub->add_option("--spacing", args->spacing, "Grid spacing sx,sy,sz (default: from the file, or 1,1,1)");

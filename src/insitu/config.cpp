@@ -54,6 +54,27 @@ OutputMode parse_output_mode(const std::string& text) {
   throw Error("[output] mode = \"" + text + "\": expected \"create\", \"overwrite\" or \"resume\"");
 }
 
+const char* to_string(ReferenceMode mode) {
+  switch (mode) {
+    case ReferenceMode::snapshot: return "snapshot";
+    case ReferenceMode::running: return "running";
+    case ReferenceMode::fixed: return "fixed";
+  }
+  return "running";
+}
+
+ReferenceMode parse_reference_mode(const std::string& text, const std::string& key) {
+  for (ReferenceMode m : {ReferenceMode::snapshot, ReferenceMode::running, ReferenceMode::fixed})
+    if (text == to_string(m)) return m;
+  if (text == "running-max") return ReferenceMode::running;  // the word before issue 41
+  throw Error(key + " = \"" + text + "\": expected \"snapshot\", \"running\" or \"fixed\"");
+}
+
+FieldScale SessionConfig::scale_of(const std::string& field) const {
+  const auto it = field_scales.find(field);
+  return it != field_scales.end() ? it->second : FieldScale{reference, 0};
+}
+
 void SessionConfig::validate() const {
   if (output_dir.empty()) throw Error("output.dir: must not be empty");
   if (width < 2 || height < 2 || width > kMaxImageSide || height > kMaxImageSide)
@@ -75,6 +96,13 @@ void SessionConfig::validate() const {
     throw Error("schedule.every_time: expected a finite number > 0");
   if (schedule.max_snapshots < 0) throw Error("schedule.max_snapshots: expected 0 (unlimited) or more");
   if (!(percentile > 0 && percentile <= 1)) throw Error("render.percentile: expected a value in (0, 1]");
+  if (reference == ReferenceMode::fixed)
+    throw Error("render.reference = \"fixed\" needs a physical value per field: give it as [render.field.NAME] "
+                "reference = \"fixed\", value = V (the other fields keep \"running\" or \"snapshot\")");
+  for (const auto& [name, fs] : field_scales)
+    if (fs.mode == ReferenceMode::fixed && !(std::isfinite(fs.value) && fs.value > 0))
+      throw Error("render.field." + name + ".value: " + std::to_string(fs.value) +
+                  "; a fixed reference needs a finite value > 0 in the field's units");
   if (!(render.sample_distance >= 0.01 && render.sample_distance <= 16))
     throw Error("render.sample_distance: " + std::to_string(render.sample_distance) + "; expected 0.01..16 voxels");
   video.validate();
@@ -181,11 +209,38 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance", "equirect_adaptive", "iso_antialias"});
-    const std::string ref = str(c, *r, "reference", "render.", "snapshot");
-    if (ref != "snapshot" && ref != "running-max")
-      c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\" or \"running-max\"");
-    s.running_max = ref == "running-max";
+                                      "adaptive_tolerance", "equirect_adaptive", "iso_antialias", "field", "share_scale"});
+    const std::string ref = str(c, *r, "reference", "render.", "running");
+    if (ref == "fixed") c.fail("render.reference", "\"fixed\" needs a value per field: [render.field.NAME] reference = \"fixed\", value = V");
+    try {
+      s.reference = parse_reference_mode(ref, "render.reference");
+    } catch (const Error&) {
+      c.fail("render.reference", "\"" + ref + "\"; expected \"snapshot\", \"running\" or \"fixed\" (per field)");
+    }
+    const std::string share = str(c, *r, "share_scale", "render.", "units");
+    if (share != "units" && share != "none")
+      c.fail("render.share_scale", "\"" + share + "\"; expected \"units\" (two-field pictures share one reference when their units agree) or \"none\"");
+    s.share_scale = share == "none" ? ScaleSharing::none : ScaleSharing::units;
+    if (const auto* fields = table(c, *r, "field"))
+      for (const auto& [key, node] : *fields) {
+        const std::string name(key.str()), where = "render.field." + name;
+        const auto* ft = node.as_table();
+        if (!ft) c.fail(where, "expected a table [render.field." + name + "] with reference and value");
+        only_keys(c, *ft, where, {"reference", "value"});
+        FieldScale fs;
+        const std::string mode = str(c, *ft, "reference", where + ".", to_string(s.reference));
+        try {
+          fs.mode = parse_reference_mode(mode, where + ".reference");
+        } catch (const Error&) {
+          c.fail(where + ".reference", "\"" + mode + "\"; expected \"snapshot\", \"running\" or \"fixed\"");
+        }
+        fs.value = num(c, *ft, "value", where + ".", 0);
+        if (fs.mode == ReferenceMode::fixed && !(std::isfinite(fs.value) && fs.value > 0))
+          c.fail(where + ".value", "a fixed reference needs a finite value > 0 in the field's units");
+        if (fs.mode != ReferenceMode::fixed && ft->get("value"))
+          c.fail(where + ".value", "only a fixed reference takes a value (reference = \"" + mode + "\")");
+        s.field_scales[name] = fs;
+      }
     s.render.sample_distance = num(c, *r, "sample_distance", "render.", s.render.sample_distance);
     if (!(s.render.sample_distance >= 0.01 && s.render.sample_distance <= 16))
       c.fail("render.sample_distance", "expected 0.01..16 voxels");

@@ -24,7 +24,7 @@ inline constexpr unsigned long long kMaxConfigBytes = 16ull << 20;
 
 /// A value window: absolute [lo, hi], or relative (lo·ref, hi·ref) where ref is the running maximum
 /// of the `percentile` quantile of |field| over the whole grid (this snapshot's, or the running
-/// maximum over snapshots: SessionConfig::running_max).
+/// maximum over snapshots, or a fixed value: SessionConfig::reference and field_scales).
 struct WindowConfig {
   double lo = 0, hi = 1;
   bool relative = true;
@@ -73,6 +73,32 @@ const char* to_string(OutputMode mode);
 /// Parses the names of to_string(); throws Error naming `[output] mode` and the accepted values.
 OutputMode parse_output_mode(const std::string& text);
 
+/// What the reference of a field's relative windows and isovalues follows over time (issue 41). The
+/// reference is the unit relative windows are multiples of; the manifest records it per frame.
+enum class ReferenceMode {
+  snapshot,  ///< this snapshot's quantile: each frame fills its window, so brightness says nothing across frames
+  running,   ///< the largest quantile so far: never shrinks, so a decaying wave gets darker (the default)
+  fixed      ///< a physical value from the configuration: the same colour means the same value in every run
+};
+/// "snapshot" / "running" / "fixed".
+const char* to_string(ReferenceMode mode);
+/// Parses the words of to_string() (and "running-max", the older word for "running"); throws Error
+/// naming `key`, the text and the accepted words.
+ReferenceMode parse_reference_mode(const std::string& text, const std::string& key);
+
+/// How one field's reference is chosen: a mode and, for ReferenceMode::fixed, the physical value.
+struct FieldScale {
+  ReferenceMode mode = ReferenceMode::running;
+  double value = 0;  ///< fixed: the reference in the field's units (> 0)
+  bool operator==(const FieldScale&) const = default;
+};
+
+/// Whether the fields of one two-field picture (volume2) share one reference (issue 41).
+enum class ScaleSharing {
+  units,  ///< share when their units agree (or are not given): p+s both in 1/s, a weak field stays dark
+  none    ///< each field its own reference: every field fills its window, whatever its strength
+};
+
 /// Everything a session needs besides the grid and the communicator.
 struct SessionConfig {
   std::string output_dir = "panoptes_out";
@@ -100,9 +126,13 @@ struct SessionConfig {
   bool outline = true;
   bool compass = true;                ///< 360° frames: horizon, ticks and N/E/S/W (render::OutlineStyle)
   double percentile = 0.999;          ///< quantile of |v| used as reference of relative windows
-  /// Reference of relative windows: this snapshot's quantile (false), or its running maximum over
-  /// snapshots (true: colours comparable across frames, but decaying waves fade out).
-  bool running_max = false;
+  /// What every field's reference follows over time ([render] reference); per-field exceptions in
+  /// field_scales ([render.field.NAME] reference, value).
+  ReferenceMode reference = ReferenceMode::running;
+  std::map<std::string, FieldScale> field_scales;
+  ScaleSharing share_scale = ScaleSharing::units;  ///< [render] share_scale: two-field pictures
+  /// The scale of `field`: its entry in field_scales, else {reference}.
+  FieldScale scale_of(const std::string& field) const;
   /// Refuse to start when the estimated memory of a rank exceeds what it has available ([resources]
   /// check_memory; false = `--force`, for people who know better than the estimate).
   bool check_memory = true;

@@ -17,7 +17,7 @@
 namespace panoptes::insitu {
 
 /// Provenance note in which the session keeps the running references of relative windows
-/// (SessionConfig::running_max), so that a resumed run goes on with them.
+/// (every field's, whatever its SessionConfig::reference mode), so that a resumed run goes on with them.
 inline constexpr const char* kRunningMaxNote = "insitu.running_max";
 
 /// A database opened for a session.

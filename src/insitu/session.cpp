@@ -184,7 +184,16 @@ void Session::Impl::init() {
     for (int s = 0; s < size; ++s) exchange.needed = exchange.needed || halo::fetches(blocks, r, s);
 
   plan = TaskPlan(cfg.tasks, grid);
+  plan.share_scales(cfg.field_units, cfg.share_scale);
   field_names = plan.field_names();
+  // A scale given for a field no task reads is a typo that would silently leave the real field on
+  // the default scale.
+  for (const auto& [name, fs] : cfg.field_scales)
+    if (std::find(field_names.begin(), field_names.end(), name) == field_names.end()) {
+      std::string read;
+      for (const std::string& f : field_names) read += (read.empty() ? "" : ", ") + f;
+      throw Error("render.field." + name + ": no task reads a field named \"" + name + "\" (the tasks read " + read + ")");
+    }
   check_resources();
   const camera::Domain domain{grid.domain_lo(), grid.domain_hi() - grid.domain_lo()};
   camera::RigSpec spec = camera::RigSpec::parse(cfg.rig);
@@ -224,7 +233,7 @@ void Session::Impl::init() {
       if (cfg.schedule.every_time > 0)
         next_time = (std::floor(last_time / cfg.schedule.every_time + 1e-9) + 1) * cfg.schedule.every_time;
     }
-    if (cfg.running_max && out.references.size() == references.size())
+    if (out.references.size() == references.size())
       for (std::size_t f = 0; f < references.size(); ++f) references[f].update(out.references[f]);
   }
   stage("database created");
@@ -315,7 +324,7 @@ store::Manifest Session::Impl::make_manifest() const {
   man.time_units = cfg.time_units;
   for (const std::string& f : field_names) {
     const auto unit = cfg.field_units.find(f);
-    man.fields.push_back({f, unit == cfg.field_units.end() ? std::string() : unit->second, {}});
+    man.fields.push_back({f, unit == cfg.field_units.end() ? std::string() : unit->second, {}, to_string(cfg.scale_of(f).mode)});
   }
   return man;
 }
@@ -577,7 +586,7 @@ void Session::Impl::checkpoint(double t) {
 #endif
   if (rank == 0) {
     writer->set_time(snapshots - 1, t);
-    if (cfg.running_max) {
+    {  // every field's running maximum, so a resumed run continues the scale whatever its mode
       std::vector<double> refs;
       for (const render::RunningMax& r : references) refs.push_back(r.value());
       writer->set_note(kRunningMaxNote, format_references(refs));
@@ -670,10 +679,15 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   auto t0 = Clock::now();
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());
-  for (std::size_t f = 0; f < m.field_names.size(); ++f)
-  {
+  for (std::size_t f = 0; f < m.field_names.size(); ++f) {
+    const FieldScale scale = m.cfg.scale_of(m.field_names[f]);
+    if (scale.mode == ReferenceMode::fixed) {
+      ref[f] = scale.value;  // the same on every rank: no quantile, no collective
+      continue;
+    }
     const double q = m.window_reference(int(f));
-    ref[f] = std::max(m.cfg.running_max ? m.references[f].update(q) : q, 1e-30);
+    const double running = m.references[f].update(q);
+    ref[f] = std::max(scale.mode == ReferenceMode::running ? running : q, 1e-30);
   }
   m.last_references = ref;
   m.plan.resolve(ref, m.specs);

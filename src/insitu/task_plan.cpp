@@ -267,14 +267,32 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
   }
 }
 
+void TaskPlan::share_scales(const std::map<std::string, std::string>& field_units, ScaleSharing sharing) {
+  auto unit = [&](const std::string& f) {
+    const auto it = field_units.find(f);
+    return it == field_units.end() ? std::string() : it->second;
+  };
+  for (PlannedTask& t : tasks_) {
+    if (t.spec.field2 < 0 || t.entry.fields.size() < 2) continue;
+    const std::string a = unit(t.entry.fields[0]), b = unit(t.entry.fields[1]);
+    // Fields of different units cannot be compared, so each keeps its own; unknown units are taken
+    // as comparable: a shared scale can hide a weak field, an own scale invents strength it lacks.
+    t.shared = sharing == ScaleSharing::units && (a == b || a.empty() || b.empty());
+    t.entry.parameters["scale"] = t.shared ? "shared" : "own";
+  }
+}
+
 void TaskPlan::resolve(const std::vector<double>& ref, std::vector<render::TaskSpec>& specs) const {
   specs.resize(tasks_.size());
   for (std::size_t i = 0; i < tasks_.size(); ++i) {
     const PlannedTask& t = tasks_[i];
     render::TaskSpec& s = specs[i];
     s = t.spec;
-    if (t.relative) s.reference = ref[std::size_t(t.spec.field)];
-    if (t.relative2 && t.spec.field2 >= 0) s.reference2 = ref[std::size_t(t.spec.field2)];
+    const double r1 = ref[std::size_t(t.spec.field)];
+    const double r2 = t.spec.field2 >= 0 ? ref[std::size_t(t.spec.field2)] : 0;
+    const double shared = std::max(r1, r2);
+    if (t.relative) s.reference = t.shared ? shared : r1;
+    if (t.relative2 && t.spec.field2 >= 0) s.reference2 = t.shared ? shared : r2;
     if (t.iso_relative) s.isovalue = float(t.iso_fraction * ref[std::size_t(t.spec.field)]);
   }
 }

@@ -34,6 +34,9 @@ struct PlannedTask {
   bool relative2 = false;     ///< volume2: second window in multiples of the reference of spec.field2
   bool iso_relative = false;  ///< isovalue = iso_fraction x the reference of spec.field
   double iso_fraction = 0;
+  /// volume2: both windows follow one reference, the larger of the two fields' (issue 41), so a
+  /// field far weaker than the other stays dark instead of being stretched to look as strong.
+  bool shared = false;
   store::TaskEntry entry;
 };
 
@@ -51,6 +54,10 @@ class TaskPlan {
   const std::vector<store::ParameterAxis>& axes() const { return axes_; }
   /// Names of the fields the tasks read, in first-use order (TaskSpec::field indexes this list).
   const std::vector<std::string>& field_names() const { return field_names_; }
+  /// Decides, for every two-field task, whether its fields share one reference: with
+  /// ScaleSharing::units when their units (`field_units`, by field name) agree or are not given.
+  /// Records the choice in the task's manifest parameters ("scale": "shared" / "own").
+  void share_scales(const std::map<std::string, std::string>& field_units, ScaleSharing sharing);
   /// The specs of one snapshot: relative windows and isovalues resolved against `references`
   /// (one per field_names() entry). `specs` is resized to size().
   void resolve(const std::vector<double>& references, std::vector<render::TaskSpec>& specs) const;

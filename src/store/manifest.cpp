@@ -336,7 +336,11 @@ json manifest_json(const Manifest& m, const CameraTableRef* table) {
   if (!m.time_units.empty()) j["time_units"] = m.time_units;
   if (!m.fields.empty()) {
     json fields = json::array();
-    for (const auto& f : m.fields) fields.push_back({{"name", f.name}, {"units", f.units}, {"references", f.references}});
+    for (const auto& f : m.fields) {
+      json e = {{"name", f.name}, {"units", f.units}, {"references", f.references}};
+      if (!f.reference_mode.empty()) e["reference_mode"] = f.reference_mode;
+      fields.push_back(std::move(e));
+    }
     j["fields"] = std::move(fields);
   }
   j["image"] = {{"width", m.image.width},
@@ -465,6 +469,10 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
       FieldInfo info;
       info.name = r.str(r.field(f, "name", at), at + ".name");
       info.units = r.opt_str(f, "units", at);
+      info.reference_mode = r.opt_str(f, "reference_mode", at);
+      if (!info.reference_mode.empty() && info.reference_mode != "snapshot" && info.reference_mode != "running" &&
+          info.reference_mode != "fixed")
+        r.fail(at + ".reference_mode", "\"" + info.reference_mode + "\"; expected \"snapshot\", \"running\" or \"fixed\"");
       if (const json* refs = r.optional(f, "references", at)) {
         r.array(*refs, at + ".references");
         info.references.reserve(refs->size());

@@ -112,6 +112,9 @@ struct FieldInfo {
   /// references[i]: the reference of frame i (a percentile of |field|, or its running maximum); may be
   /// shorter than the frames (not recorded), each finite and > 0.
   std::vector<double> references;
+  /// What the references follow (issue 41): "snapshot", "running" or "fixed"; empty in older
+  /// manifests (their references are per snapshot unless provenance says a running maximum).
+  std::string reference_mode;
   bool operator==(const FieldInfo&) const = default;
 };
 
