@@ -4,10 +4,12 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "app/command.hpp"
 #include "cinema/export.hpp"
+#include "player/legend_image.hpp"
 #include "store/database.hpp"
 
 namespace cmd_export_cinema {  // named, not anonymous: the unity build joins the command units
@@ -16,6 +18,7 @@ struct Args {
   std::string db, out, frames, format = "png";
   int quality = 95, threads = 0;
   bool overwrite = false;
+  bool legend = false;  // Cinema images are data (import-cinema reads them back): a legend only when asked
 };
 
 void run(const Args& a) {
@@ -26,6 +29,11 @@ void run(const Args& a) {
   o.jpeg_quality = a.quality;
   o.overwrite = a.overwrite;
   o.threads = a.threads;
+  std::optional<store::Manifest> manifest;
+  if (a.legend) {
+    manifest = store::Database::open(a.db).manifest();
+    o.decorate = [&manifest](Image& image, int, int task, int frame) { player::draw_legend(image, *manifest, task, frame); };
+  }
   const bool tty = ::isatty(STDERR_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
   const auto report = cinema::export_cinema(a.db, a.out, o, [&](std::int64_t done, std::int64_t total) {
@@ -56,6 +64,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--quality", args->quality, "JPEG quality 1..100")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--threads", args->threads, "Streams decoded in parallel (0 = all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing Cinema database in OUT");
+  sub->add_flag("--legend", args->legend,
+                "Draw each image's colour legend (the task's window in physical units at that frame, its scale mode) "
+                "into its bottom-left corner, as the players show it (default: off: the images stay the frames)");
   sub->callback([args] { run(*args); });
 });
 

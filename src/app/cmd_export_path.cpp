@@ -10,6 +10,7 @@
 #include "app/task_option.hpp"
 #include "core/error.hpp"
 #include "player/headless.hpp"
+#include "player/legend_image.hpp"
 #include "player/look.hpp"
 #include "video/movie_writer.hpp"
 
@@ -24,6 +25,7 @@ struct ExportArgs {
   bool paused = false;
   std::string view_size = "1280x720";
   double speed = 0;  // 0 = automatic (the players' short-run rule)
+  bool legend = true;  // the shown task's colour legend in the bottom-left corner, as the players show it
 };
 
 void run_export(const ExportArgs& a) {
@@ -67,6 +69,9 @@ void run_export(const ExportArgs& a) {
                                  f.look, view);
       image = std::move(view);
     }
+    // Issue 41: a preview shown outside Panoptes still says what its colours stand for (the legend of
+    // the shown task at the shown frame, with its scale line).
+    if (a.legend) player::draw_legend(image, manifest, f.shown.selection.task, f.shown.selection.frame);
     if (!writer)
       writer = std::make_unique<panoptes::video::MovieWriter>(a.out, image.width, image.height, settings);
     writer->append(image);
@@ -103,6 +108,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       ->capture_default_str();
   sub->add_option("--crf", args->crf, "x264 constant rate factor 0..51 (default: the database's)")
       ->check(CLI::Range(0, 51));
+  sub->add_flag("--legend,!--no-legend", args->legend,
+                "Draw the shown task's colour legend (window in physical units, scale mode) into the bottom-left "
+                "corner of each frame (default: on)");
   sub->callback([args] { run_export(*args); });
 });
 

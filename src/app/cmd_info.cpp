@@ -98,6 +98,11 @@ void run(const Args& a) {
     nlohmann::json axes = nlohmann::json::array();
     for (const auto& x : m.axes) axes.push_back({{"name", x.name}, {"values", x.values.size()}, {"units", x.units}});
     j["axes"] = axes;
+    nlohmann::json fields = nlohmann::json::array();
+    for (const auto& f : m.fields)
+      fields.push_back({{"name", f.name}, {"units", f.units}, {"reference_mode", f.reference_mode},
+                        {"references", f.references.size()}});
+    j["fields"] = fields;
     j["streams"] = db.stream_count();
     j["frames"] = m.frames_written;
     j["image"] = {{"width", m.image.width}, {"height", m.image.height},
@@ -130,6 +135,20 @@ void run(const Args& a) {
     for (std::size_t i = 0; i < m.axes.size(); ++i)
       std::printf("%s%s\n", i == 0 ? "axes       " : "           ", axis_summary(m.axes[i]).c_str());
     if (m.axes.empty()) std::printf("axes       none\n");
+    // Issue 41: what each field's colours are scaled by, so a reader knows whether brightness compares
+    // across frames.
+    for (std::size_t i = 0; i < m.fields.size(); ++i) {
+      const store::FieldInfo& f = m.fields[i];
+      std::string line = f.name + (f.units.empty() ? "" : " [" + f.units + "]");
+      if (!f.references.empty()) {
+        const auto [lo, hi] = std::minmax_element(f.references.begin(), f.references.end());
+        const std::string mode = f.reference_mode.empty() ? "not recorded" : f.reference_mode;
+        char range[96];
+        std::snprintf(range, sizeof range, "%.3g .. %.3g", *lo, *hi);
+        line += ": scale " + mode + ", reference " + range + (f.units.empty() ? "" : " " + f.units);
+      }
+      std::printf("%s%s\n", i == 0 ? "fields     " : "           ", line.c_str());
+    }
     if (m.frames_written > 0)
       std::printf("frames     %d (t = %g .. %g)\n", m.frames_written, m.frame_time(0), m.frame_time(m.frames_written - 1));
     else

@@ -197,7 +197,8 @@ ExportReport export_cinema(const fs::path& db_dir, const fs::path& out, const Ex
       const int c = int(s / tasks), t = int(s % tasks);
       const auto reader = db.stream(c, t);
       for (int f : frames) {
-        const Image img = reader->read_rgba(f);
+        Image img = reader->read_rgba(f);
+        if (o.decorate) o.decorate(img, c, t, f);
         const fs::path path = stage / rel_file(c, t, f);
         if (o.format == "png")
           write_png(path.string(), img);

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/image.hpp"
+
 namespace panoptes::cinema {
 
 /// Options of export_cinema.
@@ -16,6 +18,9 @@ struct ExportOptions {
   int jpeg_quality = 95;
   bool overwrite = false;       ///< replace an existing Cinema database (its data.csv and image/ tree)
   int threads = 0;              ///< streams decoded in parallel (0 = hardware concurrency)
+  /// Called on every image before it is written (e.g. to draw its colour legend: export-cinema
+  /// --legend); from several threads at once, so it must not share mutable state.
+  std::function<void(Image& image, int camera, int task, int frame)> decorate;
 };
 
 /// What export_cinema wrote.

@@ -85,8 +85,32 @@ std::string units_of(const store::Manifest& m, const std::string& field) {
   return f < 0 ? std::string() : m.fields[std::size_t(f)].units;
 }
 
-LegendBar window_bar(const store::Manifest& m, const std::string& field, const json& p, const char* window_key,
-                     const char* relative_key, const char* tf_key, int frame) {
+// What the references of `field` follow: the manifest's word, or for older manifests "running"
+// when the session kept its running maxima (it did so only in that mode), else "snapshot".
+std::string reference_mode(const store::Manifest& m, const std::string& field) {
+  const int f = m.find_field(field);
+  if (f < 0 || m.fields[std::size_t(f)].references.empty()) return "";
+  const std::string& mode = m.fields[std::size_t(f)].reference_mode;
+  if (!mode.empty()) return mode;
+  return m.provenance.extra.count("insitu.running_max") ? "running" : "snapshot";
+}
+
+// The reference a task's window of `field` multiplies at `frame`: the field's, or with a shared
+// scale the larger of the task's fields' (as TaskPlan::resolve).
+double task_reference(const store::Manifest& m, const std::vector<std::string>& fields, const std::string& field,
+                      bool shared, int frame) {
+  if (!shared) return reference(m, field, frame);
+  double r = 0;
+  for (const std::string& f : fields) {
+    const double v = reference(m, f, frame);
+    if (!(v > 0)) return 0;  // one unrecorded: the shared value is unknown
+    r = std::max(r, v);
+  }
+  return r;
+}
+
+LegendBar window_bar(const store::Manifest& m, const std::vector<std::string>& fields, const std::string& field,
+                     const json& p, const char* window_key, const char* relative_key, const char* tf_key, int frame) {
   LegendBar bar;
   bar.field = field;
   bar.units = units_of(m, field);
@@ -94,10 +118,16 @@ LegendBar window_bar(const store::Manifest& m, const std::string& field, const j
   bar.label = tf.is_object() && flag(tf, "absolute_value", false) ? "|" + field + "|" : field;
   number_pair(p, window_key, bar.lo, bar.hi);
   if (flag(p, relative_key, false)) {
-    const double ref = reference(m, field, frame);
+    bar.shared = fields.size() > 1 && p.contains("scale") && p["scale"] == "shared";
+    const double ref = task_reference(m, fields, field, bar.shared, frame);
     if (ref > 0) {
       bar.lo *= ref;
       bar.hi *= ref;
+      bar.scale = reference_mode(m, field);
+      if (frame > 0) {
+        const double before = task_reference(m, fields, field, bar.shared, frame - 1);
+        bar.change = before > 0 ? ref / before : 0;
+      }
     } else {
       bar.physical = false;
     }
@@ -116,9 +146,9 @@ std::vector<LegendBar> task_legend(const store::Manifest& m, int task, int frame
   if (!p.is_object() || t.fields.empty()) return bars;
   double lo = 0, hi = 0;
   if (number_pair(p, "window", lo, hi)) {
-    bars.push_back(window_bar(m, t.fields[0], p, "window", "relative", "transfer_function", frame));
+    bars.push_back(window_bar(m, t.fields, t.fields[0], p, "window", "relative", "transfer_function", frame));
     if (t.fields.size() > 1 && number_pair(p, "window2", lo, hi))
-      bars.push_back(window_bar(m, t.fields[1], p, "window2", "relative2", "transfer_function2", frame));
+      bars.push_back(window_bar(m, t.fields, t.fields[1], p, "window2", "relative2", "transfer_function2", frame));
   } else if (t.method == "isosurface" && p.contains("isovalue") && p["isovalue"].is_number()) {
     LegendBar bar;
     bar.field = bar.label = t.fields[0];
@@ -127,10 +157,16 @@ std::vector<LegendBar> task_legend(const store::Manifest& m, int task, int frame
     bar.lo = bar.hi = p["isovalue"].get<double>();
     if (flag(p, "relative", false)) {
       const double ref = reference(m, t.fields[0], frame);
-      if (ref > 0)
+      if (ref > 0) {
         bar.lo = bar.hi = bar.lo * ref;
-      else
+        bar.scale = reference_mode(m, t.fields[0]);
+        if (frame > 0) {
+          const double before = reference(m, t.fields[0], frame - 1);
+          bar.change = before > 0 ? ref / before : 0;
+        }
+      } else {
         bar.physical = false;
+      }
     }
     const auto c = p.find("colour");
     if (c != p.end() && c->is_array() && c->size() == 3 && std::all_of(c->begin(), c->end(), [](const json& x) { return x.is_number(); }))
@@ -154,6 +190,19 @@ std::string legend_range_text(const LegendBar& bar) {
   const std::string rel = bar.physical ? std::string() : " x reference";
   if (bar.isovalue) return "iso " + legend_number(bar.lo) + unit + rel;
   return legend_number(bar.lo) + " .. " + legend_number(bar.hi) + unit + rel;
+}
+
+std::string legend_scale_text(const LegendBar& bar, const std::string& shared_with) {
+  if (bar.scale.empty()) return "";
+  std::string s = bar.scale == "running" ? "running max" : bar.scale == "snapshot" ? "per snapshot" : bar.scale;
+  if (bar.shared) s += shared_with.empty() ? ", shared scale" : ", shared with " + shared_with;
+  // A change smaller than the legend's 3 digits is no change to the reader.
+  if (bar.change > 0 && std::abs(bar.change - 1) >= 0.005) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, ": x%.3g since the previous frame", bar.change);
+    s += buf;
+  }
+  return s;
 }
 
 std::string time_text(const store::Manifest& m, double time) {

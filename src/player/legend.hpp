@@ -31,6 +31,14 @@ struct LegendBar {
   /// kLegendSamples evenly spaced values from lo to hi; one entry for an isovalue; empty when the
   /// manifest does not record the transfer function (the bar then shows numbers only).
   std::vector<std::array<float, 3>> colours;
+  /// What the reference follows (issue 41): "running" (the largest so far: a colour keeps its value
+  /// along the movie), "snapshot" (each frame its own: brightness is not comparable across frames),
+  /// "fixed" (a physical value); empty for absolute windows and where nothing is recorded.
+  std::string scale;
+  /// A two-field picture whose fields share one reference (the larger of the two).
+  bool shared = false;
+  /// This frame's reference over the previous frame's (1 = the scale did not change; 0 = unknown).
+  double change = 1;
 };
 
 /// The bars of `task` at `frame` (two for a two-field volume, none for tasks without a window, e.g.
@@ -41,6 +49,9 @@ std::vector<LegendBar> task_legend(const store::Manifest& manifest, int task, in
 std::string legend_number(double value);
 /// "0 .. 2.41e-03 1/s", "0.2 .. 1 x reference" (not physical), "iso 0.015 1/s".
 std::string legend_range_text(const LegendBar& bar);
+/// What the scale follows and whether it just changed, e.g. "running max", "per snapshot: x2.3 since
+/// the previous frame", "fixed", "running max, shared with phi_s"; "" for an absolute window.
+std::string legend_scale_text(const LegendBar& bar, const std::string& shared_with = "");
 /// "t = 4.2 s" (time and the manifest's time unit; no unit when it has none).
 std::string time_text(const store::Manifest& manifest, double time);
 

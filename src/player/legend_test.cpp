@@ -12,7 +12,7 @@ namespace {
 store::Manifest seismic_like() {
   store::Manifest m;
   m.time_units = "s";
-  m.fields = {{"phi_p", "1/s", {0.5, 2.0}}, {"phi_s", "1/s", {4.0}}};
+  m.fields = {{"phi_p", "1/s", {0.5, 2.0}, ""}, {"phi_s", "1/s", {4.0}, ""}};
   const nlohmann::json pwave = {{"colour", {{0, 0.9, 0.35, 0.05}, {1, 1.0, 0.8, 0.4}}},
                                 {"extinction", {{0, 0}, {0.1, 0}, {1, 0.5}}},
                                 {"absolute_value", true}};
@@ -97,4 +97,39 @@ TEST(Legend, Numbers) {
   EXPECT_EQ(legend_number(120), "120");
   EXPECT_EQ(legend_number(2.4123e-4), "2.41e-04");
   EXPECT_EQ(legend_number(3e6), "3.00e+06");
+}
+
+// Issue 41: the legend says what the scale follows and, when the reference changed since the previous
+// frame, by what factor; a shared two-field scale uses the larger reference of the two fields.
+TEST(Legend, ScaleModeChangeAndSharedReference) {
+  store::Manifest m = seismic_like();
+  m.fields[0].reference_mode = "snapshot";
+  m.fields[1].references = {4.0, 4.0};
+  m.fields[1].reference_mode = "running";
+  auto p0 = task_legend(m, 0, 0)[0];
+  EXPECT_EQ(p0.scale, "snapshot");
+  EXPECT_EQ(legend_scale_text(p0), "per snapshot");
+  const auto p1 = task_legend(m, 0, 1)[0];
+  EXPECT_DOUBLE_EQ(p1.change, 4.0);
+  EXPECT_EQ(legend_scale_text(p1), "per snapshot: x4 since the previous frame");
+  // Shared: both bars of p+s multiply max(phi_p, phi_s) = 4 at frame 0.
+  m.tasks[1].parameters["scale"] = "shared";
+  const auto ps = task_legend(m, 1, 0);
+  ASSERT_EQ(ps.size(), 2u);
+  EXPECT_TRUE(ps[0].shared);
+  EXPECT_DOUBLE_EQ(ps[0].hi, 4.0);
+  EXPECT_DOUBLE_EQ(ps[1].hi, 2.0);  // window2 [0, 0.5] of the shared 4
+  EXPECT_EQ(legend_scale_text(ps[1], "phi_p"), "running max, shared with phi_p");
+  EXPECT_DOUBLE_EQ(task_legend(m, 1, 1)[0].change, 1.0);  // max(2, 4) = max(0.5, 4): no change
+  // Own scales: each its own reference.
+  m.tasks[1].parameters["scale"] = "own";
+  EXPECT_DOUBLE_EQ(task_legend(m, 1, 0)[0].hi, 0.5);
+  // Older manifests: no mode recorded; a running-maximum note means "running", else per snapshot.
+  m.fields[0].reference_mode.clear();
+  EXPECT_EQ(task_legend(m, 0, 0)[0].scale, "snapshot");
+  m.provenance.extra["insitu.running_max"] = "0.5 4";
+  EXPECT_EQ(task_legend(m, 0, 0)[0].scale, "running");
+  // Absolute windows have no scale to name.
+  m.tasks[0].parameters["relative"] = false;
+  EXPECT_EQ(legend_scale_text(task_legend(m, 0, 0)[0]), "");
 }

@@ -280,6 +280,18 @@ void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
     const float left = ImGui::GetStyle().WindowPadding.x;
     ImGui::SameLine(std::max(left + ImGui::CalcTextSize(lo.c_str()).x + 12, left + bar_w - hi_w));
     ImGui::TextUnformatted(hi.c_str());
+    // What the scale follows, and when it just changed by how much (issue 41): a frame that looks
+    // brighter because its window shrank says so instead of pulsing silently.
+    std::string other;
+    for (const player::LegendBar& o : bars)
+      if (&o != &bar) other = o.field;
+    const std::string scale = player::legend_scale_text(bar, other);
+    if (!scale.empty()) {
+      const bool changed = bar.change > 0 && std::abs(bar.change - 1) >= 0.005;
+      ImGui::PushStyleColor(ImGuiCol_Text, changed ? ImVec4(1, 0.78f, 0.3f, 1) : ImVec4(0.62f, 0.66f, 0.74f, 1));
+      ImGui::TextUnformatted(("scale: " + scale).c_str());
+      ImGui::PopStyleColor();
+    }
   }
   ImGui::End();
 }

@@ -51,7 +51,16 @@ nlohmann::json database_json(const store::Database& db, const DatabaseJsonOption
   j["tasks"] = std::move(tasks);
   j["time_units"] = m.time_units;
   json fields = json::array();
-  for (const auto& f : m.fields) fields.push_back({{"name", f.name}, {"units", f.units}, {"references", f.references}});
+  for (const auto& f : m.fields) {
+    json e = {{"name", f.name}, {"units", f.units}, {"references", f.references}};
+    // What the references follow (issue 41), resolved for older manifests as player::task_legend does:
+    // their session kept running maxima only in the running mode.
+    if (!f.references.empty())
+      e["reference_mode"] = !f.reference_mode.empty()                     ? f.reference_mode
+                            : m.provenance.extra.count("insitu.running_max") ? "running"
+                                                                             : "snapshot";
+    fields.push_back(std::move(e));
+  }
   j["fields"] = std::move(fields);
 
   const int n = m.camera_count();
