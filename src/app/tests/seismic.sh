@@ -90,6 +90,12 @@ grep -q "snapshots: 2 x {vz, phi_p, sxz, phi_s}" "$dir/out/report.txt"
 "$panoptes" render "$dir/out/snapshots/phi_p_*.npy" --rig fibonacci:2 --size 32x24 --out "$dir/db" > "$dir/render.txt"
 grep -q "2 cameras x 1 tasks = 2 streams, 2 frames of 32x24" "$dir/render.txt" \
   || { echo "render of snapshots: $(cat "$dir/render.txt")"; exit 1; }
+# ... oriented and labelled by their sidecars: z is depth, metres, seconds, phi_p in 1/s.
+/usr/bin/python3 -c '
+import json, sys
+m = json.load(open(sys.argv[1]))
+got = (m["domain"].get("up_axis"), m["domain"].get("units"), m.get("time_units"), [(f["name"], f["units"]) for f in m["fields"]])
+if got != ("z_down", "m", "s", [("phi_p", "1/s")]): sys.exit(f"render of snapshots: {got}")' "$dir/db/panoptes.json"
 # Errors: unknown key, wrong type, CFL violation, receiver outside; each one line, exit 1.
 expect_error() {
   local pattern=$1
