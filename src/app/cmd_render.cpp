@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <ctime>
 #include <exception>
+#include <filesystem>
 #include <algorithm>
 #include <memory>
 #include <optional>
@@ -148,8 +149,17 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
       globfree(&g);
       throw FileError(in, "the pattern matches no file");
     }
-    for (std::size_t i = 0; i < g.gl_pathc; ++i) files.push_back(g.gl_pathv[i]);  // sorted by glob()
+    std::vector<std::string> matched(g.gl_pathv, g.gl_pathv + g.gl_pathc);  // sorted by glob()
     globfree(&g);
+    // A pattern such as 'snapshots/phi_p_*' also matches the volumes' sidecars (phi_p_000020.json beside
+    // phi_p_000020.npy): they describe volumes, they are not volumes.
+    for (const std::string& m : matched) {
+      const std::filesystem::path p(m);
+      const bool sidecar = p.extension() == ".json" &&
+                           std::find(matched.begin(), matched.end(), std::filesystem::path(p).replace_extension(".npy").string()) !=
+                               matched.end();
+      if (!sidecar) files.push_back(m);
+    }
   }
   return files;
 }

@@ -95,6 +95,9 @@ render "$tmp/plain.npy" --out "$tmp/without"
 read -r top bottom < <(halves "$tmp/without")
 echo "without it (z up): light in the upper half $top, lower half $bottom"
 [ "$bottom" -gt $((4 * top)) ] || fail "without a sidecar (z up) the layer at z = 0 is not at the bottom: upper half $top, lower half $bottom"
+# A pattern that also matches the sidecar ('layer*': layer.npy, layer.json) renders the volume alone.
+"$panoptes" render "$tmp/layer*" --rig "file:$tmp/side.txt" --size 48x40 -q --out "$tmp/glob" > "$tmp/out.txt"
+grep -q "1 frames of 48x40" "$tmp/out.txt" || fail "pattern with the sidecar: $(cat "$tmp/out.txt")"
 # An option that agrees with the sidecar is accepted.
 render "$tmp/layer.npy" --up-axis z_down --spacing 1,1,1 --origin 0,0,0 --out "$tmp/agree"
 
