@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <ctime>
 #include <exception>
+#include <filesystem>
 #include <algorithm>
 #include <memory>
 #include <optional>
@@ -25,6 +26,7 @@
 
 #include "app/command.hpp"
 #include "app/render_grid.hpp"
+#include "app/series_sidecars.hpp"
 #include "app/volume_file.hpp"
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
@@ -62,7 +64,7 @@ struct Args {
   std::string title;
   int crf = -1;
   bool force = false;
-  std::string up_axis = "z_up";
+  std::string up_axis;  // "" = the volumes' sidecars say, or z_up
   std::string projection = "perspective";
   bool quiet = false;
   std::string grid_file;  // --grid: a non-uniform grid (app/render_grid.hpp)
@@ -149,8 +151,17 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
       globfree(&g);
       throw FileError(in, "the pattern matches no file");
     }
-    for (std::size_t i = 0; i < g.gl_pathc; ++i) files.push_back(g.gl_pathv[i]);  // sorted by glob()
+    std::vector<std::string> matched(g.gl_pathv, g.gl_pathv + g.gl_pathc);  // sorted by glob()
     globfree(&g);
+    // A pattern such as 'snapshots/phi_p_*' also matches the volumes' sidecars (phi_p_000020.json beside
+    // phi_p_000020.npy): they describe volumes, they are not volumes.
+    for (const std::string& m : matched) {
+      const std::filesystem::path p(m);
+      const bool sidecar = p.extension() == ".json" &&
+                           std::find(matched.begin(), matched.end(), std::filesystem::path(p).replace_extension(".npy").string()) !=
+                               matched.end();
+      if (!sidecar) files.push_back(m);
+    }
   }
   return files;
 }
@@ -176,7 +187,8 @@ void progress(bool tty, long long done, long long total, double elapsed) {
 }
 
 // The session configuration `render`'s options stand for (the grid comes from the first volume).
-insitu::SessionConfig session_config(const Args& a, const std::string& first_file, const std::string& command_line) {
+insitu::SessionConfig session_config(const Args& a, const std::string& first_file, const std::string& command_line,
+                                     const std::string& field = "volume") {
   const auto size = parse_dims_text(a.size, 2, 5);
   if (!size) throw Error("--size \"" + a.size + "\": expected WIDTHxHEIGHT, e.g. 920x896");
   insitu::SessionConfig cfg;
@@ -196,9 +208,9 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   cfg.command_line = command_line;
   cfg.rig = a.rig;
   (void)camera::RigSpec::parse(a.rig);  // a bad --rig is reported before any volume is read
-  cfg.up_axis = a.up_axis;
+  cfg.up_axis = a.up_axis.empty() ? "z_up" : a.up_axis;
   cfg.projection = a.projection;
-  cfg.tasks = insitu::tasks_from_shorthand(a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks, "volume");
+  cfg.tasks = insitu::tasks_from_shorthand(a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks, field);
   cfg.schedule.every_steps = 1;  // every volume is a snapshot
   if (a.crf > 51) throw Error("--crf " + std::to_string(a.crf) + ": expected an x264 quality 0..51");
   if (a.crf >= 0) cfg.video.crf = a.crf;
@@ -220,16 +232,55 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   return cfg;
 }
 
-void run(const Args& a, const std::string& command_line) {
-  if (a.print_tasks) {
+// What the volumes' sidecars say (issue 41) against the options: an option that contradicts a sidecar is
+// an error (which of the two is right cannot be told), an option the sidecars leave open is used. Returns
+// the options with the up axis resolved (the recorded command line shows the one rendered).
+Args resolve_with_sidecars(const Args& a, const app::SeriesSidecars& series) {
+  Args r = a;
+  if (!series.present()) {
+    if (r.up_axis.empty()) r.up_axis = "z_up";
+    return r;
+  }
+  const FieldSidecar& s = series.first();
+  if (!a.grid_file.empty())
+    throw FileError(series.paths.front(), "describes a volume on a uniform grid, but --grid \"" + a.grid_file +
+                                              "\" says the volumes hold the points of a non-uniform grid; leave out one of the two");
+  if (!a.up_axis.empty() && a.up_axis != s.up_axis)
+    throw FileError(series.paths.front(), "up_axis: \"" + s.up_axis + "\" contradicts --up-axis " + a.up_axis +
+                                              "; leave --up-axis out (the sidecar says which way is up) or correct the sidecar");
+  r.up_axis = s.up_axis;
+  auto check = [&](const std::string& option, const std::string& text, const std::string& key, const Vec3& recorded) {
+    if (text.empty()) return;
+    const auto v = parse_numbers(text, 3, option);
+    if (!app::series_detail::same(Vec3(v[0], v[1], v[2]), recorded))
+      throw FileError(series.paths.front(), key + ": " + app::series_detail::vec_text(recorded) + " contradicts " + option + " " +
+                                                text + "; leave " + option + " out (the sidecar gives it) or correct the sidecar");
+  };
+  check("--spacing", a.spacing, "spacing", s.spacing);
+  if (s.origin) check("--origin", a.origin, "origin", *s.origin);
+  return r;
+}
+
+void run(const Args& args) {
+  if (args.print_tasks) {
     for (const insitu::TaskConfig& t :
-         insitu::tasks_from_shorthand(a.tasks.empty() ? std::vector<std::string>{"volume:hot"} : a.tasks, "volume"))
+         insitu::tasks_from_shorthand(args.tasks.empty() ? std::vector<std::string>{"volume:hot"} : args.tasks, "volume"))
       std::printf("%s\n", insitu::task_table_toml(t).c_str());
     return;
   }
-  const std::vector<std::string> files = expand_inputs(a.inputs);
+  const std::vector<std::string> files = expand_inputs(args.inputs);
   if (files.empty()) throw Error("no input volume given");
-  insitu::SessionConfig cfg = session_config(a, files[0], command_line);
+  // Sidecars (<volume>.json beside a .npy, written by `panoptes seismic`): grid, units, time, up axis.
+  const app::SeriesSidecars series = app::read_series_sidecars(files);
+  const Args a = resolve_with_sidecars(args, series);
+  const std::string field = series.present() && !series.first().field.empty() ? series.first().field : "volume";
+  insitu::SessionConfig cfg = session_config(a, files[0], recorded_command_line(a), field);
+  if (series.present()) {
+    const FieldSidecar& s = series.first();
+    cfg.units = s.length_units;
+    if (series.times()) cfg.time_units = s.time_units;
+    if (!s.field_units.empty()) cfg.field_units[field] = s.field_units;
+  }
   if (!a.force) {
     // Reading a volume holds its bytes and its float values at once: refuse before, not with bad_alloc.
     MemoryEstimate read;
@@ -253,6 +304,11 @@ void run(const Args& a, const std::string& command_line) {
   // The first volume fixes the grid of the whole series.
   app::Volume first = source ? app::Volume{} : app::read_volume(files[0]);
   render::GridGeometry grid = adapter ? adapter->render_grid() : render::GridGeometry{first.dims, first.origin, first.spacing};
+  if (series.present()) {
+    app::check_volume_against_sidecar(files[0], first, series.first(), series.paths.front());
+    grid.spacing = series.first().spacing;
+    if (series.first().origin) grid.origin = *series.first().origin;
+  }
   if (!a.spacing.empty()) {
     const auto s = parse_numbers(a.spacing, 3, "--spacing");
     grid.spacing = {s[0], s[1], s[2]};
@@ -281,25 +337,29 @@ void run(const Args& a, const std::string& command_line) {
     session.set_frame_observer([&](int, int, int, const Image&) {
       progress(tty, ++done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     });
+  // Snapshot f at the time its sidecar records, or at time f.
+  const std::vector<double> times = series.times().value_or(std::vector<double>{});
+  auto time_of = [&](std::size_t f) { return times.empty() ? double(f) : times[f]; };
   for (std::size_t f = 0; f < files.size(); ++f) {
     if (adapter) {
       const std::vector<float> values = app::read_grid_volume(files[f], source->source);
       warn_if_not_finite(files[f], values);
       std::vector<insitu::FieldInput> patches;
       for (int p = 0; p < source->source.patches(); ++p)
-        patches.push_back({"volume", values.data() + p * source->source.points_per_patch(), insitu::ScalarType::f32, {0, 0, 0}});
-      session.snapshot(double(f), adapter->adapt(patches));
+        patches.push_back({field, values.data() + p * source->source.points_per_patch(), insitu::ScalarType::f32, {0, 0, 0}});
+      session.snapshot(time_of(f), adapter->adapt(patches));
       continue;
     }
     app::Volume vol = f == 0 ? std::move(first) : app::read_volume(files[f]);
     warn_if_not_finite(files[f], vol.values);
+    if (series.present()) app::check_volume_against_sidecar(files[f], vol, series.sidecars[f], series.paths[f]);
     if (vol.dims != grid.dims)
       throw FileError(files[f], "volume of " + std::to_string(vol.dims[0]) + "x" + std::to_string(vol.dims[1]) + "x" +
                                     std::to_string(vol.dims[2]) + " points; expected " + std::to_string(grid.dims[0]) + "x" +
                                     std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " like " + files[0]);
-    // Snapshot f at time f; a stop request (SIGINT/SIGTERM) throws Interrupted before the next one and
-    // the database keeps the snapshots taken, marked interrupted.
-    session.snapshot(double(f), {{"volume", vol.values.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+    // A stop request (SIGINT/SIGTERM) throws Interrupted before the next snapshot and the database keeps
+    // the snapshots taken, marked interrupted.
+    session.snapshot(time_of(f), {{field, vol.values.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }
   if (const int sig = stop_requested()) {
     if (tty) std::fprintf(stderr, "\n");
@@ -320,7 +380,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       "render",
       "Render a volume (or a time series of volumes) from every camera of a rig for every task into a movie "
       "database. Inputs: NumPy .npy (3-D float32/float64; C order = shape (nz, ny, nx)) or VTK legacy "
-      "STRUCTURED_POINTS .vtk (ASCII or BINARY); several files or a quoted glob make a time series.");
+      "STRUCTURED_POINTS .vtk (ASCII or BINARY); several files or a quoted glob make a time series. A .npy's sidecar "
+      "(the same name with .json, as `panoptes seismic` writes: grid, units, time, up axis) is read when present.");
   sub->add_option("VOLUME", args->inputs, "Volume file(s) or glob pattern(s), one frame each, in order (required)");
   sub->add_option("--rig", args->rig,
                   "Camera rig: yinyang[:NTxNP], latlon[:NLATxNLON[+poles]], fibonacci[:N], file:PATH; "
@@ -357,8 +418,10 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                   "With --reference fixed: the reference in the field's units (relative windows are multiples of it)");
   sub->add_flag("--print-tasks", args->print_tasks,
                 "Print the TOML [[task]] tables the --task options stand for (as `panoptes run` reads them) and exit");
-  sub->add_option("--spacing", args->spacing, "Grid spacing sx,sy,sz (default: from the file, or 1,1,1)");
-  sub->add_option("--origin", args->origin, "Grid origin x,y,z (default: from the file, or 0,0,0)");
+  sub->add_option("--spacing", args->spacing,
+                  "Grid spacing sx,sy,sz (default: from the file or its sidecar, or 1,1,1; must agree with a sidecar)");
+  sub->add_option("--origin", args->origin,
+                  "Grid origin x,y,z (default: from the file or its sidecar, or 0,0,0; must agree with a sidecar)");
   sub->add_option("--grid", args->grid_file,
                   "TOML file of a non-uniform grid: [grid] kind = rectilinear (x, y, z) | spherical | yinyang (r, theta, "
                   "phi), each key a 1-D .npy of coordinates (relative to the file), optional points (longest axis of "
@@ -372,9 +435,9 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
   sub->add_option("--up-axis", args->up_axis,
                   "Which way is up in the volume: z_up, or z_down (z is depth, as in seismology); the rig's poles, "
-                  "latitudes, the images' up and the player's Up key follow it")
-      ->check(CLI::IsMember({"z_up", "z_down"}))
-      ->capture_default_str();
+                  "latitudes, the images' up and the player's Up key follow it. Default: what the volumes' sidecars "
+                  "say (an error if they say otherwise), else z_up")
+      ->check(CLI::IsMember({"z_up", "z_down"}));
   sub->add_option("--projection", args->projection,
                   "perspective, or equirectangular: 360x180-degree frames (use a 2:1 --size, e.g. 1920x960) that the "
                   "player looks around in; no outline box is drawn then")
@@ -385,7 +448,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
     install_stop_handlers();
     if (!args->print_tasks && args->inputs.empty()) throw Error("render: VOLUME is required (a volume file or a glob)");
     if (!args->print_tasks && args->out.empty()) throw Error("render: --out is required (the database directory)");
-    run(*args, recorded_command_line(*args));
+    run(*args);
   });
 });
 

@@ -1,5 +1,6 @@
 // `panoptes seismic CONFIG.toml`: runs the seismic solver alone (also under mpirun), writes one CSV
-// seismogram per receiver and a run report.
+// seismogram per receiver, a run report and optional field snapshots (.npy, each with a .json sidecar
+// of its grid, units, time and up axis: core/field_sidecar.hpp).
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -11,8 +12,10 @@
 #include "app/command.hpp"
 #include "app/mpi_scope.hpp"
 #include "core/error.hpp"
+#include "core/field_sidecar.hpp"
 #include "seismic/config_toml.hpp"
 #include "seismic/medium.hpp"
+#include "seismic/snapshot.hpp"
 #include "seismic/solver.hpp"
 
 #ifdef PANOPTES_HAVE_MPI
@@ -44,10 +47,14 @@ double write_snapshots(panoptes::seismic::Solver& solver, const panoptes::seismi
     const std::vector<float> data = solver.gather_field(name);
     std::string err;
     if (solver.rank() == 0) {
-      char file[64];
-      std::snprintf(file, sizeof file, "%s_%06d.npy", name.c_str(), step);
+      char stem[64];
+      std::snprintf(stem, sizeof stem, "%s_%06d", name.c_str(), step);
+      const std::string base = rc.output_dir + "/snapshots/" + stem;
       try {
-        panoptes::seismic::write_npy(rc.output_dir + "/snapshots/" + file, data, g.nx, g.ny, g.nz);
+        panoptes::seismic::write_npy(base + ".npy", data, g.nx, g.ny, g.nz);
+        // Its grid, units, time and up axis (z is depth), so `panoptes render` shows it right side up.
+        panoptes::write_field_sidecar(base + ".json", panoptes::seismic::snapshot_sidecar(name, g, step, solver.dt(),
+                                                                                           std::string(stem) + ".npy"));
       } catch (const std::exception& e) {
         err = e.what();
       }
@@ -124,7 +131,7 @@ void run(const std::string& config_path, const std::string& output_override, boo
   if (snapshots) {
     r << "snapshots: " << snapshot_count << " x {";
     for (std::size_t i = 0; i < rc.snapshot_fields.size(); ++i) r << (i ? ", " : "") << rc.snapshot_fields[i];
-    r << "} -> " << rc.output_dir << "/snapshots/<field>_<step>.npy (" << snapshot_seconds
+    r << "} -> " << rc.output_dir << "/snapshots/<field>_<step>.npy + .json sidecar (" << snapshot_seconds
       << " s, not in the wall time above)\n";
   }
   const std::string report = rc.output_dir + "/report.txt";

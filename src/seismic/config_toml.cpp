@@ -335,7 +335,9 @@ Unknown keys and wrong types are errors.
                 float32 of the GLOBAL grid, shape (nz, ny, nx), x fastest, to
                 <output>/snapshots/<field>_<step>.npy (step = steps done, 6 digits). Fields: vx, vy,
                 vz (m/s), sxx, syy, szz, sxy, sxz, syz (Pa), phi_p = div v, phi_s = |curl v| (1/s);
-                each field at its own staggered points, indexed like the nodes (see docs/seismic.md)
+                each field at its own staggered points, indexed like the nodes (see docs/seismic.md),
+                each with a sidecar <field>_<step>.json (grid, origin, spacing, units, time, up_axis
+                "z_down") that `panoptes render` reads, so the free surface is on top of its pictures
                 snapshot_every (steps, default 0 = only after the last step)
 )";
 }

@@ -60,7 +60,29 @@ for f in $snaps; do
     || { echo "bad .npy header in $f.npy: $(head -c 100 "$npy" | tr -d '\0')"; exit 1; }
   test "$(stat -c %s "$npy")" -eq $((128 + 20 * 24 * 24 * 4)) || { echo "bad size of $f.npy"; exit 1; }
 done
-test "$(ls "$dir/out/snapshots" | wc -l)" -eq 8
+# Each beside its sidecar (issue 41): grid (each field at its own staggered points), units, time, z down.
+test "$(ls "$dir/out/snapshots" | wc -l)" -eq 16
+/usr/bin/python3 - "$dir/out/snapshots" "$dir/out/report.txt" <<'EOF'
+import json, re, sys
+snaps, report = sys.argv[1], open(sys.argv[2]).read()
+dt = float(re.search(r"^dt: (\S+) s", report, re.M).group(1))
+want = {"vz": ("m/s", [0, 0, 25.0], -0.5), "phi_p": ("1/s", [0, 0, 0], -0.5), "sxz": ("Pa", [25.0, 0, 25.0], 0.0),
+        "phi_s": ("1/s", [0, 0, 0], -0.5)}
+for field, (units, origin, shift) in want.items():
+    for step in (20, 40):
+        name = f"{field}_{step:06d}"
+        s = json.load(open(f"{snaps}/{name}.json"))
+        got = {k: s.get(k) for k in ("format", "version", "data", "field", "field_units", "dims", "origin", "spacing",
+                                     "length_units", "up_axis", "time_units", "step")}
+        exp = {"format": "panoptes field sidecar", "version": 1, "data": name + ".npy", "field": field, "field_units": units,
+               "dims": [24, 24, 20], "origin": origin, "spacing": [50.0, 50.0, 50.0], "length_units": "m",
+               "up_axis": "z_down", "time_units": "s", "step": step}
+        if got != exp:
+            sys.exit(f"{name}.json: {got}, expected {exp}")
+        # velocities and phi at (step - 1/2) dt, stresses at step dt (dt as the report prints it: 6 digits)
+        if abs(s["time"] - (step + shift) * dt) > 1e-5 * step * dt:
+            sys.exit(f"{name}.json: time {s['time']}, expected {(step + shift) * dt}")
+EOF
 # The wave has reached the grid: the last vz snapshot is not all zeros.
 test "$(tail -c $((20 * 24 * 24 * 4)) "$dir/out/snapshots/vz_000040.npy" | tr -d '\0' | wc -c)" -gt 0
 grep -q "snapshots: 2 x {vz, phi_p, sxz, phi_s}" "$dir/out/report.txt"
@@ -68,6 +90,12 @@ grep -q "snapshots: 2 x {vz, phi_p, sxz, phi_s}" "$dir/out/report.txt"
 "$panoptes" render "$dir/out/snapshots/phi_p_*.npy" --rig fibonacci:2 --size 32x24 --out "$dir/db" > "$dir/render.txt"
 grep -q "2 cameras x 1 tasks = 2 streams, 2 frames of 32x24" "$dir/render.txt" \
   || { echo "render of snapshots: $(cat "$dir/render.txt")"; exit 1; }
+# ... oriented and labelled by their sidecars: z is depth, metres, seconds, phi_p in 1/s.
+/usr/bin/python3 -c '
+import json, sys
+m = json.load(open(sys.argv[1]))
+got = (m["domain"].get("up_axis"), m["domain"].get("units"), m.get("time_units"), [(f["name"], f["units"]) for f in m["fields"]])
+if got != ("z_down", "m", "s", [("phi_p", "1/s")]): sys.exit(f"render of snapshots: {got}")' "$dir/db/panoptes.json"
 # Errors: unknown key, wrong type, CFL violation, receiver outside; each one line, exit 1.
 expect_error() {
   local pattern=$1
@@ -90,6 +118,7 @@ if command -v mpiexec >/dev/null && "$panoptes" version >/dev/null; then
     cmp "$dir/out/top.csv" "$dir/out2/top.csv" || { echo "2 ranks differ from 1"; exit 1; }
     for f in $snaps; do
       cmp "$dir/out/snapshots/$f.npy" "$dir/out2/snapshots/$f.npy" || { echo "2-rank snapshot $f differs"; exit 1; }
+      cmp "$dir/out/snapshots/$f.json" "$dir/out2/snapshots/$f.json" || { echo "2-rank sidecar $f differs"; exit 1; }
     done
   else
     echo "mpiexec run failed"; exit 1
