@@ -96,41 +96,39 @@ percentile = 0.999     # and phi without the surface sheet (2026-11-25): PSNR me
 adaptive = true        # 3-4 px per voxel: interpolate smooth cells of every 4th pixel's rays; frames within
                        # 65.6 dB (min) of marching every pixel, the thin gaps kept (docs/rendering.md, Round 4)
 
-# Windows are relative: multiples of this snapshot's 99.9th percentile of |phi_p| (|phi_s|). Chosen by
-# looking at the frames of 6 cameras at steps 120-480 (docs/ui.md, 2026-11-25). Since the solver computes
-# phi at the free surface with its own surface strains (docs/seismic.md), the surface plane no longer
-# holds a one-voxel sheet 2-6x the interior's phi_p that set the percentile (the former windows p [0, 0.2],
-# p+s [0, 0.2] / [0, 1.5] compensated for it and now saturate the box: 98 % orange at mid-run); the body
-# p fronts are now near the top of a [0, 1] window.
+# Windows are relative: multiples of the running maximum of the 99.9th percentile of |phi_p| (|phi_s|),
+# the default [render] reference = "running" (issue 41): the scale never shrinks, so a colour keeps its
+# value in 1/s along the movie and the waves darken as they spread (the legend shows the window in 1/s).
+# Per snapshot (the former default) camera 0's p-wave movie brightened by +70 % at frame 20 while the
+# field weakened. The references peak near the source at frame 5 (phi_p 1.5e-4, phi_s 6.4e-4 1/s) and the
+# waves fall to about 0.1 of that by the end, so the windows end at 0.15 of the reference: the near-source
+# frames saturate, the rings stay readable to the last frame.
 [[task]]               # first: the paper's two-colour picture is what the player opens on
 name = "p+s"
 type = "volume2"
 fields = ["phi_p", "phi_s"]
 preset = "p-wave"
 preset2 = "s-wave"
-# Both [0, 1]: orange p rings ahead of and between the green s rings; orange share of the coloured pixels
-# 19 / 45 / 49 / 39 % at steps 120 / 240 / 360 / 480 (6 cameras; before the fix, with [0, 0.2] / [0, 1.5]:
-# 50 / 36 / 92 / 52 %, the 92 % being the surface sheet saturating the box). [0, 1] / [0, 1.5]: 63 % at
-# mid-run, the green thinner.
-window = [0.0, 1.0]
-window2 = [0.0, 1.0]
+# Both fields are in 1/s, so they share one reference, the larger (phi_s's: 2-5x phi_p's; [render]
+# share_scale = "units"): a weak field stays dark (an explosion shows orange p and no green, where each
+# field on its own scale showed an all-green picture). p's window is a third of s's, the ratio of the
+# two in this source, so both ring families show; the legend gives both windows in 1/s.
+window = [0.0, 0.05]
+window2 = [0.0, 0.15]
 
 [[task]]
 name = "p-wave"
 type = "volume"
 field = "phi_p"
 preset = "p-wave"
-window = [0.0, 1.0]
+window = [0.0, 0.15]
 
 [[task]]
 name = "s-wave"
 type = "volume"
 field = "phi_s"
 preset = "s-wave"
-# The free surface doubles the s waves' curl there (1.4-1.7x the interior's max, physical), so the
-# percentile is up to 1.3x the former one; 0.75 keeps the s volume as full as before (154-171 k vs
-# 172-192 k coloured pixels at steps 240 and 480).
-window = [0.0, 0.75]
+window = [0.0, 0.15]
 )TOML";
 
 // The demo's measured run time, stated once: the configuration's "# Measured: ..." comment line
