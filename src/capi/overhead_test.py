@@ -120,8 +120,14 @@ def main():
         sum_without = sum_with = sum_line = 0.0
         for attempt in range(1, ATTEMPTS + 1):
             t0 = time.monotonic()
-            without, _ = run(sim, workdir, mpiexec, ranks, "off")
-            with_viz, stderr = run(sim, workdir, mpiexec, ranks, "on")
+            # Alternate the order, so that a machine getting busier or quieter during the test does
+            # not favour one side of the pooled sums.
+            if attempt % 2:
+                without, _ = run(sim, workdir, mpiexec, ranks, "off")
+                with_viz, stderr = run(sim, workdir, mpiexec, ranks, "on")
+            else:
+                with_viz, stderr = run(sim, workdir, mpiexec, ranks, "on")
+                without, _ = run(sim, workdir, mpiexec, ranks, "off")
             line = reported_ratio(stderr, ranks)
             sum_without += without
             sum_with += with_viz
