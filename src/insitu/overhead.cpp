@@ -1,14 +1,12 @@
 #include "insitu/overhead.hpp"
 
 #include <dirent.h>
-#include <sys/resource.h>
 #include <sys/syscall.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -50,8 +48,7 @@ double thread_cpu_seconds(int tid) {
 
 double process_cpu_seconds() {
   // The scheduler's CPU time of every thread of the process, exited ones included: the sum getrusage
-  // (RUSAGE_SELF) splits into user and system time, and what wait4 and `time` report for the process;
-  // read in ~1 us where getrusage takes ~2.
+  // (RUSAGE_SELF) splits into user and system time, and what wait4 and `time` report for the process.
   timespec t{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);

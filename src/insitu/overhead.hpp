@@ -8,23 +8,26 @@
 // batch system's accounting prints, is CPU time; the line says that.
 //
 // Attribution (per process, i.e. per MPI rank):
-//   * Panoptes: the process CPU (getrusage RUSAGE_SELF: user + system of all threads, also of threads
-//     that have exited) accrued while a session call runs (construction, snapshot, finalize), plus the
-//     CPU that threads Panoptes started consume between its calls (encoder threads, thread pools).
-//     A thread is Panoptes' when it first appears during one of its calls and is not a member of the
-//     OpenMP team (found with /proc/self/task and a per-thread CPU clock; without /proc, only the first
-//     part is counted).
+//   * Panoptes: the process CPU (user + system of all threads, also of threads that have exited) accrued
+//     while a call runs (the session's construction, snapshot, finalize; the C API brackets every call
+//     on its handle), plus the CPU that threads Panoptes started consume between its calls (encoder
+//     threads, thread pools). A thread is Panoptes' when it first appears during one of its calls that
+//     did work and is not a member of the OpenMP team (found with /proc/self/task and read with a
+//     per-thread CPU clock; without /proc, only the first part is counted).
 //   * The simulation: the rest of the process CPU since the process started (its setup and MPI_Init
 //     included), as `time` would count the code without Panoptes.
 //   * OpenMP threads belong to whoever runs them at the moment: the team is shared (Panoptes' parallel
-//     loops reuse the simulation's threads, or the simulation later reuses the team Panoptes' first
-//     loop created), so its CPU during a Panoptes call is Panoptes' — also a simulation thread that spins
+//     loops reuse the simulation's threads, or the simulation later reuses the team Panoptes' first loop
+//     created), so its CPU during a Panoptes call is Panoptes' — also a simulation thread that spins
 //     waiting (OMP_WAIT_POLICY, GOMP_SPINCOUNT) while Panoptes runs, which is CPU Panoptes' call caused —
-//     and outside the calls it is the simulation's, including the spin of the team's threads after
-//     Panoptes' last parallel loop of a call (libgomp: up to GOMP_SPINCOUNT iterations, a few ms; with
-//     OMP_WAIT_POLICY=active a code without OpenMP of its own would see them spin until the next call).
+//     and outside the calls it is the simulation's. The team's spin after Panoptes' last parallel loop
+//     of a call (libgomp: GOMP_SPINCOUNT iterations, a few ms) is made to fall inside the call: a call
+//     that did work returns once the team sleeps (settle_team). With OMP_WAIT_POLICY=active the team
+//     never sleeps and is not waited for: a code without OpenMP of its own then has Panoptes' team
+//     spinning between calls counted as its own.
 //   * Other threads of the simulation that run during a Panoptes call (an I/O or communication thread
 //     of its own) are counted as Panoptes'; a code that keeps such threads busy over-reads the ratio.
+//     The simulation's loops running slower after a snapshot (caches Panoptes evicted) count as its own.
 #include <cmath>
 #include <cstdint>
 #include <string>
