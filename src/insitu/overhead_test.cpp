@@ -5,6 +5,8 @@
 #include <time.h>
 
 #include <atomic>
+#include <cstdlib>
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -91,6 +93,25 @@ TEST(OverheadMeter, SimulationThreadsAndTheOpenMPTeamAreNotAdopted) {
   EXPECT_LT(m.read().visualization_cpu_s - before, 0.05);
   quit = true;
   simulation_thread.join();
+}
+
+TEST(OverheadMeter, TheTeamsSpinAfterPanoptesLastLoopIsPanoptes) {
+  // libgomp keeps the team spinning a few ms after a loop; after Panoptes' last loop of a call that
+  // spin must not land in the simulation's share (a code without OpenMP loops would not have it).
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  if (policy && std::string(policy) == "active") GTEST_SKIP() << "OMP_WAIT_POLICY=active: the team never sleeps";
+  if (omp_get_max_threads() < 2) GTEST_SKIP() << "a team of one thread does not spin";
+  OverheadMeter m;
+  for (int call = 0; call < 5; ++call) {
+    {
+      OverheadMeter::Scope scope(m);
+#pragma omp parallel
+      burn(0.005);
+    }
+    const RankOverhead before = m.read();
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));  // the "simulation" sleeps
+    EXPECT_LT(m.read().simulation_cpu_s - before.simulation_cpu_s, 0.0015) << "call " << call;
+  }
 }
 
 TEST(OverheadReport, OneRankStatesCpuAgainstTheSimulationsCpu) {
