@@ -42,8 +42,8 @@ struct panoptes_session {
   std::unique_ptr<insitu::GridAdapter> adapter;
   bool finalized = false;  // the overhead report is printed by the first panoptes_finalize only
   // Counts every call on this handle as Panoptes' CPU time, not only the session's own: binding fields,
-  // the grid adapter's resampling and the schedule check of panoptes_process run before the session's
-  // calls (each step, ~0.02 CPU-s over capi.overhead_vs_os's 2400 steps). Shared with the session.
+  // the grid adapter's resampling and the schedule check of panoptes_process run outside the session's
+  // calls, and codes make them every step. Shared with the session (nested calls count once).
   std::shared_ptr<insitu::OverheadMeter> meter = std::make_shared<insitu::OverheadMeter>();
 };
 
