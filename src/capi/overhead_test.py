@@ -9,8 +9,10 @@ time (user + system, all its threads) from wait4's rusage, as `time` does. So
 
 and the line panoptes_finalize printed (one rank: its ratio; several: "all ranks together") must be
 within 10 % of it. CPU time of a fixed workload varies on a busy machine (the code's own CPU by 5-10 %
-from run to run at load 8 on the 2-core test machine: caches, the other engineers' compilers, MPI
-start-up), which the ratio amplifies; so a pair that misses is run again, up to four times, and each
+from run to run at load 8-10 on the shared 2-core VM, and in bursts up to 2x: the host's other work,
+the other engineers' compilers, MPI start-up), which the ratio amplifies, while the line's own ratio
+stays within a few % (it divides two CPU times of one run); so a pair that misses is run again, up to
+four times, and each
 time the pairs so far are also pooled (true overhead of the summed CPU times against the mean of the
 lines), which averages the noise out where one pair alone would not.
 
