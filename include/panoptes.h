@@ -113,8 +113,8 @@ int panoptes_due(panoptes_session* s, long long step, double time, int* due);
 /** Renders and stores a snapshot now, whatever the schedule (a forced snapshot). */
 int panoptes_snapshot(panoptes_session* s, double time);
 /** Closes all movies and marks the database complete (collective). The first call prints, on rank 0 to
- * stderr, the in-situ overhead: visualization time as a multiple of the simulation time (the wall time
- * outside the library's calls since panoptes_create), per rank. */
+ * stderr, the in-situ overhead: the visualization's CPU time (all threads, inside the library's calls and
+ * of its own threads) as a multiple of the rest of the process's CPU time, per rank. */
 int panoptes_finalize(panoptes_session* s);
 /** Frees the session (without finalize the database is left interrupted, its snapshots playable). */
 void panoptes_destroy(panoptes_session* s);

@@ -41,6 +41,10 @@ struct panoptes_session {
   std::map<int, PatchState> other_patches;
   std::unique_ptr<insitu::GridAdapter> adapter;
   bool finalized = false;  // the overhead report is printed by the first panoptes_finalize only
+  // Counts every call on this handle as Panoptes' CPU time, not only the session's own: binding fields,
+  // the grid adapter's resampling and the schedule check of panoptes_process run outside the session's
+  // calls, and codes make them every step. Shared with the session (nested calls count once).
+  std::shared_ptr<insitu::OverheadMeter> meter = std::make_shared<insitu::OverheadMeter>();
 };
 
 namespace {
@@ -100,6 +104,8 @@ void report(const panoptes_session* s, const std::string& message) {
 template <class F>
 int guarded(const panoptes_session* s, F&& f) {
   int code = PANOPTES_OK;
+  std::optional<insitu::OverheadMeter::Scope> counted;
+  if (s && s->meter) counted.emplace(*s->meter);
   try {
     f();
     g_error.clear();
@@ -154,9 +160,10 @@ insitu::Session& session_of(panoptes_session* s) {
     if (s->source) {
       s->config.source_grid = s->source->summary();
       s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample, comm);
-      s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block(), comm);
+      s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block(), comm,
+                                                     s->meter);
     } else {
-      s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, comm);
+      s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, comm, s->meter);
     }
     return *s->session;
   }
@@ -164,9 +171,10 @@ insitu::Session& session_of(panoptes_session* s) {
   if (s->source) {
     s->config.source_grid = s->source->summary();
     s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample);
-    s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block());
+    s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block(),
+                                                   s->meter);
   } else {
-    s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block);
+    s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, s->meter);
   }
   return *s->session;
 }
@@ -267,6 +275,7 @@ int panoptes_create(const char* config, int config_is_file, int fortran_comm, pa
     need(config && out, "panoptes_create: null config or output pointer");
     *out = nullptr;
     auto s = std::make_unique<panoptes_session>();
+    insitu::OverheadMeter::Scope counted(*s->meter);  // reading the configuration is Panoptes' too
     s->fortran_comm = fortran_comm;
 #ifdef PANOPTES_HAVE_MPI
     int init = 0;

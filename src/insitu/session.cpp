@@ -117,11 +117,10 @@ struct Session::Impl {
   int batch_n = 0;
   std::int64_t frames_encoded = 0;
   Timings time;
-  // The in-situ overhead: wall time inside the session's calls on this rank (construction,
-  // snapshots, finalize) against the time since construction began; the rest is the simulation's.
-  Clock::time_point created = Clock::now();
-  std::optional<Clock::time_point> finished;  // set by finalize: the run's end for the report
-  double inside = 0;
+  // The in-situ overhead: CPU time of the process (all threads) inside the session's calls on this
+  // rank (construction, snapshots, finalize) and of Panoptes' own threads between them, against the
+  // rest of the process's CPU time (overhead.hpp says how threads are attributed).
+  std::shared_ptr<OverheadMeter> meter;
 
   int owner(int camera) const { return camera % size; }
   const BlockInfo& me() const { return blocks[std::size_t(rank)]; }
@@ -598,8 +597,11 @@ void Session::Impl::checkpoint(double t) {
   time.checkpoint += since(t0);
 }
 
-Session::Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block)
+Session::Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block,
+                 std::shared_ptr<OverheadMeter> meter)
     : impl_(std::make_unique<Impl>()) {
+  impl_->meter = meter ? std::move(meter) : std::make_shared<OverheadMeter>();
+  OverheadMeter::Scope counted(*impl_->meter);
   impl_->cfg = config;
   impl_->grid = grid;
   impl_->block = block;
@@ -611,12 +613,14 @@ Session::Session(const SessionConfig& config, const render::GridGeometry& grid, 
   }
 #endif
   impl_->init();
-  impl_->inside += since(impl_->created);
 }
 
 #ifdef PANOPTES_HAVE_MPI
-Session::Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm)
+Session::Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm,
+                 std::shared_ptr<OverheadMeter> meter)
     : impl_(std::make_unique<Impl>()) {
+  impl_->meter = meter ? std::move(meter) : std::make_shared<OverheadMeter>();
+  OverheadMeter::Scope counted(*impl_->meter);
   impl_->cfg = config;
   impl_->grid = grid;
   impl_->block = block;
@@ -624,7 +628,6 @@ Session::Session(const SessionConfig& config, const render::GridGeometry& grid, 
   MPI_Comm_rank(impl_->comm, &impl_->rank);
   MPI_Comm_size(impl_->comm, &impl_->size);
   impl_->init();
-  impl_->inside += since(impl_->created);
 }
 #endif
 
@@ -649,12 +652,7 @@ bool Session::due(std::int64_t step, double time) const {
 
 void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   Impl& m = *impl_;
-  const auto entered = Clock::now();
-  struct Inside {  // counts the call's wall time, also when it throws
-    Impl& m;
-    Clock::time_point t;
-    ~Inside() { m.inside += since(t); }
-  } inside{m, entered};
+  OverheadMeter::Scope counted(*m.meter);  // also when it throws
   if (m.finalized) throw Error("snapshot: the session is finalized");
   // [output] mode = "resume": a restarted run repeats the steps since its checkpoint; what the
   // database already holds is not written twice (the same time on every rank: the same decision).
@@ -710,21 +708,22 @@ void Session::finalize() {
   Impl& m = *impl_;
   if (m.finalized) return;
   m.finalized = true;
-  const auto entered = Clock::now();
-  int frames = INT_MAX;
-  if (m.writer && !m.owned.empty()) {
-    m.writer->flush();
-    frames = m.writer->complete_frames();
-  }
+  {
+    OverheadMeter::Scope counted(*m.meter);
+    int frames = INT_MAX;
+    if (m.writer && !m.owned.empty()) {
+      m.writer->flush();
+      frames = m.writer->complete_frames();
+    }
 #ifdef PANOPTES_HAVE_MPI
-  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, m.comm);
+    if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, m.comm);
 #endif
-  if (m.rank != 0 && m.writer) m.writer->finalize();
-  m.barrier();
-  if (m.rank == 0) m.writer->finalize(frames == INT_MAX ? m.snapshots : frames);
-  m.barrier();
-  m.inside += since(entered);
-  m.finished = Clock::now();
+    if (m.rank != 0 && m.writer) m.writer->finalize();
+    m.barrier();
+    if (m.rank == 0) m.writer->finalize(frames == INT_MAX ? m.snapshots : frames);
+    m.barrier();
+  }
+  m.meter->stop();  // the run's end for the report
 }
 
 void Session::set_frame_observer(FrameObserver observer) { impl_->observer = std::move(observer); }
@@ -756,63 +755,31 @@ SessionStats Session::stats() const {
   s.partial_buffer_bytes += std::int64_t(m.recv_buf.capacity());
   s.peak_rss_bytes = peak_rss();
   s.time = m.time;
-  s.session_seconds = m.inside;
-  s.elapsed_seconds = std::chrono::duration<double>(m.finished.value_or(Clock::now()) - m.created).count();
+  const RankOverhead o = m.meter->read();
+  s.session_seconds = o.visualization_wall_s;
+  s.elapsed_seconds = o.elapsed_wall_s;
+  s.visualization_cpu_seconds = o.visualization_cpu_s;
+  s.simulation_cpu_seconds = o.simulation_cpu_s;
   return s;
 }
 
 std::vector<RankOverhead> Session::overhead() const {
-  const SessionStats mine = stats();
-  std::vector<double> all{mine.session_seconds, mine.elapsed_seconds};
+  RankOverhead mine = impl_->meter->read();
+  mine.rank = impl_->rank;
+  constexpr int kValues = 4;
+  const double values[kValues] = {mine.visualization_cpu_s, mine.simulation_cpu_s, mine.visualization_wall_s,
+                                  mine.elapsed_wall_s};
+  std::vector<double> all(values, values + kValues);
 #ifdef PANOPTES_HAVE_MPI
   const Impl& m = *impl_;
   if (m.size > 1) {
-    all.resize(2 * std::size_t(m.size));
-    const double two[2] = {mine.session_seconds, mine.elapsed_seconds};
-    MPI_Allgather(two, 2, MPI_DOUBLE, all.data(), 2, MPI_DOUBLE, m.comm);
+    all.resize(kValues * std::size_t(m.size));
+    MPI_Allgather(values, kValues, MPI_DOUBLE, all.data(), kValues, MPI_DOUBLE, m.comm);
   }
 #endif
   std::vector<RankOverhead> out;
-  for (std::size_t r = 0; r + 1 < all.size(); r += 2)
-    out.push_back({int(r / 2), all[r], std::max(0.0, all[r + 1] - all[r])});
-  return out;
-}
-
-std::string overhead_report(const std::vector<RankOverhead>& ranks) {
-  if (ranks.empty()) return "";
-  std::vector<double> x;
-  for (const RankOverhead& r : ranks) x.push_back(r.multiple());
-  std::vector<double> sorted = x;
-  std::sort(sorted.begin(), sorted.end());
-  char buf[512];
-  auto times = [](double v) {
-    char b[64];
-    if (!std::isfinite(v)) return std::string("n/a (no simulation time)");
-    std::snprintf(b, sizeof b, "%.2fx", v);
-    return std::string(b);
-  };
-  std::string out;
-  if (ranks.size() == 1) {
-    std::snprintf(buf, sizeof buf,
-                  "in-situ overhead: visualization took %s the simulation time (visualization %.1f s, simulation "
-                  "%.1f s)\n",
-                  times(x[0]).c_str(), ranks[0].visualization_s, ranks[0].simulation_s);
-    return buf;
-  }
-  const std::size_t n = sorted.size();
-  const double median = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-  std::snprintf(buf, sizeof buf,
-                "in-situ overhead: visualization time / simulation time per rank: min %s, median %s, max %s over %zu "
-                "ranks\n",
-                times(sorted.front()).c_str(), times(median).c_str(), times(sorted.back()).c_str(), n);
-  out = buf;
-  // Every rank when they fit on a screen; otherwise the extremes are in the line above.
-  if (ranks.size() <= 16)
-    for (const RankOverhead& r : ranks) {
-      std::snprintf(buf, sizeof buf, "  rank %3d: visualization %8.1f s, simulation %8.1f s -> %s\n", r.rank,
-                    r.visualization_s, r.simulation_s, times(r.multiple()).c_str());
-      out += buf;
-    }
+  for (std::size_t r = 0; r + kValues <= all.size(); r += kValues)
+    out.push_back({int(r / kValues), all[r], all[r + 1], all[r + 2], all[r + 3]});
   return out;
 }
 

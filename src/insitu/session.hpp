@@ -22,6 +22,7 @@
 
 #include "core/image.hpp"
 #include "insitu/config.hpp"
+#include "insitu/overhead.hpp"
 #include "render/field_view.hpp"
 
 #ifdef PANOPTES_HAVE_MPI
@@ -89,21 +90,9 @@ struct SessionStats {
   Timings time;
   double session_seconds = 0;  ///< wall time inside the session's calls (construction, snapshots, finalize)
   double elapsed_seconds = 0;  ///< wall time from construction to finalize (or to now)
+  double visualization_cpu_seconds = 0;  ///< process CPU (all threads) spent by Panoptes (overhead.hpp)
+  double simulation_cpu_seconds = 0;     ///< the rest of the process CPU since the process started
 };
-
-/// One rank's in-situ overhead: wall time spent visualizing (inside the session's calls) and the rest
-/// of the run since the session was created (the simulation's time, as the session sees it).
-struct RankOverhead {
-  int rank = 0;
-  double visualization_s = 0;
-  double simulation_s = 0;
-  /// Visualization time as a multiple of simulation time (+inf without simulation time).
-  double multiple() const { return simulation_s > 0 ? visualization_s / simulation_s : INFINITY; }
-};
-
-/// The end-of-run lines printed by `panoptes run` and the C API: visualization time as a multiple of
-/// simulation time, one line for one rank; min / median / max and (up to 16 ranks) a row per rank.
-std::string overhead_report(const std::vector<RankOverhead>& ranks);
 
 /// A running in-situ visualization. Not copyable; all public calls except the accessors are
 /// collective over the communicator and must be made by every rank in the same order.
@@ -113,10 +102,14 @@ class Session {
   /// the rig, the navigation graph and the task list, and creates, replaces or resumes the database as
   /// [output] mode says (rank 0 first, then the other ranks for the movies of the cameras they own;
   /// resume: snapshots() starts at the number the database holds). Single process.
-  Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block);
+  /// `meter`: the overhead meter to count the session's calls on; a caller that does Panoptes' work
+  /// around them (the C API: grid adapters, field bindings) passes its own and brackets its calls with it.
+  Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block,
+          std::shared_ptr<OverheadMeter> meter = nullptr);
 #ifdef PANOPTES_HAVE_MPI
   /// On communicator `comm` (duplicated internally). Every rank passes the same config and grid.
-  Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm);
+  Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm,
+          std::shared_ptr<OverheadMeter> meter = nullptr);
 #endif
   ~Session();
   Session(const Session&) = delete;
@@ -152,7 +145,8 @@ class Session {
   SessionStats stats() const;
   /// The element-wise maximum over ranks of the per-rank times, and sums of the counters (collective).
   SessionStats reduced_stats() const;
-  /// Every rank's in-situ overhead, in rank order (collective; call after finalize() for the whole run).
+  /// Every rank's in-situ overhead (CPU time as the OS counts it, overhead.hpp), in rank order
+  /// (collective; call after finalize() for the whole run).
   std::vector<RankOverhead> overhead() const;
 
  private:
