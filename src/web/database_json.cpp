@@ -5,6 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "player/legend.hpp"
+#include "player/value_readout.hpp"
+
 namespace panoptes::web {
 
 nlohmann::json database_json(const store::Database& db, const DatabaseJsonOptions& options) {
@@ -41,12 +44,24 @@ nlohmann::json database_json(const store::Database& db, const DatabaseJsonOption
   for (const auto& a : m.axes) axes.push_back({{"name", a.name}, {"values", a.values}, {"units", a.units}});
   j["axes"] = std::move(axes);
   json tasks = json::array();
-  for (const auto& t : m.tasks) {
+  for (int ti = 0; ti < m.task_count(); ++ti) {
+    const auto& t = m.tasks[std::size_t(ti)];
     json positions = json::array();
     for (const auto& p : t.axes) positions.push_back({{"axis", p.axis}, {"index", p.index}});
     // fields and parameters carry what the colour legend shows (window, transfer function; issue 34).
-    tasks.push_back({{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)},
-                     {"fields", t.fields}, {"parameters", t.parameters}});
+    json task = {{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)},
+                 {"fields", t.fields}, {"parameters", t.parameters}};
+    // The legend's colours as the task draws them (player::drawn_colours: a slice opaque, a volume as a
+    // thin layer over black), so the browser shows the desktop's colours without a second rule (issue 41).
+    json drawn = json::object();
+    for (const char* key : {"transfer_function", "transfer_function2"}) {
+      const auto colours = player::drawn_colours(t, key, player::kLegendSamples);
+      if (!colours.empty()) drawn[key] = colours;
+    }
+    if (!drawn.empty()) task["drawn_colours"] = std::move(drawn);
+    // A slice's colour table and plane for the value under the cursor (player/value_readout.hpp).
+    if (json readout = player::slice_readout_json(m, ti); !readout.is_null()) task["readout"] = std::move(readout);
+    tasks.push_back(std::move(task));
   }
   j["tasks"] = std::move(tasks);
   j["time_units"] = m.time_units;
