@@ -10,7 +10,6 @@
 #include <deque>
 #include <mutex>
 #include <thread>
-#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -256,7 +255,8 @@ class WindowApp {
   int mouse_x_ = 0, mouse_y_ = 0;
   bool mouse_in_ = false;
   player::SliceReadout readout_;
-  std::tuple<int, int, const store::Manifest*> readout_key_{-1, -1, nullptr};
+  int readout_task_ = -1, readout_frame_ = -1;
+  std::shared_ptr<const store::Manifest> readout_manifest_;  // held: no other manifest can take its address
   std::string readout_text_;
   // Look-around in 360° streams (issue 14): the view (kept by the shared key dispatch, which walks and
   // changes the field of view as every front end does), and the mesh that draws it on the GPU.
@@ -518,10 +518,9 @@ void WindowApp::draw_value_readout(const player::ShownFrame& shown) {
   const int x = int(std::floor(fx)), y = int(std::floor(fy));
   const video::YuvFrame& f = *shown_frame_;
   if (x < 0 || y < 0 || x >= f.width || y >= f.height) return;
-  const std::tuple<int, int, const store::Manifest*> key{sel.task, sel.frame, &m};
-  if (key != readout_key_) {
+  if (sel.task != readout_task_ || sel.frame != readout_frame_ || readout_manifest_ != live_manifest_) {
     readout_ = player::slice_readout(m, sel.task, sel.frame);
-    readout_key_ = key;
+    readout_task_ = sel.task, readout_frame_ = sel.frame, readout_manifest_ = live_manifest_;
   }
   if (!readout_.usable) return;
   const auto reading = player::read_pixel(m, readout_, sel.camera, x, y, player::rgb_at(f, x, y));
