@@ -525,7 +525,10 @@ void WindowApp::draw_value_readout(const player::ShownFrame& shown) {
   if (!readout_.usable) return;
   const auto reading = player::read_pixel(m, readout_, sel.camera, x, y, player::rgb_at(f, x, y));
   readout_text_ = player::reading_text(readout_, reading);
-  ImGui::SetNextWindowPos(ImVec2(float(mouse_x_) + 16, float(mouse_y_) + 16), ImGuiCond_Always);
+  // Beside the pointer, on the side with room (right and below, else left / above).
+  const bool left = mouse_x_ > win_w_ * 0.55, up = mouse_y_ > win_h_ * 0.8;
+  ImGui::SetNextWindowPos(ImVec2(float(mouse_x_) + (left ? -16.f : 16.f), float(mouse_y_) + (up ? -16.f : 16.f)),
+                          ImGuiCond_Always, ImVec2(left ? 1.f : 0.f, up ? 1.f : 0.f));
   ImGui::SetNextWindowBgAlpha(0.75f);
   constexpr ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                                      ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoSavedSettings |

@@ -577,8 +577,11 @@ function updateReadout() {
   if (!S.readout) return;
   readoutEl.textContent = S.readout.text;
   readoutEl.classList.toggle("none", S.readout.kind === "none");
-  readoutEl.style.left = `${hover.px + 16}px`;
-  readoutEl.style.top = `${hover.py + 16}px`;
+  // Beside the pointer, on the side with room (right and below, else left / above), as the desktop.
+  const st = canvas.parentElement.getBoundingClientRect(), left = hover.px > st.width * 0.55, up = hover.py > st.height * 0.8;
+  readoutEl.style.left = `${hover.px + (left ? -16 : 16)}px`;
+  readoutEl.style.top = `${hover.py + (up ? -16 : 16)}px`;
+  readoutEl.style.transform = `translate(${left ? "-100%" : "0"}, ${up ? "-100%" : "0"})`;
 }
 canvas.addEventListener("pointermove", (e) => {
   const r = canvas.getBoundingClientRect(), st = canvas.parentElement.getBoundingClientRect();
