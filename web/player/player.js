@@ -543,7 +543,7 @@ function updateHud(frame) {
   if (text !== lastHud) hud.textContent = lastHud = text;  // a DOM write per display frame costs a layout
   // The legend changes with the task and, for relative windows, with the frame's reference.
   const bars = taskLegend(db, S.task, frame), legendKey = JSON.stringify(bars);
-  if (legendKey !== lastLegend) { drawLegend(legendCanvas, bars); lastLegend = legendKey; }
+  if (legendKey !== lastLegend) { drawLegend(legendCanvas, bars); lastLegend = legendKey; S.legend = bars; }
   if (statusLine.textContent !== S.message) statusLine.textContent = S.message;
   updateReadout();
 }
@@ -998,6 +998,7 @@ async function main() {
       if (next.frames !== S.db.frames) {
         S.db.frames = next.frames;
         S.db.times = next.times;
+        S.db.fields = next.fields;  // the new frames' references: the legend and the readout scale by them
         for (const s of streams.values()) s.close();
         streams.clear();
         document.getElementById("title").textContent =

@@ -27,6 +27,8 @@ export function installTestApi(p) {
     /// The value readout beside the pointer (slice tasks), null when none; readoutAt(x, y) reads frame
     /// pixel (x, y) of the shown frame as a hover there would.
     readout: () => S.readout ?? null,
+    /// The legend's bars as last drawn ({label, units, lo, hi, colours, ...}; [] when none).
+    legend: () => S.legend ?? [],
     readoutAt: (x, y) => p.readoutAt(x, y),
     pause: () => setPlaying(false),
     shown: () => S.shown,
