@@ -195,9 +195,10 @@ std::array<int, 3> rgb_at(const video::YuvFrame& f, int x, int y) {
 json slice_readout_json(const store::Manifest& m, int task) {
   const SliceReadout r = slice_readout(m, task, 0);
   if (!r.usable) return nullptr;
-  json colours = json::array();
+  json colours = json::array(), u = json::array();
   for (const auto& c : r.table.colours) colours.push_back({c[0], c[1], c[2]});
-  json j = {{"colours", std::move(colours)}, {"u", r.table.u},  {"axis", r.axis},
+  for (const double x : r.table.u) u.push_back(std::round(x * 1e6) / 1e6);  // 1/1000 of a bin
+  json j = {{"colours", std::move(colours)}, {"u", std::move(u)},  {"axis", r.axis},
             {"position", r.position},        {"max_distance", kReadoutMaxDistance},
             {"margin", kReadoutMargin},      {"max_spread", kReadoutMaxSpread},
             {"centroid_band", kReadoutCentroidBand}, {"uncertainty_steps", kReadoutUncertaintySteps}};

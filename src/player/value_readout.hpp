@@ -97,10 +97,11 @@ std::string reading_text(const SliceReadout& readout, const ValueReading& readin
 /// the chroma sample covering the pixel). Throws panoptes::Error naming the pixel when it is outside.
 std::array<int, 3> rgb_at(const video::YuvFrame& frame, int x, int y);
 
-/// The table, plane and rule of a slice task as the web player reads them (database.json's
-/// tasks[i].readout): {"colours": [[r, g, b], ...], "u": [...], "axis", "position", "box_lo", "box_hi",
-/// "max_distance", "margin", "max_spread", "centroid_band", "uncertainty_steps"}; null for tasks without a readout. Frame-independent: the
-/// player scales u by the frame's window, as for the legend.
+/// The table, plane and rule of a slice task as the web player reads them: {"colours": [[r, g, b], ...],
+/// "u": [...] (to 1e-6), "axis", "position", "box_lo", "box_hi", "max_distance", "margin", "max_spread",
+/// "centroid_band", "uncertainty_steps"}; null for tasks without a readout. Frame-independent: the
+/// player scales u by the frame's window, as for the legend. (database.json moves colours and u into
+/// a shared readout_tables entry that the task's "table" names.)
 nlohmann::json slice_readout_json(const store::Manifest& manifest, int task);
 
 }  // namespace panoptes::player

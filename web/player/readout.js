@@ -1,6 +1,6 @@
 // The value under the cursor of a slice task (issue 41), as the desktop window shows it. The colour
-// table, the slice's plane and the rule's thresholds come from database.json (tasks[i].readout, written
-// by src/player/value_readout.cpp's slice_readout_json); this file only searches them, line for line as
+// table, the slice's plane and the rule's thresholds come from database.json (tasks[i].readout and the
+// readout_tables entry it names, written from src/player/value_readout.cpp's slice_readout_json); this file only searches them, line for line as
 // read_colour() and pixel_on_slice() there, and scales by the frame's window as the legend does.
 import { taskLegend, legendNumber } from "./legend.js";
 
@@ -12,7 +12,9 @@ export function readColour(db, t, frame, rgb) {
   const task = db.tasks[t], R = task && task.readout;
   const bar = R && taskLegend(db, t, frame)[0];
   if (!R || !bar || bar.isovalue) return null;
-  const cs = R.colours, u = R.u;
+  const T = db.readout_tables && db.readout_tables[R.table];  // shared by tasks with the same map
+  if (!T) return null;
+  const cs = T.colours, u = T.u;
   const resolution = Math.abs(bar.hi - bar.lo) / cs.length;
   let best = 0, dbest = dist(cs[0], rgb);
   for (let i = 1; i < cs.length; i++) { const d = dist(cs[i], rgb); if (d < dbest) { dbest = d; best = i; } }
