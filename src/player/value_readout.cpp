@@ -61,6 +61,9 @@ SliceReadout slice_readout(const store::Manifest& m, int task, int frame) {
     r.table.u.push_back(u);
     u_sum = u, run = 1;
   }
+  r.usable = std::isfinite(r.lo) && std::isfinite(r.hi) && r.hi != r.lo && !r.table.colours.empty();
+  // The plane, for telling pixels off the slice by geometry; without it (a task that does not record
+  // it, a manifest without the domain) the colour alone decides.
   const json& p = t.parameters;
   const auto axis = p.find("axis");
   const auto position = p.find("position");
@@ -70,13 +73,12 @@ SliceReadout slice_readout(const store::Manifest& m, int task, int frame) {
   r.axis = a[0] - 'x';
   r.position = position->get<double>();
   const auto& d = m.domain;
-  if (d.dims[0] >= 2 && d.dims[1] >= 2 && d.dims[2] >= 2) {
+  if (std::isfinite(r.position) && d.dims[0] >= 2 && d.dims[1] >= 2 && d.dims[2] >= 2) {
     r.have_box = true;
     r.box_lo = d.origin;
     r.box_hi = {d.origin.x + double(d.dims[0] - 1) * d.spacing.x, d.origin.y + double(d.dims[1] - 1) * d.spacing.y,
                 d.origin.z + double(d.dims[2] - 1) * d.spacing.z};
   }
-  r.usable = std::isfinite(r.lo) && std::isfinite(r.hi) && r.hi != r.lo && !r.table.colours.empty();
   return r;
 }
 

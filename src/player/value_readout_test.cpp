@@ -235,6 +235,11 @@ TEST(ValueReadout, BoundsAmbiguityAndText) {
   const SliceReadout l = slice_readout(m, 1, 0);
   EXPECT_EQ(read_colour(l, {100, 100, 100}).reason, "ambiguous colour");
   EXPECT_FALSE(slice_readout(m, 2, 0).usable) << "volumes have no readout";
+  store::TaskEntry bare = t;  // no plane recorded (e.g. an imported database): the colour alone decides
+  bare.parameters.erase("axis");
+  m.tasks.push_back(bare);
+  EXPECT_TRUE(slice_readout(m, 3, 0).usable);
+  EXPECT_EQ(read_pixel(m, slice_readout(m, 3, 0), 0, 0, 0, {128, 128, 128}).kind, ValueReading::Kind::value);
   EXPECT_FALSE(slice_readout(m, 7, 0).usable);
   EXPECT_TRUE(slice_readout_json(m, 2).is_null());
   const auto j = slice_readout_json(m, 0);
