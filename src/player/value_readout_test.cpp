@@ -162,7 +162,7 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
   EXPECT_GT(r.table.colours.size(), 300u);
   video::YuvFrame f;
   db.stream(0, 0)->read(frame, f);
-  std::vector<double> err, edge_err;
+  std::vector<double> err, edge_err, colour_distance;
   int on = 0, read = 0, bounds = 0, no_reading_on = 0, off = 0, off_read = 0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
@@ -188,11 +188,14 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
       }
       ++read;
       (interior ? err : edge_err).push_back(std::abs(v.value - t.value) / res);
+      if (interior) colour_distance.push_back(v.colour_distance);
     }
   const double p50 = quantile(err, 0.5), p95 = quantile(err, 0.95), mx = quantile(err, 1.0);
   std::printf("readout error / resolution over %zu interior pixels: median %.2f, p95 %.2f, max %.2f; %zu edge pixels: "
               "median %.2f, max %.2f\n", err.size(), p50, p95, mx, edge_err.size(), quantile(edge_err, 0.5),
               quantile(edge_err, 1.0));
+  std::printf("interior pixels' distance to the nearest map colour (levels): median %.2f, p99 %.2f, max %.2f\n",
+              quantile(colour_distance, 0.5), quantile(colour_distance, 0.99), quantile(colour_distance, 1.0));
   std::printf("on the slice %d pixels: %d values, %d bounds, %d interior without a reading; off it %d pixels, %d read\n",
               on, read, bounds, no_reading_on, off, off_read);
   EXPECT_EQ(off_read, 0) << "a pixel off the slice gave a value";
