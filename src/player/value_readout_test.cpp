@@ -164,6 +164,7 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
   db.stream(0, 0)->read(frame, f);
   std::vector<double> err, edge_err, colour_distance;
   int on = 0, read = 0, bounds = 0, no_reading_on = 0, off = 0, off_read = 0;
+  double bound_steps = 0;  // how far inside the window the true value of a pixel read as a bound lay
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
       const Truth t = truth(m, x, y, kAmplitude[frame]);
@@ -181,6 +182,7 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
       }
       if (v.kind != ValueReading::Kind::value) {
         ++bounds;
+        bound_steps = std::max(bound_steps, v.kind == ValueReading::Kind::below ? (t.value - r.lo) / res : (r.hi - t.value) / res);
         // A bound says the value is at or beyond the window's end: true within the worst error.
         if (interior) EXPECT_TRUE(v.kind == ValueReading::Kind::below ? t.value <= r.lo + 16 * res : t.value >= r.hi - 16 * res)
             << "pixel (" << x << ", " << y << ") true " << t.value;
@@ -196,8 +198,9 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
               quantile(edge_err, 1.0));
   std::printf("interior pixels' distance to the nearest map colour (levels): median %.2f, p99 %.2f, max %.2f\n",
               quantile(colour_distance, 0.5), quantile(colour_distance, 0.99), quantile(colour_distance, 1.0));
-  std::printf("on the slice %d pixels: %d values, %d bounds, %d interior without a reading; off it %d pixels, %d read\n",
-              on, read, bounds, no_reading_on, off, off_read);
+  std::printf("on the slice %d pixels: %d values, %d bounds (true values at most %.1f steps inside the window), %d "
+              "interior without a reading; off it %d pixels, %d read\n",
+              on, read, bounds, bound_steps, no_reading_on, off, off_read);
   EXPECT_EQ(off_read, 0) << "a pixel off the slice gave a value";
   EXPECT_LE(no_reading_on, on / 100) << "interior slice pixels without a reading";
   EXPECT_GT(err.size(), 10000u);
