@@ -29,7 +29,17 @@ with open(f"{out}/camera.txt", "w") as c:
 PY
 "$panoptes" render "$tmp/f_0.npy" "$tmp/f_1.npy" --rig "$tmp/camera.txt" --task slice:z:0.5 --size 256x192 \
   --no-outline -q --out "$tmp/db"
-. "$here/serve_db.sh"  # serve_db DB LOG
-url=$(serve_db "$tmp/db" "$tmp/serve.log")
+# Started here, not through serve_db.sh's function: called as url=$(serve_db ...) it records the
+# server's pid in a subshell, and the cleanup above never stops it.
+: > "$tmp/serve.log"
+"$panoptes" serve "$tmp/db" --port 0 --quiet > "$tmp/serve.log" 2>&1 &
+pids+=($!)
+url=""
+for _ in $(seq 100); do
+  url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$tmp/serve.log")
+  [ -n "$url" ] && break
+  sleep 0.1
+done
+[ -n "$url" ] || { echo "serve did not start:"; cat "$tmp/serve.log"; exit 1; }
 export NODE_PATH=$node_modules
 node "$here/legend_test.mjs" "$url" "$chromium" "$node_modules" "$shots"
