@@ -113,7 +113,12 @@ nlohmann::json to_json(const Statistics& st) {
 // ------------------------------------------------------------------------------------------------
 
 struct Engine::Impl {
-  store::Database db;
+  // The database as opened; the workers read it and it is never modified (refresh() needs no locks).
+  std::shared_ptr<const store::Database> opened;
+  const store::Database& db;
+  // The database as last re-read by refresh() (the opened one until then, not a copy): the display
+  // thread's view of what is recorded per frame.
+  std::shared_ptr<const store::Database> live;
   EngineOptions options;
   TimeSource now;
   int cameras = 0, tasks = 0, frames = 0;
@@ -176,7 +181,9 @@ struct Engine::Impl {
   bool has_view_hint = false;
 
   Impl(store::Database database, EngineOptions opts)
-      : db(std::move(database)),
+      : opened(std::make_shared<const store::Database>(std::move(database))),
+        db(*opened),
+        live(opened),
         options(std::move(opts)),
         pool(db, std::max(1, options.reader_pool_capacity)),
         cache(options.cache_bytes ? options.cache_bytes : default_cache_bytes()) {}
@@ -574,6 +581,9 @@ Engine& Engine::operator=(Engine&& other) noexcept {
 
 const store::Database& Engine::database() const { return impl_->db; }
 const store::Manifest& Engine::manifest() const { return impl_->db.manifest(); }
+std::shared_ptr<const store::Manifest> Engine::live_manifest() const {
+  return {impl_->live, &impl_->live->manifest()};  // aliasing: keeps that Database alive
+}
 const EngineOptions& Engine::options() const { return impl_->options; }
 int Engine::frame_count() const { return impl_->frames; }
 double Engine::fps() const { return impl_->fps; }
@@ -583,7 +593,8 @@ store::Status Engine::status() const { return impl_->db_status; }
 int Engine::refresh() {
   Impl& m = *impl_;
   // A fresh Database object: the one the workers use is never modified (no locking needed).
-  const store::Database fresh = store::Database::open(m.db.dir());
+  auto fresh_ptr = std::make_shared<const store::Database>(store::Database::open(m.db.dir()));
+  const store::Database& fresh = *fresh_ptr;
   const auto& a = m.db.manifest();
   const auto& b = fresh.manifest();
   if (b.camera_count() != a.camera_count() || b.task_count() != a.task_count() || !(b.graph == a.graph) ||
@@ -592,6 +603,7 @@ int Engine::refresh() {
                 "movie pattern) since it was opened; open it again");
   m.db_status = fresh.status();
   m.times = b.times;
+  m.live = std::move(fresh_ptr);
   if (fresh.frame_count() > 0 && fresh.frame_count() != m.frames) {
     m.frames = fresh.frame_count();
     m.scheduled_valid = false;

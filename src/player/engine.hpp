@@ -182,8 +182,14 @@ class Engine {
   /// and times (cameras, tasks and graph must be unchanged), and forgets streams that were missing so
   /// they are tried again. Returns the new frame_count(). Throws FileError/Error if the manifest cannot
   /// be read or the database's shape changed; the engine is unchanged then. manifest() keeps the
-  /// manifest read at construction (its frames_written/times are not updated).
+  /// manifest read at construction (its frames_written/times are not updated); live_manifest() is the
+  /// one read now.
   int refresh();
+  /// The manifest as of construction or the last refresh(): what is recorded per frame (times, the
+  /// fields' references that legends and value readouts scale by) for the frames that appeared since
+  /// the database was opened. Shares the shape of manifest() (refresh() refuses a changed shape). The
+  /// pointer stays valid however often the engine refreshes afterwards.
+  std::shared_ptr<const store::Manifest> live_manifest() const;
   /// Effective status of the database at construction or the last refresh().
   store::Status status() const;
   /// Playback rate at speed ×1: the manifest's playback_fps if set, else its video fps.

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/frame_stamp.hpp"
+#include "player/legend.hpp"
 #include "player/test_db.hpp"
 
 namespace panoptes::player {
@@ -475,6 +476,56 @@ TEST(LiveDb, RefreshTakesOverNewCheckpoints) {
   w.finalize();
   e.refresh();
   EXPECT_EQ(e.status(), store::Status::complete);
+}
+
+// Issue 41.3: a window opened while the run is still writing (scripts/demo with a display) kept frame 0's
+// reference: at frame 9 the legend read 0..6.90e-07 where that frame recorded 1.13e-04. The manifest the
+// front ends read per frame (live_manifest) must follow the database as it grows, and after a seek.
+TEST(LiveDb, TheLegendFollowsTheReferencesOfFramesWrittenAfterOpening) {
+  TempDir dir("player-live-legend");
+  auto m = testing::ring_manifest(2, 1);
+  m.fields = {{"phi_p", "1/s", {}}};
+  m.tasks[0].method = "slice";
+  m.tasks[0].fields = {"phi_p"};
+  m.tasks[0].parameters = {{"window", {-1.0, 1.0}}, {"relative", true}};
+  auto w = store::DatabaseWriter::create(dir.path, m, true);
+  const auto reference = [](int f) { return 6.9e-7 * std::pow(2.0, f); };  // grows as a wave front does
+  const auto write = [&](int from, int to) {
+    for (int f = from; f < to; ++f) {
+      for (int c = 0; c < 2; ++c) w.append(c, 0, testing::stamped_frame(c, 0, f, 64, 64));
+      w.set_field_reference(f, 0, reference(f));
+    }
+    w.checkpoint();
+  };
+  write(0, 1);
+  VirtualClock clock;
+  EngineOptions o;
+  o.time_source = clock.source();
+  o.start_playing = false;
+  Engine e(dir.path, o);
+  ASSERT_EQ(e.frame_count(), 1);
+  write(1, 10);
+  clock.advance(2 * o.refresh_seconds);
+  e.tick();  // a running database is re-read on the playback clock
+  ASSERT_EQ(e.frame_count(), 10);
+  for (const int f : {9, 4}) {
+    e.seek(f);
+    ASSERT_EQ(e.selection().frame, f);
+    const auto bars = task_legend(*e.live_manifest(), 0, e.selection().frame);
+    ASSERT_EQ(bars.size(), 1u);
+    EXPECT_DOUBLE_EQ(bars[0].hi, reference(f)) << "frame " << f << ": " << legend_range_text(bars[0]);
+    EXPECT_DOUBLE_EQ(bars[0].lo, -reference(f));
+  }
+  // A pointer taken before a refresh stays valid (the HUD holds one for the frame it draws).
+  const auto held = e.live_manifest();
+  write(10, 12);
+  clock.advance(2 * o.refresh_seconds);
+  e.tick();
+  EXPECT_EQ(e.frame_count(), 12);
+  EXPECT_EQ(held->fields[0].references.size(), 10u);
+  EXPECT_EQ(e.live_manifest()->fields[0].references.size(), 12u);
+  EXPECT_EQ(e.manifest().fields[0].references.size(), 1u) << "manifest() stays the one read at opening";
+  w.finalize();
 }
 
 TEST(LiveDb, TickRefreshesARunningDatabase) {

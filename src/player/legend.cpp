@@ -42,19 +42,11 @@ bool lookup(const json& points, double u, std::array<double, N>& out) {
   return true;
 }
 
-std::vector<std::array<float, 3>> sample_colours(const json& tf) {
-  std::vector<std::array<float, 3>> out;
-  if (!tf.is_object() || !tf.contains("colour") || !tf.contains("extinction")) return out;
-  for (int i = 0; i < kLegendSamples; ++i) {
-    const double u = double(i) / (kLegendSamples - 1);
-    std::array<double, 3> rgb{};
-    std::array<double, 1> sigma{};
-    if (!lookup(tf["colour"], u, rgb) || !lookup(tf["extinction"], u, sigma)) return {};
-    const double alpha = 1 - std::exp(-std::max(0.0, sigma[0]) * kLegendDepthVoxels);
-    out.push_back({float(std::clamp(rgb[0], 0.0, 1.0) * alpha), float(std::clamp(rgb[1], 0.0, 1.0) * alpha),
-                   float(std::clamp(rgb[2], 0.0, 1.0) * alpha)});
-  }
-  return out;
+// How opaque a slice is drawn: the renderer's slice_opacity (render/task_spec.hpp), 1 unless the task
+// records another.
+double slice_opacity(const json& p) {
+  const auto it = p.find("slice_opacity");
+  return it != p.end() && it->is_number() ? std::clamp(it->get<double>(), 0.0, 1.0) : 1.0;
 }
 
 bool number_pair(const json& p, const char* key, double& a, double& b) {
@@ -109,8 +101,9 @@ double task_reference(const store::Manifest& m, const std::vector<std::string>& 
   return r;
 }
 
-LegendBar window_bar(const store::Manifest& m, const std::vector<std::string>& fields, const std::string& field,
-                     const json& p, const char* window_key, const char* relative_key, const char* tf_key, int frame) {
+LegendBar window_bar(const store::Manifest& m, const store::TaskEntry& t, const std::string& field, const json& p,
+                     const char* window_key, const char* relative_key, const char* tf_key, int frame) {
+  const std::vector<std::string>& fields = t.fields;
   LegendBar bar;
   bar.field = field;
   bar.units = units_of(m, field);
@@ -132,11 +125,42 @@ LegendBar window_bar(const store::Manifest& m, const std::vector<std::string>& f
       bar.physical = false;
     }
   }
-  bar.colours = sample_colours(tf);
+  bar.colours = drawn_colours(t, tf_key, kLegendSamples);
   return bar;
 }
 
 }  // namespace
+
+std::vector<std::array<float, 3>> drawn_colours(const store::TaskEntry& task, const char* tf_key, int samples) {
+  std::vector<std::array<float, 3>> out;
+  const json& p = task.parameters;
+  if (!p.is_object() || samples < 2) return out;
+  const auto it = p.find(tf_key);
+  if (it == p.end() || !it->is_object() || !it->contains("colour")) return out;
+  const json& tf = *it;
+  // A slice is a surface: the renderer writes its colour map's colour at the slice's opacity (1, opaque,
+  // unless recorded otherwise) over the black background, whatever the map's extinction says. Drawing it
+  // as a volume's thin layer made the diverging map's zero (light grey on the plane) black in the legend.
+  const bool slice = task.method == "slice";
+  if (!slice && !tf.contains("extinction")) return out;
+  const double opacity = slice ? slice_opacity(p) : 0;
+  for (int i = 0; i < samples; ++i) {
+    const double u = double(i) / (samples - 1);
+    std::array<double, 3> rgb{};
+    if (!lookup(tf["colour"], u, rgb)) return {};
+    double alpha = opacity;
+    if (!slice) {
+      // A volume: the colour with the opacity of a kLegendDepthVoxels-thick layer over black, so
+      // transparent values look dark as they do in the picture.
+      std::array<double, 1> sigma{};
+      if (!lookup(tf["extinction"], u, sigma)) return {};
+      alpha = 1 - std::exp(-std::max(0.0, sigma[0]) * kLegendDepthVoxels);
+    }
+    out.push_back({float(std::clamp(rgb[0], 0.0, 1.0) * alpha), float(std::clamp(rgb[1], 0.0, 1.0) * alpha),
+                   float(std::clamp(rgb[2], 0.0, 1.0) * alpha)});
+  }
+  return out;
+}
 
 std::vector<LegendBar> task_legend(const store::Manifest& m, int task, int frame) {
   std::vector<LegendBar> bars;
@@ -146,9 +170,9 @@ std::vector<LegendBar> task_legend(const store::Manifest& m, int task, int frame
   if (!p.is_object() || t.fields.empty()) return bars;
   double lo = 0, hi = 0;
   if (number_pair(p, "window", lo, hi)) {
-    bars.push_back(window_bar(m, t.fields, t.fields[0], p, "window", "relative", "transfer_function", frame));
+    bars.push_back(window_bar(m, t, t.fields[0], p, "window", "relative", "transfer_function", frame));
     if (t.fields.size() > 1 && number_pair(p, "window2", lo, hi))
-      bars.push_back(window_bar(m, t.fields, t.fields[1], p, "window2", "relative2", "transfer_function2", frame));
+      bars.push_back(window_bar(m, t, t.fields[1], p, "window2", "relative2", "transfer_function2", frame));
   } else if (t.method == "isosurface" && p.contains("isovalue") && p["isovalue"].is_number()) {
     LegendBar bar;
     bar.field = bar.label = t.fields[0];

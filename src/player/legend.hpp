@@ -10,9 +10,10 @@
 
 namespace panoptes::player {
 
-/// Optical depth (in voxels) the legend's colours are drawn at: a sample's colour is shown with the
-/// opacity 1 − exp(−σ·kLegendDepthVoxels) over black, the renderer's background, so transparent
-/// values look dark as they do in the picture.
+/// Optical depth (in voxels) a volume's legend colours are drawn at: a sample's colour is shown with
+/// the opacity 1 − exp(−σ·kLegendDepthVoxels) over black, the renderer's background, so transparent
+/// values look dark as they do in the picture. (A slice's legend shows its colour map as the slice is
+/// drawn: opaque.)
 inline constexpr double kLegendDepthVoxels = 4;
 /// Colours sampled along a bar (evenly over the window, both ends included).
 inline constexpr int kLegendSamples = 32;
@@ -27,9 +28,9 @@ struct LegendBar {
   /// databases): lo and hi are then fractions of that unknown reference.
   bool physical = true;
   bool isovalue = false;  ///< an isosurface: one value, one colour
-  /// Colours (r, g, b in [0, 1], premultiplied by the opacity described at kLegendDepthVoxels) at
-  /// kLegendSamples evenly spaced values from lo to hi; one entry for an isovalue; empty when the
-  /// manifest does not record the transfer function (the bar then shows numbers only).
+  /// Colours (r, g, b in [0, 1]) as the task draws them (drawn_colours()) at kLegendSamples evenly
+  /// spaced values from lo to hi; one entry for an isovalue; empty when the manifest does not record
+  /// the transfer function (the bar then shows numbers only).
   std::vector<std::array<float, 3>> colours;
   /// What the reference follows (issue 41): "running" (the largest so far: a colour keeps its value
   /// along the movie), "snapshot" (each frame its own: brightness is not comparable across frames),
@@ -40,6 +41,13 @@ struct LegendBar {
   /// This frame's reference over the previous frame's (1 = the scale did not change; 0 = unknown).
   double change = 1;
 };
+
+/// The colours the transfer function `tf_key` of `task` ("transfer_function" or "transfer_function2" of
+/// its manifest parameters) puts on screen at `samples` (>= 2) evenly spaced window positions, both ends
+/// included: a slice's colour map as the slice renderer writes it (opaque: render/march_plan.cpp's
+/// slice_opacity, recorded as "slice_opacity" when not 1, over black), a volume's as a
+/// kLegendDepthVoxels-thick layer over black. Empty when the manifest does not record them.
+std::vector<std::array<float, 3>> drawn_colours(const store::TaskEntry& task, const char* tf_key, int samples);
 
 /// The bars of `task` at `frame` (two for a two-field volume, none for tasks without a window, e.g.
 /// synthetic ones). Never throws on a malformed or older manifest: what cannot be read is left out.

@@ -133,3 +133,38 @@ TEST(Legend, ScaleModeChangeAndSharedReference) {
   m.tasks[0].parameters["relative"] = false;
   EXPECT_EQ(legend_scale_text(task_legend(m, 0, 0)[0]), "");
 }
+
+// Issue 41.4: a slice is drawn opaque (render/march_plan.cpp: slice_opacity 1, the colour map's colour
+// as it is), so its legend shows the colour map itself. Drawn as a volume's thin layer over black, the
+// diverging preset's zero — light grey (222, 222, 222) on the plane — was black in the legend.
+TEST(Legend, ASlicesColoursAreItsColourMapAsTheSliceIsDrawn) {
+  store::Manifest m;
+  m.fields = {{"vz", "m/s", {2.0}, ""}};
+  const nlohmann::json diverging = {{"colour", {{0, 0.23, 0.30, 0.75}, {0.5, 0.87, 0.87, 0.87}, {1, 0.71, 0.02, 0.15}}},
+                                    {"extinction", {{0, 0.5}, {0.45, 0}, {0.55, 0}, {1, 0.5}}},
+                                    {"absolute_value", false}};
+  store::TaskEntry slice;
+  slice.id = 0, slice.name = "slice", slice.method = "slice", slice.fields = {"vz"};
+  slice.parameters = {{"axis", "z"}, {"position", 0.5}, {"window", {-1.0, 1.0}}, {"relative", true},
+                      {"transfer_function", diverging}};
+  store::TaskEntry volume = slice;
+  volume.id = 1, volume.name = "volume", volume.method = "volume";
+  m.tasks = {slice, volume};
+  const auto s = task_legend(m, 0, 0);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_DOUBLE_EQ(s[0].lo, -2.0);
+  ASSERT_EQ(s[0].colours.size(), std::size_t(kLegendSamples));
+  // kLegendSamples = 32 values from lo to hi: zero lies between samples 15 and 16, each 1/62 of the
+  // window from it; the grey there is within 2 levels of 222.
+  for (const int i : {15, 16})
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[0].colours[std::size_t(i)][k] * 255, 222, 10) << "sample " << i;
+  EXPECT_NEAR(s[0].colours[0][2], 0.75f, 1e-6) << "the map's low end, unattenuated";
+  EXPECT_NEAR(s[0].colours.back()[0], 0.71f, 1e-6);
+  // The same map on a volume stays a thin layer over black: transparent values are dark.
+  const auto v = task_legend(m, 1, 0);
+  ASSERT_EQ(v.size(), 1u);
+  EXPECT_LT(v[0].colours[16][0], 0.05f);
+  // A slice recorded as translucent is drawn at that opacity over black.
+  m.tasks[0].parameters["slice_opacity"] = 0.5;
+  EXPECT_NEAR(task_legend(m, 0, 0)[0].colours[0][2], 0.375f, 1e-6);
+}

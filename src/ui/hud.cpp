@@ -235,6 +235,8 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
 
 void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
   const auto bars = player::task_legend(*info.manifest, info.selection.task, info.selection.frame);
+  legend_text_.clear();
+  for (const auto& bar : bars) legend_text_ += (legend_text_.empty() ? "" : "; ") + player::legend_range_text(bar);
   if (bars.empty()) return;
   // Bottom left, above the time slider: the top-left corner belongs to the frame (and its stamp in
   // tests), the right side to the status panel and the mini-map.

@@ -107,6 +107,8 @@ class Hud {
   void notify(std::string text, bool error = false);
   /// The last notice given to notify() (empty if none), whether or not still on screen.
   const std::string& last_notice() const { return message_; }
+  /// The legend's ranges as last drawn (legend_range_text of each bar, joined by "; "; empty: none).
+  const std::string& last_legend() const { return legend_text_; }
   /// True if the status panel was submitted in the last draw() (the window test checks it).
   bool panel_drawn() const { return panel_drawn_; }
   /// True if the help overlay showed every line without scrolling in the last draw() that drew it.
@@ -126,6 +128,7 @@ class Hud {
   LatticeMap lattice_map_;
   bool z_down_ = false;  ///< replaces the sphere map for rigs inside the volume (lattice, path)
   std::string message_;
+  std::string legend_text_;
   bool message_error_ = false;
   double message_until_ = 0;
   bool panel_drawn_ = false;

@@ -25,6 +25,7 @@
 #include "player/controls.hpp"
 #include "player/face_action.hpp"
 #include "player/step_toward.hpp"
+#include "player/value_readout.hpp"
 #include "player/headless.hpp"
 #include "player/playback_rule.hpp"
 #include "player/trace.hpp"
@@ -224,6 +225,7 @@ class WindowApp {
   void zoom_by(double factor);
   void apply_hud_requests(const HudRequests& req);
   HudInfo gather_hud_info(const player::ShownFrame& shown);
+  void draw_value_readout(const player::ShownFrame& shown);
   void refresh_statistics();
   void toggle_recording();
   void save_screenshot(const Image& picture);
@@ -245,6 +247,17 @@ class WindowApp {
   InputLatency latency_;  // key / click → presented frame, from the input's own timestamp
   FrameLoop loop_;        // which loop iterations draw (nothing is drawn while nothing changes)
   int shell_count_ = 1;
+  // The manifest as the engine last re-read it: a database still being written records each new frame's
+  // reference there, and the legend and the value readout must scale by it (issue 41.3).
+  std::shared_ptr<const store::Manifest> live_manifest_;
+  // The value under the cursor of a slice task (issue 41): the pointer in window coordinates, and the
+  // readout of the shown (task, frame) kept until either changes.
+  int mouse_x_ = 0, mouse_y_ = 0;
+  bool mouse_in_ = false;
+  player::SliceReadout readout_;
+  int readout_task_ = -1, readout_frame_ = -1;
+  std::shared_ptr<const store::Manifest> readout_manifest_;  // held: no other manifest can take its address
+  std::string readout_text_;
   // Look-around in 360° streams (issue 14): the view (kept by the shared key dispatch, which walks and
   // changes the field of view as every front end does), and the mesh that draws it on the GPU.
   bool equirect_ = false, walkable_ = false;
@@ -424,6 +437,7 @@ void WindowApp::handle_event(const SDL_Event& e) {
     case SDL_QUIT: quit_ = true; break;
     case SDL_WINDOWEVENT:
       if (e.window.event == SDL_WINDOWEVENT_CLOSE && e.window.windowID == SDL_GetWindowID(window_.window())) quit_ = true;
+      if (e.window.event == SDL_WINDOWEVENT_LEAVE) mouse_in_ = false;
       break;
     case SDL_KEYDOWN: {
       if (io.WantTextInput) break;
@@ -462,6 +476,7 @@ void WindowApp::handle_event(const SDL_Event& e) {
       }
       break;
     case SDL_MOUSEMOTION:
+      mouse_x_ = e.motion.x, mouse_y_ = e.motion.y, mouse_in_ = true;  // the value readout follows it
       if (left_down_ && equirect_) {
         // Grab-and-drag: the scene follows the pointer (one output pixel = fov / height degrees).
         const double deg_per_px = look_.fov_deg / std::max(1, out_h_);
@@ -488,6 +503,44 @@ void WindowApp::handle_event(const SDL_Event& e) {
   }
 }
 
+// The value under the cursor when the shown task is a slice (player/value_readout.hpp): read from the
+// decoded pixel and the frame's recorded scale, shown beside the pointer. Perspective frames only: in a
+// 360° cut-out the window pixel is a resampled mix of frame pixels.
+void WindowApp::draw_value_readout(const player::ShownFrame& shown) {
+  readout_text_.clear();
+  if (equirect_ || !mouse_in_ || !shown_frame_ || shown.status != player::FrameStatus::ok || !live_manifest_) return;
+  const store::Manifest& m = *live_manifest_;
+  const auto& sel = shown.selection;
+  if (m.tasks[std::size_t(sel.task)].method != "slice") return;
+  if (hud_.covers(float(mouse_x_), float(mouse_y_))) return;
+  double fx = 0, fy = 0;
+  view_.window_to_frame(mouse_x_ * px_x_, mouse_y_ * px_y_, fx, fy);
+  const int x = int(std::floor(fx)), y = int(std::floor(fy));
+  const video::YuvFrame& f = *shown_frame_;
+  if (x < 0 || y < 0 || x >= f.width || y >= f.height) return;
+  if (sel.task != readout_task_ || sel.frame != readout_frame_ || readout_manifest_ != live_manifest_) {
+    readout_ = player::slice_readout(m, sel.task, sel.frame);
+    readout_task_ = sel.task, readout_frame_ = sel.frame, readout_manifest_ = live_manifest_;
+  }
+  if (!readout_.usable) return;
+  const auto reading = player::read_pixel(m, readout_, sel.camera, x, y, player::rgb_at(f, x, y));
+  readout_text_ = player::reading_text(readout_, reading);
+  // Beside the pointer, on the side with room (right and below, else left / above).
+  const bool left = mouse_x_ > win_w_ * 0.55, up = mouse_y_ > win_h_ * 0.8;
+  ImGui::SetNextWindowPos(ImVec2(float(mouse_x_) + (left ? -16.f : 16.f), float(mouse_y_) + (up ? -16.f : 16.f)),
+                          ImGuiCond_Always, ImVec2(left ? 1.f : 0.f, up ? 1.f : 0.f));
+  ImGui::SetNextWindowBgAlpha(0.75f);
+  constexpr ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                     ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoSavedSettings |
+                                     ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
+  if (ImGui::Begin("##readout", nullptr, flags)) {
+    if (reading.kind == player::ValueReading::Kind::none) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.7f, 0.7f, 0.7f, 1));
+    ImGui::TextUnformatted(readout_text_.c_str());
+    if (reading.kind == player::ValueReading::Kind::none) ImGui::PopStyleColor();
+  }
+  ImGui::End();
+}
+
 void WindowApp::apply_hud_requests(const HudRequests& req) {
   if (req.seek >= 0) engine_.seek(req.seek);
   if (req.jump_camera >= 0) engine_.jump_to_camera(req.jump_camera);
@@ -509,7 +562,8 @@ void WindowApp::refresh_statistics() {
 
 HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   HudInfo h;
-  const auto& m = engine_.manifest();
+  live_manifest_ = engine_.live_manifest();
+  const store::Manifest& m = *live_manifest_;
   h.manifest = &m;
   h.selection = shown.selection;
   h.frame_count = engine_.frame_count();
@@ -717,6 +771,7 @@ WindowResult WindowApp::run() {
     ImGui::GetIO().FontGlobalScale = Hud::scale_for(float(win_w_), float(win_h_));
     window_.begin_imgui_frame();
     const HudRequests req = hud_.draw(gather_hud_info(shown), float(win_w_), float(win_h_));
+    draw_value_readout(shown);
     window_.render_imgui();
     apply_hud_requests(req);
 
@@ -747,6 +802,8 @@ WindowResult WindowApp::run() {
     result.window_h = out_h_;
     result.fullscreen = window_.fullscreen();
     result.notice = hud_.last_notice();
+    result.legend = hud_.last_legend();
+    result.readout = readout_text_;
     result.help_fits = hud_.help_fits();
     result.status = std::string(player::to_string(shown.status));
   }

@@ -71,6 +71,8 @@ struct WindowResult {
   int native_w = 0, native_h = 0;  ///< the window's size at exit as the windowing system has it
   bool fullscreen = false;         ///< in full screen at exit
   std::string notice;              ///< the last notice the HUD showed (why a key did nothing, ...)
+  std::string legend;              ///< the colour legend's ranges as last drawn ("0 .. 2.41e-03 1/s"; bars joined by "; ")
+  std::string readout;             ///< the value readout beside the pointer as last drawn (slice tasks; empty: none)
   bool hud_drawn = false;       ///< the HUD window was submitted to ImGui in the last frame
   bool help_fits = false;       ///< the help overlay, when last drawn, showed every line without scrolling
   std::string status = "ok";    ///< health of the frame shown last: "ok", "missing", "unreadable"

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/frame_stamp.hpp"
 #include "core/png.hpp"
+#include "player/legend.hpp"
 #include "camera/navigation.hpp"
 #include "camera/rig_spec.hpp"
 #include "store/database.hpp"
@@ -379,6 +380,128 @@ TEST_F(WindowTest, MissingDisplayIsAClearError) {
 TEST_F(WindowTest, NotADatabaseIsReportedBeforeAnyWindowOpens) {
   WindowOptions o;
   EXPECT_THROW(run_window(dir_->path / "no-such-db", o), FileError);
+}
+
+// ---- Slices: the legend on a growing database, the value under the pointer (issue 41) --------------
+
+// The diverging preset as `panoptes run` records a slice's colour map.
+const nlohmann::json kDiverging = {{"colour", {{0, 0.23, 0.30, 0.75}, {0.5, 0.87, 0.87, 0.87}, {1, 0.71, 0.02, 0.15}}},
+                                   {"extinction", {{0, 0.5}, {0.45, 0}, {0.55, 0}, {1, 0.5}}},
+                                   {"absolute_value", false}};
+std::array<double, 3> diverging_at(double u) {
+  const double w = u < 0.5 ? u / 0.5 : (u - 0.5) / 0.5;
+  const std::array<double, 3> a = u < 0.5 ? std::array<double, 3>{0.23, 0.30, 0.75} : std::array<double, 3>{0.87, 0.87, 0.87};
+  const std::array<double, 3> b = u < 0.5 ? std::array<double, 3>{0.87, 0.87, 0.87} : std::array<double, 3>{0.71, 0.02, 0.15};
+  return {a[0] + (b[0] - a[0]) * w, a[1] + (b[1] - a[1]) * w, a[2] + (b[2] - a[2]) * w};
+}
+double reference_of(int frame) { return 6.9e-7 * std::pow(2.0, frame); }
+
+// test_manifest() with one slice task of phi_p (per-frame references) instead of the synthetic ones.
+store::Manifest slice_manifest() {
+  store::Manifest m = test_manifest();
+  m.axes.clear();
+  m.fields = {{"phi_p", "1/s", {}}};
+  m.time_units = "s";
+  m.playback_fps = 10;
+  store::TaskEntry t;
+  t.name = "slice z";
+  t.method = "slice";
+  t.fields = {"phi_p"};
+  t.parameters = {{"axis", "z"}, {"position", 0.5}, {"window", {-1.0, 1.0}}, {"relative", true},
+                  {"transfer_function", kDiverging}};
+  m.tasks = {t};
+  return m;
+}
+
+// A frame as a slice of the field phi = ref * (2 (x + 0.5) / kW - 1) looks: the map's colour per column.
+Image ramp_frame(int f) {
+  Image img(kW, kH, 3);
+  for (int x = 0; x < kW; ++x) {
+    const auto c = diverging_at((x + 0.5) / kW);
+    for (int y = 0; y < kH; ++y)
+      for (int k = 0; k < 3; ++k) img.at(x, y)[k] = std::uint8_t(std::lround(c[std::size_t(k)] * 255));
+  }
+  draw_frame_stamp(img, {0, 0, std::uint32_t(f)});
+  return img;
+}
+
+// Issue 41.3: `scripts/demo` opens the window while the run still writes. The legend kept frame 0's
+// reference (at frame 9: 0..6.90e-07 where the frame recorded 1.13e-04). Frames 1..9 are written while
+// the window is open; after the engine's refresh the script seeks to 9 and then to 4.
+TEST_F(WindowTest, TheLegendFollowsAGrowingDatabase) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  // End goes to the last frame once the engine has re-read the manifest; each ',' steps one back.
+  for (const auto& [shown, keys] : {std::pair{9, std::string("t=2 key=End\n")},
+                                    std::pair{4, std::string("t=2 key=End\nt=2.2 key=Comma\nt=2.3 key=Comma\n"
+                                                             "t=2.4 key=Comma\nt=2.5 key=Comma\nt=2.6 key=Comma\n")}}) {
+    const auto db = dir_->path / ("growing" + std::to_string(shown));
+    auto writer = store::DatabaseWriter::create(db, slice_manifest(), true);
+    const auto write = [&](int from, int to) {
+      for (int f = from; f < to; ++f) {
+        for (int c = 0; c < kCameras; ++c) writer.append(c, 0, ramp_frame(f));
+        writer.set_time(f, 0.5 * f);
+        writer.set_field_reference(f, 0, reference_of(f));
+      }
+      writer.checkpoint();
+    };
+    write(0, 1);
+    const auto script = dir_->path / "growing.txt";
+    std::ofstream(script) << keys;
+    WindowOptions o = test_window();
+    o.width = kW, o.height = kH;
+    o.script = script;
+    o.max_frames = 40;  // 0.1 s of playback clock a frame: the engine re-reads the manifest at 1 s
+    o.before_frame = [&](int n) {
+      if (n == 2) write(1, 10);  // the run goes on while the window is open
+    };
+    const WindowResult r = run_window(db, o);
+    EXPECT_EQ(r.frame, shown);
+    player::LegendBar bar;
+    bar.lo = -reference_of(shown), bar.hi = reference_of(shown), bar.units = "1/s";
+    EXPECT_EQ(r.legend, player::legend_range_text(bar)) << "frame " << shown;
+    writer.finalize();
+  }
+}
+
+// The value under the pointer of a slice task: the HUD reads the decoded pixel back through the colour
+// map and the frame's reference. The frame is the diverging map over its window, column by column.
+TEST_F(WindowTest, TheValueUnderThePointerOfASlice) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  const auto db = dir_->path / "slice";
+  {
+    auto writer = store::DatabaseWriter::create(db, slice_manifest(), true);
+    for (int f = 0; f < 2; ++f) {
+      for (int c = 0; c < kCameras; ++c) writer.append(c, 0, ramp_frame(f));
+      writer.set_time(f, 0.5 * f);
+      writer.set_field_reference(f, 0, reference_of(10 + f));
+    }
+    writer.finalize();
+  }
+  for (const int x : {120, 300}) {
+    WindowOptions o = test_window();
+    o.width = kW, o.height = kH;
+    o.frame = 1;
+    o.max_frames = 8;
+    o.screenshot_on_exit = dir_->path / "readout.png";
+    o.before_frame = [&](int n) {
+      if (n != 2) return;
+      SDL_Event e{};
+      e.type = SDL_MOUSEMOTION;
+      e.motion.x = x, e.motion.y = 180;  // 1:1 (a window of the frame's size), clear of the HUD
+      SDL_PushEvent(&e);
+    };
+    const WindowResult r = run_window(db, o);
+    keep_for_humans(o.screenshot_on_exit, "ui_readout_" + std::to_string(x) + ".png");
+    const double ref = reference_of(11), truth = ref * (2 * (x + 0.5) / kW - 1);
+    std::printf("pointer at column %d: \"%s\" (true value %.4g)\n", x, r.readout.c_str(), truth);
+    const auto eq = r.readout.find(" = ");
+    ASSERT_NE(eq, std::string::npos) << r.readout;
+    EXPECT_EQ(r.readout.substr(0, eq), "phi_p");
+    const double value = std::stod(r.readout.substr(eq + 3));
+    // Within 3 steps of the map's resolution (2 ref / ~380 colours) after H.264 and 3 digits.
+    EXPECT_NEAR(value, truth, 3 * 2 * ref / 380 + 0.005 * std::abs(truth)) << r.readout;
+    EXPECT_NE(r.readout.find(" 1/s  (+-"), std::string::npos) << r.readout;
+  }
 }
 
 // ---- First sight at 1280x1024 (registered as ui.window_demo under a 1280x1024 Xvfb screen) ----------

@@ -1,9 +1,14 @@
 #include "web/database_json.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
+
+#include "player/legend.hpp"
+#include "player/value_readout.hpp"
 
 namespace panoptes::web {
 
@@ -41,14 +46,42 @@ nlohmann::json database_json(const store::Database& db, const DatabaseJsonOption
   for (const auto& a : m.axes) axes.push_back({{"name", a.name}, {"values", a.values}, {"units", a.units}});
   j["axes"] = std::move(axes);
   json tasks = json::array();
-  for (const auto& t : m.tasks) {
+  // Slice colour tables (~600 colours each) are shared by every task with the same map, e.g. a sweep of
+  // slice positions: each is sent once, and tasks name theirs by index.
+  json readout_tables = json::array();
+  std::map<std::string, std::size_t> table_index;
+  for (int ti = 0; ti < m.task_count(); ++ti) {
+    const auto& t = m.tasks[std::size_t(ti)];
     json positions = json::array();
     for (const auto& p : t.axes) positions.push_back({{"axis", p.axis}, {"index", p.index}});
     // fields and parameters carry what the colour legend shows (window, transfer function; issue 34).
-    tasks.push_back({{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)},
-                     {"fields", t.fields}, {"parameters", t.parameters}});
+    json task = {{"id", t.id}, {"name", t.name}, {"method", t.method}, {"axes", std::move(positions)},
+                 {"fields", t.fields}, {"parameters", t.parameters}};
+    // The legend's colours as the task draws them (player::drawn_colours: a slice opaque, a volume as a
+    // thin layer over black), so the browser shows the desktop's colours without a second rule (issue 41).
+    // Four decimals are finer than the 8-bit colours they become.
+    json drawn = json::object();
+    for (const char* key : {"transfer_function", "transfer_function2"}) {
+      json colours = json::array();
+      for (const auto& c : player::drawn_colours(t, key, player::kLegendSamples))
+        colours.push_back({std::round(c[0] * 1e4) / 1e4, std::round(c[1] * 1e4) / 1e4, std::round(c[2] * 1e4) / 1e4});
+      if (!colours.empty()) drawn[key] = std::move(colours);
+    }
+    if (!drawn.empty()) task["drawn_colours"] = std::move(drawn);
+    // A slice's colour table and plane for the value under the cursor (player/value_readout.hpp).
+    if (json readout = player::slice_readout_json(m, ti); !readout.is_null()) {
+      json table = {{"colours", std::move(readout["colours"])}, {"u", std::move(readout["u"])}};
+      readout.erase("colours");
+      readout.erase("u");
+      const auto [it, added] = table_index.emplace(table.dump(), readout_tables.size());
+      if (added) readout_tables.push_back(std::move(table));
+      readout["table"] = it->second;
+      task["readout"] = std::move(readout);
+    }
+    tasks.push_back(std::move(task));
   }
   j["tasks"] = std::move(tasks);
+  if (!readout_tables.empty()) j["readout_tables"] = std::move(readout_tables);
   j["time_units"] = m.time_units;
   json fields = json::array();
   for (const auto& f : m.fields) {

@@ -1,31 +1,10 @@
 // Colour legends (issue 34): each bar of the current task — its transfer function's colours and its
-// window in physical values and units at the shown frame — as the desktop HUD draws them
-// (src/player/legend.cpp holds the same rules: the colours are shown with the opacity of a
-// LEGEND_DEPTH_VOXELS-thick layer over black, the renderer's background).
-export const LEGEND_DEPTH_VOXELS = 4, LEGEND_SAMPLES = 32;
+// window in physical values and units at the shown frame — as the desktop HUD draws them. The colours
+// are the desktop's own (src/player/legend.cpp, drawn_colours): database.json publishes them per task
+// as `drawn_colours` (a slice's opaque colour map, a volume's thin layer over black), so the two front
+// ends cannot drift apart (issue 41: this file used to recompute them, every task as a volume).
 
-// Piecewise-linear lookup over [[x, v...], ...] control points, constant beyond the ends; null if malformed.
-function lookup(points, u) {
-  if (!Array.isArray(points) || points.length === 0 || !points.every((p) => Array.isArray(p) && p.length >= 2)) return null;
-  if (u <= points[0][0]) return points[0].slice(1);
-  for (let i = 1; i < points.length; i++) {
-    const [x0, ...a] = points[i - 1], [x1, ...b] = points[i];
-    if (u <= x1) { const w = x1 > x0 ? (u - x0) / (x1 - x0) : 1; return a.map((v, k) => v + (b[k] - v) * w); }
-  }
-  return points[points.length - 1].slice(1);
-}
-
-function sampleColours(tf) {
-  if (!tf || !tf.colour || !tf.extinction) return [];
-  const out = [];
-  for (let i = 0; i < LEGEND_SAMPLES; i++) {
-    const u = i / (LEGEND_SAMPLES - 1), rgb = lookup(tf.colour, u), s = lookup(tf.extinction, u);
-    if (!rgb || rgb.length !== 3 || !s) return [];
-    const alpha = 1 - Math.exp(-Math.max(0, s[0]) * LEGEND_DEPTH_VOXELS);
-    out.push(rgb.map((c) => Math.min(1, Math.max(0, c)) * alpha));
-  }
-  return out;
-}
+const drawnColours = (task, tfKey) => (task.drawn_colours && task.drawn_colours[tfKey]) || [];
 
 function reference(db, field, frame) {
   const f = (db.fields || []).find((x) => x.name === field);
@@ -52,10 +31,10 @@ function taskReference(db, fields, field, shared, frame) {
   return r;
 }
 
-function windowBar(db, fields, field, p, windowKey, relativeKey, tfKey, frame) {
-  const tf = p[tfKey];
+function windowBar(db, task, field, p, windowKey, relativeKey, tfKey, frame) {
+  const tf = p[tfKey], fields = task.fields || [];
   const bar = { field, label: tf && tf.absolute_value ? `|${field}|` : field, units: unitsOf(db, field),
-                lo: p[windowKey][0], hi: p[windowKey][1], physical: true, isovalue: false, colours: sampleColours(tf),
+                lo: p[windowKey][0], hi: p[windowKey][1], physical: true, isovalue: false, colours: drawnColours(task, tfKey),
                 scale: "", shared: false, change: 1 };
   if (p[relativeKey]) {
     bar.shared = fields.length > 1 && p.scale === "shared";
@@ -86,8 +65,8 @@ export function taskLegend(db, t, frame) {
   if (!p || fields.length === 0) return [];
   const pair = (k) => Array.isArray(p[k]) && p[k].length === 2 && p[k].every(Number.isFinite);
   if (pair("window")) {
-    const bars = [windowBar(db, fields, fields[0], p, "window", "relative", "transfer_function", frame)];
-    if (fields.length > 1 && pair("window2")) bars.push(windowBar(db, fields, fields[1], p, "window2", "relative2", "transfer_function2", frame));
+    const bars = [windowBar(db, task, fields[0], p, "window", "relative", "transfer_function", frame)];
+    if (fields.length > 1 && pair("window2")) bars.push(windowBar(db, task, fields[1], p, "window2", "relative2", "transfer_function2", frame));
     return bars;
   }
   if (task.method === "isosurface" && Number.isFinite(p.isovalue)) {

@@ -24,6 +24,12 @@ export function installTestApi(p) {
     /// The camera a walk ("forward", "back", "left", "right", "up", "down") leads to from here, or -1.
     walkTarget: (w) => walkTarget(S.cams, S.camera, S.look, w),
     message: () => S.message,
+    /// The value readout beside the pointer (slice tasks), null when none; readoutAt(x, y) reads frame
+    /// pixel (x, y) of the shown frame as a hover there would.
+    readout: () => S.readout ?? null,
+    /// The legend's bars as last drawn ({label, units, lo, hi, colours, ...}; [] when none).
+    legend: () => S.legend ?? [],
+    readoutAt: (x, y) => p.readoutAt(x, y),
     pause: () => setPlaying(false),
     shown: () => S.shown,
     switches: () => S.switches,

@@ -282,10 +282,17 @@ await check("live database: new frames of a running simulation play without a re
   // browser_test.sh holds the writer lock, so serve reports the database as running; a checkpoint is
   // simulated by rewriting panoptes.json (atomically, as the writer does) with more frames written.
   const manifestPath = path.join(liveDir, "panoptes.json");
+  // Each checkpoint also records the frames' references and the task gets a relative window, so the
+  // legend must follow them (issue 41.3: the desktop's froze on frame 0's; this player kept the
+  // references of the first database.json).
+  const reference = (f) => 1e-6 * 2 ** (f / 2);
   const checkpoint = (frames) => {
     const m = JSON.parse(fs.readFileSync(manifestPath, "utf8"));
     m.status = "running";
     m.frames_written = frames;
+    m.fields = [{ name: "v", units: "m/s", references: Array.from({ length: frames }, (_, f) => reference(f)) }];
+    m.tasks[0].fields = ["v"];
+    m.tasks[0].parameters = { window: [0, 1], relative: true };
     fs.writeFileSync(manifestPath + ".tmp", JSON.stringify(m));
     fs.renameSync(manifestPath + ".tmp", manifestPath);
   };
@@ -316,6 +323,9 @@ await check("live database: new frames of a running simulation play without a re
   await page.evaluate(() => window.panoptes.pause());
   await page.keyboard.press("End");
   await expectShown(page, 0, 0, 15, "the last frame of the new checkpoint");
+  await page.waitForFunction(() => window.panoptes.legend().length === 1, { timeout: 5000 });
+  const bar = (await page.evaluate(() => window.panoptes.legend()))[0];
+  assert.equal(bar.hi, reference(15), `legend at frame 15: 0 .. ${bar.hi} m/s, the frame's reference is ${reference(15)}`);
   assert.deepEqual(errors, []);
   await page.close();
 });
