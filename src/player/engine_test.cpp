@@ -484,7 +484,7 @@ TEST(LiveDb, RefreshTakesOverNewCheckpoints) {
 TEST(LiveDb, TheLegendFollowsTheReferencesOfFramesWrittenAfterOpening) {
   TempDir dir("player-live-legend");
   auto m = testing::ring_manifest(2, 1);
-  m.fields = {{"phi_p", "1/s", {}}};
+  m.fields = {{"phi_p", "1/s", {}, ""}};
   m.tasks[0].method = "slice";
   m.tasks[0].fields = {"phi_p"};
   m.tasks[0].parameters = {{"window", {-1.0, 1.0}}, {"relative", true}};

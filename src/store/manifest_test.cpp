@@ -111,7 +111,7 @@ TEST(Manifest, FieldUnitsReferencesAndTimeUnitsAreOptionalAndChecked) {
   EXPECT_FALSE(j.contains("time_units"));
   EXPECT_TRUE(manifest_from_json(j, "mem").fields.empty());
   m.time_units = "s";
-  m.fields = {{"phi_p", "1/s", {0.5, 0.25}}, {"phi_s", "", {}}};
+  m.fields = {{"phi_p", "1/s", {0.5, 0.25}, "running"}, {"phi_s", "", {}, ""}};
   j = to_json(m);
   const Manifest back = manifest_from_json(j, "mem");
   EXPECT_EQ(back.time_units, "s");
@@ -128,6 +128,9 @@ TEST(Manifest, FieldUnitsReferencesAndTimeUnitsAreOptionalAndChecked) {
   bad = j;
   bad["fields"][1]["name"] = "phi_p";
   expect_error([&] { manifest_from_json(bad, "mem"); }, {"fields[1]", "used twice"});
+  bad = j;  // issue 41: the scale mode is one of three words
+  bad["fields"][0]["reference_mode"] = "sometimes";
+  expect_error([&] { manifest_from_json(bad, "mem"); }, {"fields[0].reference_mode", "\"sometimes\""});
   bad = j;
   bad["fields"][0]["references"] = "many";
   expect_error([&] { manifest_from_json(bad, "mem"); }, {"fields[0].references"});

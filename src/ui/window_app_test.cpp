@@ -400,7 +400,7 @@ double reference_of(int frame) { return 6.9e-7 * std::pow(2.0, frame); }
 store::Manifest slice_manifest() {
   store::Manifest m = test_manifest();
   m.axes.clear();
-  m.fields = {{"phi_p", "1/s", {}}};
+  m.fields = {{"phi_p", "1/s", {}, ""}};
   m.time_units = "s";
   m.playback_fps = 10;
   store::TaskEntry t;
@@ -544,7 +544,7 @@ void write_demo_like_database(const std::filesystem::path& dir, bool legend = fa
   t.method = "synthetic";
   if (legend) {  // as `panoptes run` writes a p-wave task (issue 34)
     m.time_units = "s";
-    m.fields = {{"phi_p", "1/s", {}}};
+    m.fields = {{"phi_p", "1/s", {}, ""}};
     t.name = "p-wave";
     t.method = "volume";
     t.fields = {"phi_p"};
