@@ -44,8 +44,7 @@ bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double
 
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
                        const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       std::int64_t k_first, std::int64_t k_last, double t_exit, float tr_stop, float* a,
-                       IsoSliver& sliver) {
+                       std::int64_t k_last, double t_exit, float tr_stop, float* a) {
   const double dt = S.dt, pitch = S.iso_aa_pitch;
   const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
   const float iso = T.iso;
@@ -119,10 +118,6 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     const float sp = s(j - 1), sc = s(j);
     const bool cross = (sp < 0) != (sc < 0);
     const std::int64_t k = k0 - 1 + j;
-    if (sliver.open && t0 + double(k - 1) * dt > sliver.t_end) {  // the exit never came
-      close_as_hit(sliver, a);
-      return j - 1;
-    }
     float cell_range = 0;
     if (!cross) {
       // A near miss needs the surface within half a voxel: in this grid cell, |∇f| per voxel is at
@@ -170,17 +165,21 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th * pitch >= 0.25 * hmin) {
         // The samples' curvature of s along the ray mixes the surface's bend with how the field
         // changes across the surface (its second derivative along the normal, |∇f| varying along
-        // the ray). Only the bend makes the ray leave the surface again: a ray entering a ball
-        // from outside where the field rises convexly looked like the exit of a sliver behind it
-        // (the outside), got nothing, and showed what lay behind the ball — often the black
-        // background (issue 41: speckles on smooth surfaces, cracks where sheets meet). So the
-        // bend is measured from the gradients at the two samples around the hit (H·u by their
-        // difference; both lie within the ghost layers, so every brick computes the same): s'' of
-        // the surface = u·Hu − (n·Hu)(n·u), n = ∇f / |∇f|. It must curve the way the samples do,
-        // and it alone sets the vertex (the samples' parabola scattered by a factor 2 around it on
-        // a distance field, whose s'' is the bend alone): s' = ∇f·u, the vertex lies
-        // −s'/s'' along the ray, |s| there is s'² / (2|s''|), and the pixel's centre lies that over
-        // |∇f| inside the surface's outline (its coverage 0.5 + depth / footprint, box filter).
+        // the ray); only the bend makes the ray leave the surface again. A ray crossing a sheet
+        // where the field's own curvature turned the parabola back was taken for one end of a
+        // sliver: as an exit it got nothing and showed what lay behind — often the black
+        // background — as an entry too little coverage (issue 41's speckles). So the bend is
+        // measured from the gradients at the two samples around the hit (H·u by their difference;
+        // both lie within the ghost layers, so every brick computes the same): s'' of the surface
+        // = u·Hu − (n·Hu)(n·u), n = ∇f / |∇f|. It must curve the way the samples do, and it alone
+        // sets the vertex (on a distance field, where s'' is the bend alone, the samples' parabola
+        // scattered by a factor 2 around it): s' = ∇f·u, the vertex lies −s'/s'' along the ray,
+        // |s| there is s'² / (2|s''|), and the pixel's centre lies that over |∇f| inside the
+        // surface's outline (coverage 0.5 + depth / footprint, box filter). Still taken for an
+        // exit: a first crossing where the bend does curve back but the region behind is open
+        // towards the camera (a valley where two sheets meet); telling it from a real exit needs
+        // the ray's earlier crossings, which a brick does not see when they lie in the brick in
+        // front (docs/rendering.md, "Isosurface anti-aliasing").
         double gm[3], gq[3], Hu[3];
         const double tm = t0 + double(k - 1) * dt, tq = tm + dt;
         const double pm[3] = {O[0] + tm * D[0], O[1] + tm * D[1], O[2] + tm * D[2]};
@@ -196,28 +195,10 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
           const double reach = -s1 / s2;  // world units from the hit to the vertex
           if (std::abs(reach) <= max_reach * dt) {
             const double cover = 0.5 + s1 * s1 / (2 * std::abs(s2)) / gn / (th * pitch);
-            if (cover < 1) {
-              // An exit adds nothing only when its entry took the coverage: an entry with partial
-              // coverage earlier in this march, or one that may lie in a brick in front (its root,
-              // twice the reach behind, before this brick's first sample, which is not the ray's
-              // first). Otherwise no entry was there: the sliver the local fit claims behind is
-              // open towards the camera (a valley where two surfaces meet, issue 41's cracks) and
-              // the crossing is an opaque hit.
-              if (reach > 0) {
-                alpha = cover;
-                // Its exit must come within twice the chord the fit predicts (and a voxel); if it
-                // does not, the entry becomes an opaque hit (close_as_hit()).
-                std::copy_n(a, 4, sliver.before);
-                std::copy_n(rgb, 4, sliver.rgb);
-                sliver.t_end = th + 4 * reach + 2 * half_voxel;
-              } else if (sliver.open || (k_first > 0 && th + 2 * reach < t0 + double(k_first) * dt)) {
-                alpha = 0;
-              }
-            }
+            if (cover < 1) alpha = reach > 0 ? cover : 0.0;
           }
         }
       }
-      sliver.open = alpha < 1 && alpha > 0;  // an entry with partial coverage; any other crossing closes
       if (alpha <= 0) continue;
       if (add(rgb, alpha)) return j - 1;
       continue;

@@ -53,10 +53,10 @@ bool brick_samples(const MarchPlan& S, const double O[3], const double D[3], dou
 class RayMarch {
  public:
   RayMarch(const MarchPlan& plan, const double* origin, const double* direction, const Vec3& world_dir, double t_0,
-           double tg1, std::int64_t ks, std::int64_t ke, std::int64_t kg_last, std::uint64_t tasks, float (*accumulators)[4],
+           double tg1, std::int64_t ke, std::int64_t kg_last, std::uint64_t tasks, float (*accumulators)[4],
            std::uint64_t& marched_samples)
       : S(plan), O(origin), D(direction), dir(world_dir), t0(t_0), dt(plan.dt), live(tasks), acc(accumulators),
-        marched(marched_samples), k_last(kg_last), t_exit(tg1), k_first(ks) {
+        marched(marched_samples), k_last(kg_last), t_exit(tg1) {
     for (std::size_t s = 0; s < S.acc.size(); ++s) fa[s] = S.acc[s];
     // The last sample of the ray in the whole domain stands for a shorter segment.
     if (ke == kg_last) {
@@ -141,16 +141,6 @@ class RayMarch {
   }
 
   // The macro-cell walk: queues runs of visible cells and hands them to run().
-  // After the march: a sliver still open whose exit should have come by the brick's last sample
-  // (ke) had none — the entry is an opaque hit. One whose exit may lie in the brick behind stays.
-  void close_slivers(std::int64_t ke) {
-    for (std::uint64_t m = sliver_open & live; m; m &= m - 1) {
-      const int i = std::countr_zero(m);
-      if (t0 + double(ke) * dt > sliver[i].t_end) close_as_hit(sliver[i], acc[i]);
-    }
-    sliver_open = 0;
-  }
-
   void walk_macro_cells(std::int64_t ks, std::int64_t ke) {
     const Brick& B = S.brick;
     // 3-D DDA over the macro-cells (Amanatides–Woo): per cell only a compare, an add and a mask load;
@@ -446,11 +436,7 @@ class RayMarch {
           const float* v = vb[T.s1];
           const int l0 = (prev_valid >> T.s1 & 1) ? 0 : 1;
           if (S.iso_aa_pitch > 0) {
-            IsoSliver& sl = sliver[i];
-            sl.open = sliver_open >> i & 1;
-            stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, l0 == 0, k_first, k_last, t_exit,
-                                      tr_stop, a, sl);
-            sliver_open = (sliver_open & ~(std::uint64_t(1) << i)) | (std::uint64_t(sl.open) << i);
+            stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, l0 == 0, k_last, t_exit, tr_stop, a);
             break;
           }
           // Lanes whose segment (sample l − 1 … l) changes sign, found for the whole block at once.
@@ -519,9 +505,6 @@ class RayMarch {
   std::uint32_t prev_valid = 0, vq_from_vb = 0;
   const std::int64_t k_last;  // the ray's last sample in the domain, and where it leaves the domain
   const double t_exit;        // (isosurface anti-aliasing looks at the stretch between them)
-  const std::int64_t k_first;  // the first sample this brick owns (anti-aliasing: is an entry in front possible?)
-  std::uint64_t sliver_open = 0;  // isosurface tasks inside a sliver they gave partial coverage (iso_edges.hpp)
-  IsoSliver sliver[kMaxTasksPerMarch];  // theirs (valid where sliver_open has the task's bit)
 };
 
 }  // namespace
@@ -536,7 +519,7 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   // During the march acc[i][3] holds the TRANSMITTANCE T = 1 − α: the loop-carried chain per
   // sample is then one multiply, T ← T·(1 − α_s), and colour accumulates as C ← C + T·c_s·α_s.
   for (std::uint64_t m = mm; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
-  RayMarch ray(S, O, D, dir, t0, tg1, ks, ke, kg_last, mm, acc, marched);
+  RayMarch ray(S, O, D, dir, t0, tg1, ke, kg_last, mm, acc, marched);
   if (S.direct && ray.clear_of_exceptions(ks, ke)) {
     // One run over the whole ray: the samples and their order are those of the merged walk, so
     // images are the same bits; `safe` = false only means clamped indices (same bits, see interp()).
@@ -544,7 +527,6 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   } else {
     ray.walk_macro_cells(ks, ke);
   }
-  ray.close_slivers(ke);
   for (std::uint64_t m = mm; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
