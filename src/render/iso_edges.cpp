@@ -155,17 +155,49 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       double alpha = 1;
       // A grazing ray: the parabola has a second root close by (its vertex on the other side of
       // zero than its curvature, within max_reach of the crossing), so the ray leaves the surface
-      // again soon. Its depth |s_v| / |∇f| at the vertex sets the coverage. The entry (vertex ahead)
-      // takes all of it; the exit (vertex behind) adds nothing, so the pair covers `cover`. (Letting
-      // an exit with nothing before it on the ray count broke compositing: the entry may lie in the
-      // brick in front.)
+      // again soon. The entry (vertex ahead) takes the coverage; the exit (vertex behind) adds
+      // nothing, so the pair covers `cover`. (Letting an exit with nothing before it on the ray
+      // count broke compositing: the entry may lie in the brick in front.)
       const double uc = -1 + double(sp) / (double(sp) - double(sc));  // the crossing in u
       // Only where a pixel is a sizeable part of a voxel (>= 1/4): in views magnified beyond that
       // (inside the data, near the camera) a fit across a crease of the trilinear field could
       // predict an exit that never comes, and the ray would see the dark behind (dotted lines).
       if (std::abs(uv - uc) <= max_reach && c2 * sv < 0 && gn > 0 && th * pitch >= 0.25 * hmin) {
-        const double cover = 0.5 + std::abs(sv) / gn / (th * pitch);
-        if (cover < 1) alpha = uv > uc ? cover : 0.0;
+        // The samples' curvature of s along the ray mixes the surface's bend with how the field
+        // changes across the surface (its second derivative along the normal, |∇f| varying along
+        // the ray); only the bend makes the ray leave the surface again. A ray crossing a sheet
+        // where the field's own curvature turned the parabola back was taken for one end of a
+        // sliver: as an exit it got nothing and showed what lay behind — often the black
+        // background — as an entry too little coverage (issue 41's speckles). So the bend is
+        // measured from the gradients at the two samples around the hit (H·u by their difference;
+        // both lie within the ghost layers, so every brick computes the same): s'' of the surface
+        // = u·Hu − (n·Hu)(n·u), n = ∇f / |∇f|. It must curve the way the samples do, and it alone
+        // sets the vertex (on a distance field, where s'' is the bend alone, the samples' parabola
+        // scattered by a factor 2 around it): s' = ∇f·u, the vertex lies −s'/s'' along the ray,
+        // |s| there is s'² / (2|s''|), and the pixel's centre lies that over |∇f| inside the
+        // surface's outline (coverage 0.5 + depth / footprint, box filter). Still taken for an
+        // exit: a first crossing where the bend does curve back but the region behind is open
+        // towards the camera (a valley where two sheets meet); telling it from a real exit needs
+        // the ray's earlier crossings, which a brick does not see when they lie in the brick in
+        // front (docs/rendering.md, "Isosurface anti-aliasing").
+        double gm[3], gq[3], Hu[3];
+        const double tm = t0 + double(k - 1) * dt, tq = tm + dt;
+        const double pm[3] = {O[0] + tm * D[0], O[1] + tm * D[1], O[2] + tm * D[2]};
+        const double pq[3] = {O[0] + tq * D[0], O[1] + tq * D[1], O[2] + tq * D[2]};
+        field_gradient(f, S.grid.dims, S.spacing, pm, gm);
+        field_gradient(f, S.grid.dims, S.spacing, pq, gq);
+        for (int c = 0; c < 3; ++c) Hu[c] = (gq[c] - gm[c]) / dt;
+        const double s1 = g[0] * dir[0] + g[1] * dir[1] + g[2] * dir[2];
+        const double uHu = Hu[0] * dir[0] + Hu[1] * dir[1] + Hu[2] * dir[2];
+        const double nHu = (Hu[0] * g[0] + Hu[1] * g[1] + Hu[2] * g[2]) / gn;
+        const double s2 = uHu - nHu * (s1 / gn);
+        if (s2 * c2 > 0) {
+          const double reach = -s1 / s2;  // world units from the hit to the vertex
+          if (std::abs(reach) <= max_reach * dt) {
+            const double cover = 0.5 + s1 * s1 / (2 * std::abs(s2)) / gn / (th * pitch);
+            if (cover < 1) alpha = reach > 0 ? cover : 0.0;
+          }
+        }
       }
       if (alpha <= 0) continue;
       if (add(rgb, alpha)) return j - 1;

@@ -1,8 +1,8 @@
 #pragma once
 // Isosurface anti-aliasing in the march (issue 32): partial coverage where a ray passes within a
 // pixel footprint of the surface, so silhouettes are not stair-stepped. Compositing-exact: every
-// contribution is a sample of one ray at one owned position, so bricks still composite to the
-// single-brick image.
+// contribution is a sample of one ray at one owned position, and every decision uses the brick's
+// data within its ghost layers, so bricks still composite to the single-brick image.
 #include <cstdint>
 
 #include "core/vec3.hpp"
@@ -20,9 +20,12 @@ double pixel_pitch(const camera::Camera& cam);
 /// v[0] is the value at sample k0 − 1 (valid when `prev`), v[1 + l] at sample k0 + l, l < n.
 /// Events in sample order:
 /// - a crossing between samples k − 1 and k: the parabola through s(k−1), s(k), s(k+1) (s = f − iso)
-///   tells whether the ray grazes the surface and how deep (|s| at the vertex / |∇f|, world units);
-///   coverage c = 0.5 + depth / footprint (box filter), each of the two crossings of a grazing ray
-///   gets α = 1 − √(1 − c) so both together cover c; a crossing with c ≥ 1 is opaque (the old hit).
+///   proposes a grazing ray (a second root within max_reach); the surface's bend along the ray,
+///   s'' = u·Hu − (n·Hu)(n·u) from the gradients at samples k − 1 and k, must curve the same way and
+///   sets the depth s'²/(2|s''|)/|∇f| (the field's own curvature across the surface bends the
+///   parabola too: issue 41). Coverage c = 0.5 + depth / footprint (box filter); the entry (vertex
+///   ahead) gets α = c, the exit (vertex behind) adds nothing, so both together cover c; a crossing
+///   with c ≥ 1 is opaque (the old hit).
 /// - a local minimum of |s| at sample k (no sign change): the field at the parabola's vertex, one
 ///   extra sample, tells a sliver pierced between two samples (a hit, found by regula falsi towards
 ///   the vertex: the saw teeth of grazing views came from missing those) from a near miss, which

@@ -58,13 +58,10 @@ void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing
   shade_from_gradient(g, dir, colour, false, a);
 }
 
-// The renderer's hit shading: the same six interpolations (float positions, clamps and lerps of
-// interp_clamped(), so the same values) as lanes of one 8-lane gather evaluation, and |n·l|^32 by
-// squarings. With eight isosurfaces a ray makes ~3 hits, each of which paid six scalar
-// interpolations and a libm pow.
-void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
-               const float colour[3], float* a, double* gradient) {
-  double q[6][3], h[3], g[3];
+// The renderer's gradient: the six interpolations of the central differences (float positions, clamps
+// and lerps of interp_clamped(), so the same values) as lanes of one 8-lane gather evaluation.
+void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], double g[3]) {
+  double q[6][3], h[3];
   gradient_points(p, dims, spacing, q, h);
 #ifdef PANOPTES_RENDER_AVX2
   if (f.gather32) {
@@ -79,8 +76,6 @@ void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const
     const __m256 px = pos(x, 0), py = pos(y, 1), pz = pos(z, 2);
     _mm256_store_ps(v, trilinear8(f, px, py, pz));
     for (int ax = 0; ax < 3; ++ax) g[ax] = h[ax] > 0 ? (double(v[2 * ax + 1]) - double(v[2 * ax])) / h[ax] : 0.0;
-    shade_from_gradient(g, dir, colour, true, a);
-    if (gradient) std::copy_n(g, 3, gradient);
     return;
   }
 #endif
@@ -89,6 +84,14 @@ void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const
     const double* q1 = q[2 * ax + 1];
     g[ax] = h[ax] > 0 ? (interp_clamped(f, q1[0], q1[1], q1[2]) - interp_clamped(f, q0[0], q0[1], q0[2])) / h[ax] : 0.0;
   }
+}
+
+// The renderer's hit shading: field_gradient() and |n·l|^32 by squarings. With eight isosurfaces a
+// ray makes ~3 hits, each of which paid six scalar interpolations and a libm pow.
+void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
+               const float colour[3], float* a, double* gradient) {
+  double g[3];
+  field_gradient(f, dims, spacing, p, g);
   shade_from_gradient(g, dir, colour, true, a);
   if (gradient) std::copy_n(g, 3, gradient);
 }

@@ -25,6 +25,9 @@ namespace panoptes::render::march {
 /// `gradient` (optional, 3 values) receives ∇f in field units per world unit (anti-aliasing's distances).
 void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
                const float colour[3], float* a, double* gradient = nullptr);
+/// ∇f at index-space position p in field units per world unit: shade_hit()'s central differences
+/// (the same six interpolations as one 8-lane evaluation), without the shading.
+void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], double g[3]);
 /// The pre-issue-10 hit shading (six scalar interpolations, std::pow): the reference renderer's.
 void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
                       const Vec3& dir, const float colour[3], float* a);
