@@ -100,9 +100,9 @@ adaptive = true        # 3-4 px per voxel: interpolate smooth cells of every 4th
 # the default [render] reference = "running" (issue 41): the scale never shrinks, so a colour keeps its
 # value in 1/s along the movie and the waves darken as they spread (the legend shows the window in 1/s).
 # Per snapshot (the former default) camera 0's p-wave movie brightened by +70 % at frame 20 while the
-# field weakened. The references peak near the source at frame 5 (phi_p 1.5e-4, phi_s 6.4e-4 1/s) and the
-# waves fall to about 0.1 of that by the end, so the windows end at 0.15 of the reference: the near-source
-# frames saturate, the rings stay readable to the last frame.
+# field weakened. The references peak near the source at frame 5 (phi_s 6.4e-4 1/s) and the waves fall to
+# about 0.1 of that by the end, so the windows end at 0.15 of the reference: the near-source frames
+# saturate, the rings stay readable to the last frame.
 [[task]]               # first: the paper's two-colour picture is what the player opens on
 name = "p+s"
 type = "volume2"
@@ -121,7 +121,9 @@ name = "p-wave"
 type = "volume"
 field = "phi_p"
 preset = "p-wave"
-window = [0.0, 0.15]
+# phi_p's running reference is set near the source by the reference floor (0.02 x max |phi_p|: 4.6e-4 1/s
+# against a percentile of 1.5e-4), so its window ends at a third of s's fraction: the same 2.3e-5 1/s.
+window = [0.0, 0.05]
 
 [[task]]
 name = "s-wave"

@@ -83,6 +83,20 @@ Pixels count(const std::vector<Image>& images) {
   return p;
 }
 
+// One snapshot of a two-field task: field `a` a strong P-like shell, field `b` residue 148x weaker
+// (an explosion's S field), with `toml` giving units or sharing; returns every camera's frame.
+std::vector<Image> two_field_frames(const fs::path& dir, const std::string& a, const std::string& b, const std::string& toml) {
+  auto cfg = config(dir, toml + "[[task]]\nname = \"two\"\ntype = \"volume2\"\nfields = [\"" + a + "\", \"" + b +
+                             "\"]\npreset = \"p-wave\"\npreset2 = \"s-wave\"\n");
+  std::vector<Image> frames;
+  insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
+  s.set_frame_observer([&](int, int, int, const Image& im) { frames.push_back(im); });
+  const auto strong = shell(9, 2, 1.0), weak = residue(1.0 / 148);
+  s.snapshot(0.72, {{a, strong.data(), insitu::ScalarType::f32, {0, 0, 0}}, {b, weak.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  s.finalize();
+  return frames;
+}
+
 }  // namespace
 
 // An explosion radiates no S waves: its S field is only discretisation residue (148x weaker than P in
@@ -90,30 +104,10 @@ Pixels count(const std::vector<Image>& images) {
 // on the shared scale of two fields in the same unit it shows orange P and no green.
 TEST(HonestScale, ExplosionShowsOrangePAndNoGreen) {
   const fs::path dir = temp_dir("scale_explosion");
-  auto cfg = config(dir, R"(
-[output]
-field_units = { phi_p = "1/s", phi_s = "1/s" }
-[[task]]
-name = "p+s"
-type = "volume2"
-fields = ["phi_p", "phi_s"]
-preset = "p-wave"
-preset2 = "s-wave"
-)");
-  std::vector<Image> frames;
-  {
-    insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
-    s.set_frame_observer([&](int, int, int, const Image& im) { frames.push_back(im); });
-    const auto p = shell(9, 2, 1.0), sres = residue(1.0 / 148);
-    s.snapshot(0.72, {{"phi_p", p.data(), insitu::ScalarType::f32, {0, 0, 0}},
-                      {"phi_s", sres.data(), insitu::ScalarType::f32, {0, 0, 0}}});
-    s.finalize();
-  }
-  const Pixels px = count(frames);
+  const Pixels px = count(two_field_frames(dir, "phi_p", "phi_s", "[output]\nfield_units = { phi_p = \"1/s\", phi_s = \"1/s\" }\n"));
   EXPECT_GT(px.orange, 300) << "the P shell must show";
   EXPECT_EQ(px.green, 0) << px.green << " green pixels for an S field 148x weaker than P";
-  const auto db = store::Database::open(dir);
-  EXPECT_EQ(db.manifest().tasks[0].parameters.at("scale"), "shared");
+  EXPECT_EQ(store::Database::open(dir).manifest().tasks[0].parameters.at("scale"), "shared");
   fs::remove_all(dir);
 }
 
@@ -123,22 +117,7 @@ TEST(HonestScale, OwnScalesWhenUnitsDifferOrAsked) {
   for (const std::string& extra : {std::string("[output]\nfield_units = { a = \"m/s\", b = \"Pa\" }\n"),
                                   std::string("[render]\nshare_scale = \"none\"\n")}) {
     const fs::path dir = temp_dir("scale_own");
-    auto cfg = config(dir, extra + R"(
-[[task]]
-name = "ab"
-type = "volume2"
-fields = ["a", "b"]
-preset = "p-wave"
-preset2 = "s-wave"
-)");
-    std::vector<Image> frames;
-    {
-      insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
-      s.set_frame_observer([&](int, int, int, const Image& im) { frames.push_back(im); });
-      const auto a = shell(9, 2, 1.0), b = residue(1.0 / 148);
-      s.snapshot(0, {{"a", a.data(), insitu::ScalarType::f32, {0, 0, 0}}, {"b", b.data(), insitu::ScalarType::f32, {0, 0, 0}}});
-      s.finalize();
-    }
+    const std::vector<Image> frames = two_field_frames(dir, "a", "b", extra);
     // The residue stretched to its own window, as asked: the explosion's picture before issue 41.
     EXPECT_GT(count(frames).green, 300) << extra;
     EXPECT_EQ(store::Database::open(dir).manifest().tasks[0].parameters.at("scale"), "own") << extra;
