@@ -289,10 +289,17 @@ void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
       if (&o != &bar) other = o.field;
     const std::string scale = player::legend_scale_text(bar, other);
     if (!scale.empty()) {
-      const bool changed = bar.change > 0 && std::abs(bar.change - 1) >= 0.005;
-      ImGui::PushStyleColor(ImGuiCol_Text, changed ? ImVec4(1, 0.78f, 0.3f, 1) : ImVec4(0.62f, 0.66f, 0.74f, 1));
-      ImGui::TextUnformatted(("scale: " + scale).c_str());
+      // The mode in grey, the change (if any) on its own line in amber: one line would make the
+      // legend twice as wide over the picture.
+      const auto cut = scale.find(": x");
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.62f, 0.66f, 0.74f, 1));
+      ImGui::TextUnformatted(("scale: " + scale.substr(0, cut)).c_str());
       ImGui::PopStyleColor();
+      if (cut != std::string::npos) {
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.78f, 0.3f, 1));
+        ImGui::TextUnformatted(scale.substr(cut + 2).c_str());
+        ImGui::PopStyleColor();
+      }
     }
   }
   ImGui::End();
