@@ -106,9 +106,13 @@ function scaleLines(bar, bars) {
   const other = bars.find((o) => o !== bar);
   const text = legendScaleText(bar, other ? other.field : "");
   if (!text) return [];
-  const cut = text.indexOf(": x");
-  return cut < 0 ? [{ text: `scale: ${text}`, changed: false }]
-                 : [{ text: `scale: ${text.slice(0, cut)}`, changed: false }, { text: text.slice(cut + 2), changed: true }];
+  // One phrase a line: the canvas is 240 CSS pixels wide, and the whole text took 60 characters.
+  const cut = text.indexOf(": x"), head = cut < 0 ? text : text.slice(0, cut);
+  const shared = head.indexOf(", shared");
+  const lines = [{ text: `scale: ${shared < 0 ? head : head.slice(0, shared)}`, changed: false }];
+  if (shared >= 0) lines.push({ text: head.slice(shared + 2), changed: false });
+  if (cut >= 0) lines.push({ text: text.slice(cut + 2), changed: true });
+  return lines;
 }
 
 /// Draws the bars into `canvas` (sized to fit, in CSS pixels × devicePixelRatio); hides it when empty.
