@@ -9,6 +9,7 @@ tmp=$(mktemp -d)
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  declare -F serve_db_stop >/dev/null && serve_db_stop "$tmp/serve.log" "$tmp/sphere.log"
   wait 2>/dev/null || true
   rm -rf "$tmp"
 }
