@@ -104,13 +104,15 @@ int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data
 int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
                               const long long extents[3], const long long strides[3]);
 /** If the schedule asks for a snapshot at (step, time), renders and stores it; *taken (may be NULL)
- * tells whether it did. */
+ * tells whether it did. A time that is not finite, or a snapshot time not after the previous snapshot's
+ * (other than the times a resumed run repeats before its first new snapshot, which are skipped), is
+ * refused with PANOPTES_ERROR_USAGE before anything is written. */
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken);
 /** Whether the schedule asks for a snapshot at (step, time): *due = 1 or 0, the same on every rank. Does not
  * render; panoptes_process(step, time) would take exactly this snapshot. Collective the first time (it
  * starts the session, as the first snapshot does). */
 int panoptes_due(panoptes_session* s, long long step, double time, int* due);
-/** Renders and stores a snapshot now, whatever the schedule (a forced snapshot). */
+/** Renders and stores a snapshot now, whatever the schedule (a forced snapshot). Times as panoptes_process. */
 int panoptes_snapshot(panoptes_session* s, double time);
 /** Closes all movies and marks the database complete (collective). The first call prints, on rank 0 to
  * stderr, the in-situ overhead: the visualization's CPU time (all threads, inside the library's calls and

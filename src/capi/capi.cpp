@@ -116,6 +116,9 @@ int guarded(const panoptes_session* s, F&& f) {
   } catch (const UsageError& e) {
     g_error = e.what();
     code = PANOPTES_ERROR_USAGE;
+  } catch (const insitu::UsageError& e) {  // the session's argument checks (times)
+    g_error = e.what();
+    code = PANOPTES_ERROR_USAGE;
   } catch (const std::exception& e) {
     g_error = e.what();
     code = PANOPTES_ERROR_RUN;
@@ -459,6 +462,7 @@ int panoptes_set_field_layout(panoptes_session* s, const char* name, const void*
 
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken) {
   return guarded(s, [&] {
+    if (taken) *taken = 0;  // also when refused
     insitu::Session& ss = session_of(s);
     const bool t = ss.process(step, time, inputs(s));
     if (taken) *taken = t ? 1 : 0;

@@ -2,6 +2,7 @@
 // bound, layouts are parsed and checked, errors are printed as the error mode says and returned as codes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -98,6 +99,26 @@ TEST_F(Capi, DueFollowsTheScheduleAndSnapshotForcesOne) {
   EXPECT_EQ(panoptes_snapshot(s_, 0.5), PANOPTES_OK);
   int taken = -1;
   EXPECT_EQ(panoptes_process(s_, 3, 3.0, &taken), PANOPTES_OK);
+  EXPECT_EQ(taken, 1);
+  EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
+}
+
+// Issue 42, point 5: NaN / inf times were taken (return 0) and made the manifest unreadable; times
+// going back were stored. Now PANOPTES_ERROR_USAGE with the value and the previous time named.
+TEST_F(Capi, TimesMustBeFiniteAndIncreasing) {
+  std::vector<float> T(224, 0.5f);
+  ASSERT_EQ(panoptes_set_field_n(s_, "T", T.data(), PANOPTES_FLOAT32, nullptr, 224), PANOPTES_OK);
+  int taken = -1;
+  EXPECT_EQ(panoptes_process(s_, 0, std::nan(""), &taken), PANOPTES_ERROR_USAGE);
+  EXPECT_EQ(taken, 0);
+  EXPECT_NE(std::string(panoptes_last_error()).find("time nan; expected a finite simulation time"), std::string::npos)
+      << panoptes_last_error();
+  EXPECT_EQ(panoptes_snapshot(s_, HUGE_VAL), PANOPTES_ERROR_USAGE);
+  EXPECT_EQ(panoptes_snapshot(s_, 1.0), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_process(s_, 3, 0.5, &taken), PANOPTES_ERROR_USAGE);
+  EXPECT_NE(std::string(panoptes_last_error()).find("time 0.5 is not after the previous snapshot's time 1"), std::string::npos)
+      << panoptes_last_error();
+  EXPECT_EQ(panoptes_process(s_, 6, 2.0, &taken), PANOPTES_OK) << panoptes_last_error();
   EXPECT_EQ(taken, 1);
   EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
 }

@@ -90,9 +90,12 @@ struct Session::Impl {
   std::vector<int> owned;
   int snapshots = 0;
   double next_time = 0;
-  // Resume: the time of the last snapshot written; the restarted run's snapshots at or before it
-  // (repeated after a checkpoint restart) are skipped, so times stay increasing.
+  // The time of the last snapshot written (this run's or, after a resume, the database's): snapshot
+  // times must increase. Resume: until the restarted run writes its first snapshot, its times at or
+  // before the database's last one are the steps it repeats since its checkpoint and are skipped;
+  // once it has written one, a time that goes back is a mistake like in any run.
   bool resumed = false;
+  int written = 0;  // snapshots written by this run
   double last_time = -INFINITY;
   bool finalized = false;
   FrameObserver observer;
@@ -133,7 +136,12 @@ struct Session::Impl {
 
   void init();
   bool repeated(double time) const {
-    return resumed && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
+    return resumed && written == 0 && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
+  }
+  // NaN or ±inf would be stored as null in the manifest, which then no reader accepts.
+  static void check_finite(const char* call, double time) {
+    if (!std::isfinite(time))
+      throw UsageError(std::string(call) + ": time " + number_text(time) + "; expected a finite simulation time");
   }
   void check_resources();
   store::Manifest make_manifest() const;
@@ -643,6 +651,7 @@ Session::~Session() {
 
 bool Session::due(std::int64_t step, double time) const {
   const ScheduleConfig& s = impl_->cfg.schedule;
+  Impl::check_finite("due", time);
   if (impl_->finalized) return false;
   if (s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots) return false;
   if (impl_->repeated(time)) return false;
@@ -654,6 +663,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   Impl& m = *impl_;
   OverheadMeter::Scope counted(*m.meter);  // also when it throws
   if (m.finalized) throw Error("snapshot: the session is finalized");
+  Impl::check_finite("snapshot", time);
   // [output] mode = "resume": a restarted run repeats the steps since its checkpoint; what the
   // database already holds is not written twice (the same time on every rank: the same decision).
   if (m.repeated(time)) {
@@ -662,6 +672,12 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
                 "snapshots up to time " + number_text(m.last_time));
     return;
   }
+  // Same time on every rank, same decision: all ranks refuse before any collective.
+  if (std::isfinite(m.last_time) && !(time > m.last_time))
+    throw UsageError("snapshot: time " + number_text(time) + " is not after the previous snapshot's time " +
+                     number_text(m.last_time) + "; snapshot times must increase" +
+                     (m.resumed && m.written > 0 ? " (a resumed run skips only the times it repeats before its first new snapshot)"
+                                                 : ""));
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
   // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
@@ -692,6 +708,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   m.time.copy += since(t0);
   m.render_snapshot(m.snapshots);
   ++m.snapshots;
+  ++m.written;
   m.last_time = time;
   if (m.cfg.schedule.every_time > 0)
     m.next_time = (std::floor(time / m.cfg.schedule.every_time + 1e-9) + 1) * m.cfg.schedule.every_time;
@@ -699,6 +716,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
 }
 
 bool Session::process(std::int64_t step, double time, const std::vector<FieldInput>& fields) {
+  Impl::check_finite("process", time);
   if (!due(step, time)) return false;
   snapshot(time, fields);
   return true;
