@@ -23,6 +23,7 @@
 #include "core/stop_request.hpp"
 #include "core/log.hpp"
 #include "core/number_text.hpp"
+#include "core/strided.hpp"
 #include "insitu/halo.hpp"
 #include "insitu/output.hpp"
 #include "insitu/resources.hpp"
@@ -348,6 +349,19 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
       if (in.name == field_names[f]) inputs[f] = &in;
     if (!inputs[f] || !inputs[f]->data)
       throw Error("snapshot: field \"" + field_names[f] + "\" (read by a task) was not given or has no data");
+    // FieldInput carries no size, but its strides must at least address the ghosted block without
+    // overflowing (a wrapped offset would read plane 0 for every z, or far outside the array).
+    const LocalBlock& lb = block;
+    const std::array<std::int64_t, 3> st = halo::field_strides(lb, inputs[f]->stride);
+    const std::array<std::int64_t, 3> n{std::int64_t(lb.extent[0]) + lb.ghost_lo[0] + lb.ghost_hi[0],
+                                        std::int64_t(lb.extent[1]) + lb.ghost_lo[1] + lb.ghost_hi[1],
+                                        std::int64_t(lb.extent[2]) + lb.ghost_lo[2] + lb.ghost_hi[2]};
+    const std::int64_t elem = inputs[f]->type == ScalarType::f64 ? 8 : 4;
+    if (!strided_reach(n, st, elem, {lb.ghost_lo[0], lb.ghost_lo[1], lb.ghost_lo[2]}))
+      throw UsageError("snapshot: field \"" + field_names[f] + "\": strides (" + std::to_string(st[0]) + ", " +
+                       std::to_string(st[1]) + ", " + std::to_string(st[2]) + ") over the ghosted block (" +
+                       std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " + std::to_string(n[2]) +
+                       ") reach further than 64-bit offsets can address; expected the strides of an array in memory");
     buffers[f].resize(std::size_t(req.size()));
   }
   exchange.load(inputs, req, buffers);

@@ -133,3 +133,18 @@ def test_times_must_be_finite_and_increasing(tmp_path):
     assert s.process(4, 2.0)
     s.finalize()
     np.testing.assert_allclose(panoptes.open(tmp_path / "d").times, [1.0, 2.0])
+
+
+def test_strides_that_overflow_are_refused(tmp_path):
+    """Issue 42, point 6: a view whose strides reach past 64-bit offsets (numpy's as_strided allows any)
+    was bound and read at wrapped addresses; now set_field refuses it."""
+    s = panoptes.Session(HEAT_TOML.format(dir=tmp_path / "d"))
+    s.set_grid((NX, NY, NZ))
+    s.set_block((0, 0, 0), (NX, NY, NZ))
+    T = blob((NZ, NY, NX), (12, 10, 8)).astype(np.float32)
+    huge = np.lib.stride_tricks.as_strided(T, shape=T.shape, strides=(2**62, T.strides[1], T.strides[2]))
+    with pytest.raises(panoptes.Error, match="reach further than 64-bit offsets can address"):
+        s.set_field("T", huge)
+    s.set_field("T", T)
+    assert s.process(0, 0.0)
+    s.finalize()
