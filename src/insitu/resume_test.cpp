@@ -269,4 +269,77 @@ TEST(InsituTimes, ResumeSkipsRepeatedTimesOnlyBeforeItsFirstNewSnapshot) {
   fs::remove_all(dir);
 }
 
+std::string resume_refusal(const insitu::SessionConfig& c) {
+  try {
+    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+// Issue 42, point 4: mode = "resume" on a FINISHED database took it (one info line, exit 0) and
+// skipped every snapshot of the rerun, whose times were all in the database: a rerun with a changed
+// source kept the old movies. A complete database is refused, naming the directory and the options.
+TEST(InsituResume, RefusesACompleteDatabase) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_complete_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  run(dir, insitu::OutputMode::create, 0);  // finished: complete, kSteps snapshots
+  const std::string why = resume_refusal(config(dir, insitu::OutputMode::resume));
+  EXPECT_NE(why.find(dir.string() + ": holds a complete database (its run finished: 6 snapshots up to time 1)"),
+            std::string::npos) << why;
+  EXPECT_NE(why.find("mode = \"overwrite\""), std::string::npos) << why;
+  EXPECT_NE(why.find("another [output] dir"), std::string::npos) << why;
+  EXPECT_NE(why.find("resume_complete = true"), std::string::npos) << why;
+  const auto db = store::Database::open(dir);  // untouched
+  EXPECT_EQ(db.status(), store::Status::complete);
+  EXPECT_EQ(db.frame_count(), kSteps);
+  fs::remove_all(dir);
+}
+
+// ... unless the configuration asks for it: [output] resume_complete = true appends to the finished run.
+TEST(InsituResume, ResumeCompleteAppendsToAFinishedRun) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_append_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  run(dir, insitu::OutputMode::create, 0);
+  EXPECT_TRUE(insitu::parse_session_config_text(std::string(kConfig) + "[output]\nresume_complete = true\n", "t").resume_complete);
+  insitu::SessionConfig c = config(dir, insitu::OutputMode::resume);
+  c.resume_complete = true;
+  {
+    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    EXPECT_EQ(s.snapshots(), kSteps);
+    const auto f = field(time_of(kSteps));
+    EXPECT_TRUE(s.process(kSteps, time_of(kSteps), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
+    s.finalize();
+  }
+  EXPECT_EQ(store::Database::open(dir).frame_count(), kSteps + 1);
+  fs::remove_all(dir);
+}
+
+// Issue 42, point 4: a changed every_steps (or every_time) on resume was accepted silently; it is
+// named like every other change, and the database is left as it was.
+TEST(InsituResume, RefusesAnotherSchedule) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_schedule_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    const auto f = field(0);
+    s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }  // interrupted
+  insitu::SessionConfig steps = config(dir, insitu::OutputMode::resume);
+  steps.schedule.every_steps = 2;
+  const std::string a = resume_refusal(steps);
+  EXPECT_NE(a.find("the schedule ([schedule]) differs (every_steps = 1 in the database, every_steps = 2 in this run)"),
+            std::string::npos) << a;
+  insitu::SessionConfig time = config(dir, insitu::OutputMode::resume);
+  time.schedule.every_steps = 0;
+  time.schedule.every_time = 0.25;
+  const std::string b = resume_refusal(time);
+  EXPECT_NE(b.find("every_steps = 1 in the database, every_time = 0.25 in this run"), std::string::npos) << b;
+  insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+  EXPECT_EQ(s.snapshots(), 1);
+  s.finalize();
+  fs::remove_all(dir);
+}
+
 }  // namespace

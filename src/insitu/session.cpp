@@ -294,6 +294,7 @@ store::Manifest Session::Impl::make_manifest() const {
   man.provenance.version = panoptes::kVersion;
   man.provenance.command_line = cfg.command_line;
   man.provenance.extra["mpi_ranks"] = std::to_string(size);
+  man.provenance.extra[kScheduleNote] = schedule_text(cfg.schedule);
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
   man.domain.origin = grid.origin;
   man.domain.spacing = grid.spacing;
