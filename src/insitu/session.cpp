@@ -146,6 +146,7 @@ struct Session::Impl {
   }
   void check_resources();
   store::Manifest make_manifest() const;
+  std::exception_ptr field_refusal(const std::vector<FieldInput>& fields) const;
   void load_fields(const std::vector<FieldInput>& fields);
   double global_percentile(int field);
   double window_reference(int field);
@@ -340,6 +341,32 @@ store::Manifest Session::Impl::make_manifest() const {
 
 // Copies (and converts) every field to float32 over this rank's required point range: the points
 // its arrays hold valid values for are read there, the others come from their owners (halo.hpp).
+// This rank's fields, checked before the snapshot's first collective (the caller agrees on the
+// outcome with the other ranks, so a refusal on one rank cannot leave the others waiting): every field
+// a task reads is given, and its strides address the ghosted block without overflowing 64-bit offsets
+// (FieldInput carries no size; a wrapped offset would read plane 0 for every z, or far outside).
+std::exception_ptr Session::Impl::field_refusal(const std::vector<FieldInput>& fields) const {
+  for (const std::string& name : field_names) {
+    const FieldInput* in = nullptr;
+    for (const FieldInput& x : fields)
+      if (x.name == name) in = &x;
+    if (!in || !in->data)
+      return std::make_exception_ptr(Error("snapshot: field \"" + name + "\" (read by a task) was not given or has no data"));
+    const LocalBlock& lb = block;
+    const std::array<std::int64_t, 3> st = halo::field_strides(lb, in->stride);
+    const std::array<std::int64_t, 3> n{std::int64_t(lb.extent[0]) + lb.ghost_lo[0] + lb.ghost_hi[0],
+                                        std::int64_t(lb.extent[1]) + lb.ghost_lo[1] + lb.ghost_hi[1],
+                                        std::int64_t(lb.extent[2]) + lb.ghost_lo[2] + lb.ghost_hi[2]};
+    const std::int64_t elem = in->type == ScalarType::f64 ? 8 : 4;
+    if (!strided_reach(n, st, elem, {lb.ghost_lo[0], lb.ghost_lo[1], lb.ghost_lo[2]}))
+      return std::make_exception_ptr(UsageError(
+          "snapshot: field \"" + name + "\": strides (" + std::to_string(st[0]) + ", " + std::to_string(st[1]) + ", " +
+          std::to_string(st[2]) + ") over the ghosted block (" + std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " +
+          std::to_string(n[2]) + ") reach further than 64-bit offsets can address; expected the strides of an array in memory"));
+  }
+  return nullptr;
+}
+
 void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   const BlockInfo& b = me();
   const Box& req = b.has_brick ? b.required : b.owned;
@@ -348,21 +375,8 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   for (std::size_t f = 0; f < field_names.size(); ++f) {
     for (const FieldInput& in : fields)
       if (in.name == field_names[f]) inputs[f] = &in;
-    if (!inputs[f] || !inputs[f]->data)
+    if (!inputs[f] || !inputs[f]->data)  // refused by field_refusal() before the snapshot's collectives
       throw Error("snapshot: field \"" + field_names[f] + "\" (read by a task) was not given or has no data");
-    // FieldInput carries no size, but its strides must at least address the ghosted block without
-    // overflowing (a wrapped offset would read plane 0 for every z, or far outside the array).
-    const LocalBlock& lb = block;
-    const std::array<std::int64_t, 3> st = halo::field_strides(lb, inputs[f]->stride);
-    const std::array<std::int64_t, 3> n{std::int64_t(lb.extent[0]) + lb.ghost_lo[0] + lb.ghost_hi[0],
-                                        std::int64_t(lb.extent[1]) + lb.ghost_lo[1] + lb.ghost_hi[1],
-                                        std::int64_t(lb.extent[2]) + lb.ghost_lo[2] + lb.ghost_hi[2]};
-    const std::int64_t elem = inputs[f]->type == ScalarType::f64 ? 8 : 4;
-    if (!strided_reach(n, st, elem, {lb.ghost_lo[0], lb.ghost_lo[1], lb.ghost_lo[2]}))
-      throw UsageError("snapshot: field \"" + field_names[f] + "\": strides (" + std::to_string(st[0]) + ", " +
-                       std::to_string(st[1]) + ", " + std::to_string(st[2]) + ") over the ghosted block (" +
-                       std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " + std::to_string(n[2]) +
-                       ") reach further than 64-bit offsets can address; expected the strides of an array in memory");
     buffers[f].resize(std::size_t(req.size()));
   }
   exchange.load(inputs, req, buffers);
@@ -698,13 +712,21 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
   // does): every rank stops before this snapshot; the writer's destructor marks the database
   // interrupted with the snapshots taken so far.
-  int stop = stop_requested();
+  // The fields are this rank's own (another rank's may be fine): every rank learns in the same
+  // reduction whether any refused them, and then all refuse this snapshot instead of waiting for it.
+  const std::exception_ptr refusal = m.field_refusal(fields);
+  int agree[2] = {stop_requested(), refusal ? m.rank + 1 : 0};
 #ifdef PANOPTES_HAVE_MPI
-  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, m.comm);
+  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, agree, 2, MPI_INT, MPI_MAX, m.comm);
 #endif
+  const int stop = agree[0];
   if (stop)
     throw Interrupted(stop, m.cfg.output_dir + ": stopped by " + signal_name(stop) + " before snapshot " +
                                 std::to_string(m.snapshots) + "; the database is marked interrupted");
+  if (refusal) std::rethrow_exception(refusal);
+  if (agree[1])
+    throw Error("snapshot: rank " + std::to_string(agree[1] - 1) + " refused its fields (its message says why); no rank took "
+                "this snapshot");
   auto t0 = Clock::now();
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());
