@@ -203,10 +203,11 @@ int compare(const std::vector<std::string>& dirs) {
   return worst >= 45 ? 0 : 1;
 }
 
-// Refusals of one rank's own fields (issue 42): rank 1 hands a field whose stride of 2^62 floats
-// overflows 64-bit offsets, then omits a field; every rank must refuse each snapshot (before, the
-// refusing rank left and the others waited for it in the snapshot's collectives: this test would
-// time out), nothing is written, and the same session then takes a good snapshot.
+// Refusals of one rank's own arguments (issue 42): rank 1 hands a field whose stride of 2^62 floats
+// overflows 64-bit offsets, then omits a field, then gives a NaN time to process() on a due step, then
+// a time that does not increase; every rank must refuse each snapshot (before, the refusing rank left
+// and the others waited for it in the snapshot's collectives: this test timed out), nothing is
+// written, and the same session then takes good snapshots.
 int refusals(const std::string& dir) {
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -224,9 +225,13 @@ int refusals(const std::string& dir) {
   const insitu::FieldInput huge_b{"b", b.data() + first, insitu::ScalarType::f32, {1, nx, std::int64_t(1) << 62}};
   insitu::Session s(cfg, g, block, MPI_COMM_WORLD);
   int failures = 0;
-  auto expect_refused = [&](const std::vector<insitu::FieldInput>& fields, const std::string& want, double t) {
+  auto expect_refused = [&](const std::vector<insitu::FieldInput>& fields, const std::string& want, double t,
+                            bool process = false) {
     try {
-      s.snapshot(t, fields);
+      if (process)
+        s.process(0, t, fields);
+      else
+        s.snapshot(t, fields);
       std::fprintf(stderr, "rank %d: FAIL: the snapshot at %g was taken\n", rank, t);
       ++failures;
     } catch (const Error& e) {
@@ -238,15 +243,19 @@ int refusals(const std::string& dir) {
     }
   };
   const bool bad = rank == 1 % size;  // rank 1, or rank 0 alone
-  expect_refused({good_a, bad ? huge_b : good_b}, bad ? "reach further than 64-bit offsets" : "rank 1 refused its fields", 0);
+  const std::string other = "rank 1 refused its time or fields";
+  expect_refused({good_a, bad ? huge_b : good_b}, bad ? "reach further than 64-bit offsets" : other, 0);
   if (bad) expect_refused({good_a}, "field \"b\" (read by a task) was not given", 0);
-  else expect_refused({good_a, good_b}, "rank 1 refused its fields", 0);
+  else expect_refused({good_a, good_b}, other, 0);
+  expect_refused({good_a, good_b}, bad ? "time nan; expected a finite" : other, bad ? NAN : 0.0, true);
   if (s.snapshots() != 0) ++failures;
   s.snapshot(0, {good_a, good_b});
+  expect_refused({good_a, good_b}, bad ? "time 0 is not after the previous snapshot's time 0" : other, bad ? 0.0 : 1.0);
+  s.snapshot(1, {good_a, good_b});
   s.finalize();
   if (rank == 0) {
     const auto db = store::Database::open(dir);
-    if (db.frame_count() != 1 || db.status() != store::Status::complete) ++failures;
+    if (db.frame_count() != 2 || db.status() != store::Status::complete) ++failures;
   }
   int all = failures;
   MPI_Allreduce(&failures, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);

@@ -146,6 +146,7 @@ struct Session::Impl {
   }
   void check_resources();
   store::Manifest make_manifest() const;
+  std::exception_ptr time_refusal(double time) const;
   std::exception_ptr field_refusal(const std::vector<FieldInput>& fields) const;
   void load_fields(const std::vector<FieldInput>& fields);
   double global_percentile(int field);
@@ -345,6 +346,19 @@ store::Manifest Session::Impl::make_manifest() const {
 // outcome with the other ranks, so a refusal on one rank cannot leave the others waiting): every field
 // a task reads is given, and its strides address the ghosted block without overflowing 64-bit offsets
 // (FieldInput carries no size; a wrapped offset would read plane 0 for every z, or far outside).
+// This rank's snapshot time: finite, and after the previous snapshot's (a resumed run's repeats were
+// skipped before). Checked with the fields, before the snapshot's first collective.
+std::exception_ptr Session::Impl::time_refusal(double time) const {
+  if (!std::isfinite(time))
+    return std::make_exception_ptr(UsageError("snapshot: time " + number_text(time) + "; expected a finite simulation time"));
+  if (std::isfinite(last_time) && !(time > last_time))
+    return std::make_exception_ptr(UsageError(
+        "snapshot: time " + number_text(time) + " is not after the previous snapshot's time " + number_text(last_time) +
+        "; snapshot times must increase" +
+        (resumed && written > 0 ? " (a resumed run skips only the times it repeats before its first new snapshot)" : "")));
+  return nullptr;
+}
+
 std::exception_ptr Session::Impl::field_refusal(const std::vector<FieldInput>& fields) const {
   for (const std::string& name : field_names) {
     const FieldInput* in = nullptr;
@@ -692,29 +706,25 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   Impl& m = *impl_;
   OverheadMeter::Scope counted(*m.meter);  // also when it throws
   if (m.finalized) throw Error("snapshot: the session is finalized");
-  Impl::check_finite("snapshot", time);
   // [output] mode = "resume": a restarted run repeats the steps since its checkpoint; what the
   // database already holds is not written twice (the same time on every rank: the same decision).
+  // NaN is never a repeat: it is refused below.
   if (m.repeated(time)) {
     if (m.rank == 0)
       log::info(m.cfg.output_dir + ": snapshot at time " + number_text(time) + " skipped: the resumed database already holds "
                 "snapshots up to time " + number_text(m.last_time));
     return;
   }
-  // Same time on every rank, same decision: all ranks refuse before any collective.
-  if (std::isfinite(m.last_time) && !(time > m.last_time))
-    throw UsageError("snapshot: time " + number_text(time) + " is not after the previous snapshot's time " +
-                     number_text(m.last_time) + "; snapshot times must increase" +
-                     (m.resumed && m.written > 0 ? " (a resumed run skips only the times it repeats before its first new snapshot)"
-                                                 : ""));
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
   // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
   // does): every rank stops before this snapshot; the writer's destructor marks the database
   // interrupted with the snapshots taken so far.
-  // The fields are this rank's own (another rank's may be fine): every rank learns in the same
-  // reduction whether any refused them, and then all refuse this snapshot instead of waiting for it.
-  const std::exception_ptr refusal = m.field_refusal(fields);
+  // The time and the fields are this rank's own arguments (another rank's may be fine): every rank
+  // learns in the same reduction whether any refused its own, and then all refuse this snapshot
+  // instead of waiting for that rank in the snapshot's collectives.
+  std::exception_ptr refusal = m.time_refusal(time);
+  if (!refusal) refusal = m.field_refusal(fields);
   int agree[2] = {stop_requested(), refusal ? m.rank + 1 : 0};
 #ifdef PANOPTES_HAVE_MPI
   if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, agree, 2, MPI_INT, MPI_MAX, m.comm);
@@ -725,8 +735,8 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
                                 std::to_string(m.snapshots) + "; the database is marked interrupted");
   if (refusal) std::rethrow_exception(refusal);
   if (agree[1])
-    throw Error("snapshot: rank " + std::to_string(agree[1] - 1) + " refused its fields (its message says why); no rank took "
-                "this snapshot");
+    throw Error("snapshot: rank " + std::to_string(agree[1] - 1) + " refused its time or fields (its message says why); no rank "
+                "took this snapshot");
   auto t0 = Clock::now();
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());
@@ -753,7 +763,18 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
 }
 
 bool Session::process(std::int64_t step, double time, const std::vector<FieldInput>& fields) {
-  Impl::check_finite("process", time);
+  if (!std::isfinite(time)) {
+    // due() cannot answer for such a time. Under an every_steps schedule the step decides: a due step
+    // takes the time into snapshot(), which refuses it on every rank (one rank's NaN then cannot leave
+    // the others waiting there); a step that is not due, or an every_time schedule, refuses it here.
+    const ScheduleConfig& s = impl_->cfg.schedule;
+    if (s.every_steps > 0 && step % s.every_steps == 0 && !impl_->finalized &&
+        !(s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots)) {
+      snapshot(time, fields);  // throws
+      return false;
+    }
+    Impl::check_finite("process", time);
+  }
   if (!due(step, time)) return false;
   snapshot(time, fields);
   return true;
