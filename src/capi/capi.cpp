@@ -460,7 +460,9 @@ int panoptes_set_halo(panoptes_session* s, const int valid_lo[3], const int vali
 int panoptes_set_field(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3]) {
   return guarded(s, [&] {
     const std::string call = "panoptes_set_field";
-    bind_field(s, call, name, data, type, field_strides(s, call, name, data, type, strides));
+    // {0, 0, 0} always meant what NULL means here (FieldInput's "contiguous x-fastest"), and codes pass it.
+    const bool contiguous = strides && strides[0] == 0 && strides[1] == 0 && strides[2] == 0;
+    bind_field(s, call, name, data, type, field_strides(s, call, name, data, type, contiguous ? nullptr : strides));
   });
 }
 

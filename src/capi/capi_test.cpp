@@ -77,6 +77,8 @@ TEST_F(Capi, HugeStridesAreRefusedNotWrapped) {
   const long long bytes[3] = {1, 8, 1LL << 61};
   EXPECT_EQ(panoptes_set_field(s_, "T", D.data(), PANOPTES_FLOAT64, bytes), PANOPTES_ERROR_USAGE);
   EXPECT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_ERROR_RUN);  // nothing was bound
+  const long long contiguous[3] = {0, 0, 0};  // panoptes_set_field's other spelling of NULL stays accepted
+  EXPECT_EQ(panoptes_set_field(s_, "T", T.data(), PANOPTES_FLOAT32, contiguous), PANOPTES_OK) << panoptes_last_error();
   EXPECT_EQ(panoptes_set_field_n(s_, "T", T.data(), PANOPTES_FLOAT32, nullptr, 224), PANOPTES_OK) << panoptes_last_error();
   EXPECT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_OK) << panoptes_last_error();
   EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
