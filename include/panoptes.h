@@ -100,17 +100,27 @@ int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data
  * "xyz" for V(i,j,k)); extents[d] = points along dimension d, which must equal the block's owned + stored
  * ghost points on that axis; strides[d] = elements between neighbours along dimension d (any sign, not 0);
  * data = the element at index 0 of every dimension. A shape that does not fit the block is refused with a
- * message naming both shapes. The Fortran module passes its arrays (sections included) through this call. */
+ * message naming both shapes. The Fortran module passes its arrays (sections included) through this call.
+ * Strides whose reach overflows 64-bit offsets are refused by every set_field call. Prefer
+ * panoptes_set_field_layout_n, which also checks the buffer's size. */
 int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
                               const long long extents[3], const long long strides[3]);
+/** panoptes_set_field_layout for a buffer of `count` elements starting at data (data = the element at index 0
+ * of every dimension and the buffer's first element): refused (PANOPTES_ERROR_USAGE, nothing bound) when the
+ * array, at these strides, reaches outside data[0 .. count-1] — e.g. a buffer too short for its strides, or a
+ * negative stride (bind a reversed view with panoptes_set_field_layout). */
+int panoptes_set_field_layout_n(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
+                                const long long extents[3], const long long strides[3], long long count);
 /** If the schedule asks for a snapshot at (step, time), renders and stores it; *taken (may be NULL)
- * tells whether it did. */
+ * tells whether it did. A time that is not finite, or a snapshot time not after the previous snapshot's
+ * (other than the times a resumed run repeats before its first new snapshot, which are skipped), is
+ * refused with PANOPTES_ERROR_USAGE before anything is written. */
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken);
 /** Whether the schedule asks for a snapshot at (step, time): *due = 1 or 0, the same on every rank. Does not
  * render; panoptes_process(step, time) would take exactly this snapshot. Collective the first time (it
  * starts the session, as the first snapshot does). */
 int panoptes_due(panoptes_session* s, long long step, double time, int* due);
-/** Renders and stores a snapshot now, whatever the schedule (a forced snapshot). */
+/** Renders and stores a snapshot now, whatever the schedule (a forced snapshot). Times as panoptes_process. */
 int panoptes_snapshot(panoptes_session* s, double time);
 /** Closes all movies and marks the database complete (collective). The first call prints, on rank 0 to
  * stderr, the in-situ overhead: the visualization's CPU time (all threads, inside the library's calls and

@@ -110,6 +110,13 @@ class Session {
                  const std::array<long long, 3>& strides) {
     check(panoptes_set_field_layout(s_, name.c_str(), data, type_of<T>(), layout.c_str(), extents.data(), strides.data()));
   }
+  /// The same for a buffer of `count` elements from data on (checked: an array that reaches outside it is refused).
+  template <class T>
+  void set_field(const std::string& name, const T* data, const std::string& layout, const std::array<long long, 3>& extents,
+                 const std::array<long long, 3>& strides, std::size_t count) {
+    check(panoptes_set_field_layout_n(s_, name.c_str(), data, type_of<T>(), layout.c_str(), extents.data(), strides.data(),
+                                      static_cast<long long>(count)));
+  }
   /// Whether the schedule asks for a snapshot at (step, time).
   bool due(long long step, double time) {
     int d = 0;

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
                    0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
       MPI_Sendrecv(&u[at(0, 0, 0)], int(plane), MPI_DOUBLE, down, 1, &u[at(nxl, 0, 0)], int(plane), MPI_DOUBLE, up, 1,
                    MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-      viz.set_field("T", u.data(), "xyz", extents, strides);                       // panoptes
+      viz.set_field("T", u.data(), "xyz", extents, strides, u.size());             // panoptes: size checked
       viz.process(step, step * dt);                                                // panoptes
       if (step == steps) break;
       for (int i = 0; i < nxl; ++i)

@@ -268,8 +268,9 @@ CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--out", opt->out, "Database directory (overrides [output] dir)");
   sub->add_flag("--overwrite", opt->overwrite, "Replace an existing database ([output] mode = \"overwrite\")");
   sub->add_flag("--resume", opt->resume,
-                "Continue the database after a restart: its snapshots stay, the run's snapshots at or before its "
-                "last time are skipped, the movies go on ([output] mode = \"resume\")");
+                "Continue the interrupted database after a restart: its snapshots stay, the run's snapshots at or "
+                "before its last time are skipped, the movies go on ([output] mode = \"resume\"; a complete "
+                "database is refused unless [output] resume_complete = true)");
   sub->add_flag("-q,--quiet", opt->quiet, "No progress output");
   sub->add_flag("--force", opt->force,
                 "Start even when the estimated memory per rank exceeds what the rank has available");

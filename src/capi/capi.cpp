@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/strided.hpp"
 #include "core/version.hpp"
 #include "grid/grid_description.hpp"
 #include "insitu/grid_adapter.hpp"
@@ -114,6 +115,9 @@ int guarded(const panoptes_session* s, F&& f) {
     g_error = e.what();
     code = PANOPTES_ERROR_CONFIG;
   } catch (const UsageError& e) {
+    g_error = e.what();
+    code = PANOPTES_ERROR_USAGE;
+  } catch (const insitu::UsageError& e) {  // the session's argument checks (times)
     g_error = e.what();
     code = PANOPTES_ERROR_USAGE;
   } catch (const std::exception& e) {
@@ -241,11 +245,29 @@ std::array<long long, 3> ghosted_extent(const insitu::LocalBlock& b) {
           (long long)b.extent[2] + b.ghost_lo[2] + b.ghost_hi[2]};
 }
 
-// Binds `data` (first STORED element) with strides per grid axis x, y, z.
-void bind_field(panoptes_session* s, const char* name, const void* data, int type, const std::array<std::int64_t, 3>& st) {
+// Binds `data` (first STORED element) with strides per grid axis x, y, z. Every binding is checked for
+// strides whose reach over the ghosted block overflows 64 bits (a wrapped offset would pass any bounds
+// check and read elsewhere); with a `count` (the _n calls), the reach must also lie in data[0 .. count-1].
+void bind_field(panoptes_session* s, const std::string& call, const char* name, const void* data, int type,
+                const std::array<std::int64_t, 3>& st, std::optional<long long> count = std::nullopt) {
   const insitu::LocalBlock& b = *s->block;
-  const std::int64_t shift = b.ghost_lo[0] * st[0] + b.ghost_lo[1] * st[1] + b.ghost_lo[2] * st[2];
+  const auto n = ghosted_extent(b);
   const std::size_t elem = type == PANOPTES_FLOAT64 ? sizeof(double) : sizeof(float);
+  for (int a = 0; a < 3; ++a)
+    need(st[a] != 0 || n[a] <= 1, call + ": field \"" + name + "\" has stride 0 on axis " + "xyz"[a]);
+  const std::string what = call + ": field \"" + name + "\": the block with its stored ghosts " + shape_text(n) +
+                           " (x, y, z) at strides " + shape_text({st[0], st[1], st[2]});
+  const auto reach = strided_reach({n[0], n[1], n[2]}, st, std::int64_t(elem));
+  need(reach.has_value(), what + " reaches further than 64-bit offsets can address; expected the strides of an array in memory");
+  if (count) {
+    const long long c = *count;
+    need(reach->lo >= 0 && reach->hi < c,
+         what + " reaches elements " + std::to_string(reach->lo) + " .. " + std::to_string(reach->hi) +
+             " of the buffer, which holds " + std::to_string(c) + (c > 0 ? " (0 .. " + std::to_string(c - 1) + ")" : "") +
+             (reach->lo < 0 ? "; a negative stride reaches before data, which must be the buffer's first element" : ""));
+  }
+  // Within the reach (ghost_lo < the ghosted extent), so neither this offset nor its bytes overflow.
+  const std::int64_t shift = b.ghost_lo[0] * st[0] + b.ghost_lo[1] * st[1] + b.ghost_lo[2] * st[2];
   insitu::FieldInput in;
   in.name = name;
   in.data = static_cast<const char*>(data) + shift * std::int64_t(elem);
@@ -264,6 +286,44 @@ std::array<std::int64_t, 3> field_strides(panoptes_session* s, const std::string
   if (strides) return {strides[0], strides[1], strides[2]};
   const auto n = ghosted_extent(*s->block);
   return {1, n[0], n[0] * n[1]};
+}
+
+// panoptes_set_field_layout and its _n form (count: the buffer's elements from data on).
+void set_field_layout(panoptes_session* s, const std::string& call, const char* name, const void* data, int type,
+                      const char* layout, const long long extents[3], const long long strides[3],
+                      std::optional<long long> count) {
+  {
+    need(s && name && extents && strides, call + ": null session, name, extents or strides");
+    need(s->block.has_value(), call + ": call panoptes_set_block first");
+    const auto axis = parse_layout(layout, call);
+    const std::string lay = std::string("\"") + layout + "\"";
+    const auto n = ghosted_extent(*s->block);
+    const std::array<long long, 3> got{extents[0], extents[1], extents[2]};
+    std::array<long long, 3> want{};
+    for (int d = 0; d < 3; ++d) want[d] = n[axis[d]];
+    if (got != want) {
+      std::string msg = call + ": field \"" + name + "\" has shape " + shape_text(got) + "; the block with its stored ghosts is " +
+                        shape_text(n) + " points (x, y, z), which in layout " + lay + " is the shape " + shape_text(want);
+      // A hint when the array fits the block in another axis order (the usual mistake: z fastest).
+      static const char* const orders[] = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx"};
+      for (const char* o : orders) {
+        const auto ax = parse_layout(o, call);
+        if (std::array<long long, 3>{n[ax[0]], n[ax[1]], n[ax[2]]} == got && ax != axis) {
+          msg += std::string("; the array fits layout \"") + o + "\": is that its axis order?";
+          break;
+        }
+      }
+      throw UsageError(msg);
+    }
+    need(data, call + ": field \"" + std::string(name) + "\": null data");
+    std::array<std::int64_t, 3> st{};
+    for (int d = 0; d < 3; ++d) {
+      need(strides[d] != 0 || got[d] <= 1, call + ": field \"" + std::string(name) + "\" has stride 0 along dimension " + std::to_string(d + 1));
+      st[axis[d]] = strides[d];
+    }
+    bind_field(s, call, name, data, type,
+               field_strides(s, call, name, data, type, std::array<long long, 3>{st[0], st[1], st[2]}.data()), count);
+  }
 }
 
 }  // namespace
@@ -398,67 +458,39 @@ int panoptes_set_halo(panoptes_session* s, const int valid_lo[3], const int vali
 }
 
 int panoptes_set_field(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3]) {
-  return guarded(s, [&] { bind_field(s, name, data, type, field_strides(s, "panoptes_set_field", name, data, type, strides)); });
+  return guarded(s, [&] {
+    const std::string call = "panoptes_set_field";
+    // {0, 0, 0} always meant what NULL means here (FieldInput's "contiguous x-fastest"), and codes pass it.
+    const bool contiguous = strides && strides[0] == 0 && strides[1] == 0 && strides[2] == 0;
+    bind_field(s, call, name, data, type, field_strides(s, call, name, data, type, contiguous ? nullptr : strides));
+  });
 }
 
 int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3],
                          long long count) {
   return guarded(s, [&] {
     const std::string call = "panoptes_set_field_n";
-    const auto st = field_strides(s, call, name, data, type, strides);
-    const auto n = ghosted_extent(*s->block);
-    // The elements the block reaches, relative to data (the first stored element).
-    long long lo = 0, hi = 0;
-    for (int a = 0; a < 3; ++a) {
-      need(st[a] != 0 || n[a] <= 1, call + ": field \"" + name + "\" has stride 0 on axis " + std::to_string(a));
-      (st[a] > 0 ? hi : lo) += (n[a] - 1) * st[a];
-    }
-    need(lo >= 0 && hi < count,
-         call + ": field \"" + name + "\": the block with its stored ghosts " + shape_text(n) + " (x, y, z) at strides " +
-             shape_text({st[0], st[1], st[2]}) + " reaches elements " + std::to_string(lo) + " .. " + std::to_string(hi) +
-             " of the buffer, which holds " + std::to_string(count) + (count > 0 ? " (0 .. " + std::to_string(count - 1) + ")" : ""));
-    bind_field(s, name, data, type, st);
+    bind_field(s, call, name, data, type, field_strides(s, call, name, data, type, strides), count);
   });
 }
 
 int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
                               const long long extents[3], const long long strides[3]) {
   return guarded(s, [&] {
-    const std::string call = "panoptes_set_field_layout";
-    need(s && name && extents && strides, call + ": null session, name, extents or strides");
-    need(s->block.has_value(), call + ": call panoptes_set_block first");
-    const auto axis = parse_layout(layout, call);
-    const std::string lay = std::string("\"") + layout + "\"";
-    const auto n = ghosted_extent(*s->block);
-    const std::array<long long, 3> got{extents[0], extents[1], extents[2]};
-    std::array<long long, 3> want{};
-    for (int d = 0; d < 3; ++d) want[d] = n[axis[d]];
-    if (got != want) {
-      std::string msg = call + ": field \"" + name + "\" has shape " + shape_text(got) + "; the block with its stored ghosts is " +
-                        shape_text(n) + " points (x, y, z), which in layout " + lay + " is the shape " + shape_text(want);
-      // A hint when the array fits the block in another axis order (the usual mistake: z fastest).
-      static const char* const orders[] = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx"};
-      for (const char* o : orders) {
-        const auto ax = parse_layout(o, call);
-        if (std::array<long long, 3>{n[ax[0]], n[ax[1]], n[ax[2]]} == got && ax != axis) {
-          msg += std::string("; the array fits layout \"") + o + "\": is that its axis order?";
-          break;
-        }
-      }
-      throw UsageError(msg);
-    }
-    need(data, call + ": field \"" + std::string(name) + "\": null data");
-    std::array<std::int64_t, 3> st{};
-    for (int d = 0; d < 3; ++d) {
-      need(strides[d] != 0 || got[d] <= 1, call + ": field \"" + std::string(name) + "\" has stride 0 along dimension " + std::to_string(d + 1));
-      st[axis[d]] = strides[d];
-    }
-    bind_field(s, name, data, type, field_strides(s, call, name, data, type, std::array<long long, 3>{st[0], st[1], st[2]}.data()));
+    set_field_layout(s, "panoptes_set_field_layout", name, data, type, layout, extents, strides, std::nullopt);
+  });
+}
+
+int panoptes_set_field_layout_n(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
+                                const long long extents[3], const long long strides[3], long long count) {
+  return guarded(s, [&] {
+    set_field_layout(s, "panoptes_set_field_layout_n", name, data, type, layout, extents, strides, count);
   });
 }
 
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken) {
   return guarded(s, [&] {
+    if (taken) *taken = 0;  // also when refused
     insitu::Session& ss = session_of(s);
     const bool t = ss.process(step, time, inputs(s));
     if (taken) *taken = t ? 1 : 0;

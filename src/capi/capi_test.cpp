@@ -2,6 +2,8 @@
 // bound, layouts are parsed and checked, errors are printed as the error mode says and returned as codes.
 #include <gtest/gtest.h>
 
+#include <climits>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -55,6 +57,55 @@ TEST_F(Capi, ShortBufferIsRefusedAndNothingIsBound) {
   EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
 }
 
+// Issue 42, point 6: the bounds check multiplied extents by strides in plain 64-bit arithmetic, so a
+// huge stride wrapped back into the buffer: {1, 8, LLONG_MAX/3 + 1} with the true count was accepted
+// (a SIGSEGV at the next snapshot) and a stride of 2^62 read plane 0 for every z. Now refused by every
+// set_field call, with or without a count.
+TEST_F(Capi, HugeStridesAreRefusedNotWrapped) {
+  std::vector<float> T(224, 0.5f);
+  const long long wraps[3] = {1, 8, LLONG_MAX / 3 + 1}, plane0[3] = {1, 8, 1LL << 62};
+  for (const long long* st : {wraps, plane0}) {
+    EXPECT_EQ(panoptes_set_field_n(s_, "T", T.data(), PANOPTES_FLOAT32, st, 224), PANOPTES_ERROR_USAGE) << st[2];
+    EXPECT_NE(std::string(panoptes_last_error()).find("reaches further than 64-bit offsets can address"), std::string::npos)
+        << panoptes_last_error();
+    EXPECT_EQ(panoptes_set_field(s_, "T", T.data(), PANOPTES_FLOAT32, st), PANOPTES_ERROR_USAGE) << st[2];
+    const long long extents[3] = {8, 7, 4};
+    EXPECT_EQ(panoptes_set_field_layout(s_, "T", T.data(), PANOPTES_FLOAT32, "xyz", extents, st), PANOPTES_ERROR_USAGE);
+  }
+  // A stride whose element reach fits but whose byte offsets do not (2^61 doubles = 2^64 bytes).
+  std::vector<double> D(224, 0.5);
+  const long long bytes[3] = {1, 8, 1LL << 61};
+  EXPECT_EQ(panoptes_set_field(s_, "T", D.data(), PANOPTES_FLOAT64, bytes), PANOPTES_ERROR_USAGE);
+  EXPECT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_ERROR_RUN);  // nothing was bound
+  const long long contiguous[3] = {0, 0, 0};  // panoptes_set_field's other spelling of NULL stays accepted
+  EXPECT_EQ(panoptes_set_field(s_, "T", T.data(), PANOPTES_FLOAT32, contiguous), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_set_field_n(s_, "T", T.data(), PANOPTES_FLOAT32, nullptr, 224), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
+}
+
+// panoptes_set_field_layout takes no element count; its _n form does, as panoptes_set_field_n.
+TEST_F(Capi, LayoutWithACountChecksTheBuffer) {
+  std::vector<double> V(224, 0.5);  // V[x][y][z], z fastest: extents (8, 7, 4), strides (28, 4, 1)
+  const long long extents[3] = {8, 7, 4}, strides[3] = {28, 4, 1}, padded[3] = {32, 4, 1}, reversed[3] = {-28, 4, 1};
+  EXPECT_EQ(panoptes_set_field_layout_n(s_, "T", V.data(), PANOPTES_FLOAT64, "xyz", extents, strides, 223), PANOPTES_ERROR_USAGE);
+  EXPECT_NE(std::string(panoptes_last_error()).find("panoptes_set_field_layout_n: field \"T\""), std::string::npos)
+      << panoptes_last_error();
+  EXPECT_NE(std::string(panoptes_last_error()).find("reaches elements 0 .. 223 of the buffer, which holds 223"), std::string::npos)
+      << panoptes_last_error();
+  EXPECT_EQ(panoptes_set_field_layout_n(s_, "T", V.data(), PANOPTES_FLOAT64, "xyz", extents, padded, 224), PANOPTES_ERROR_USAGE);
+  EXPECT_EQ(panoptes_set_field_layout_n(s_, "T", V.data(), PANOPTES_FLOAT64, "xyz", extents, reversed, 224), PANOPTES_ERROR_USAGE);
+  EXPECT_NE(std::string(panoptes_last_error()).find("a negative stride reaches before data"), std::string::npos)
+      << panoptes_last_error();
+  const long long zfirst[3] = {4, 8, 7};  // the wrong axis order is still named
+  EXPECT_EQ(panoptes_set_field_layout_n(s_, "T", V.data(), PANOPTES_FLOAT64, "xyz", zfirst, strides, 224), PANOPTES_ERROR_USAGE);
+  EXPECT_NE(std::string(panoptes_last_error()).find("fits layout \"zxy\""), std::string::npos) << panoptes_last_error();
+  EXPECT_EQ(panoptes_set_field_layout_n(s_, "T", V.data(), PANOPTES_FLOAT64, "xyz", extents, strides, 224), PANOPTES_OK)
+      << panoptes_last_error();
+  EXPECT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
+}
+
 TEST_F(Capi, LayoutShapesAreCheckedAndNamed) {
   std::vector<double> T(224, 0.5);
   // A C array V[x][y][z] (z fastest) declared as such: extents per dimension (x, y, z), strides to match.
@@ -98,6 +149,26 @@ TEST_F(Capi, DueFollowsTheScheduleAndSnapshotForcesOne) {
   EXPECT_EQ(panoptes_snapshot(s_, 0.5), PANOPTES_OK);
   int taken = -1;
   EXPECT_EQ(panoptes_process(s_, 3, 3.0, &taken), PANOPTES_OK);
+  EXPECT_EQ(taken, 1);
+  EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
+}
+
+// Issue 42, point 5: NaN / inf times were taken (return 0) and made the manifest unreadable; times
+// going back were stored. Now PANOPTES_ERROR_USAGE with the value and the previous time named.
+TEST_F(Capi, TimesMustBeFiniteAndIncreasing) {
+  std::vector<float> T(224, 0.5f);
+  ASSERT_EQ(panoptes_set_field_n(s_, "T", T.data(), PANOPTES_FLOAT32, nullptr, 224), PANOPTES_OK);
+  int taken = -1;
+  EXPECT_EQ(panoptes_process(s_, 0, std::nan(""), &taken), PANOPTES_ERROR_USAGE);
+  EXPECT_EQ(taken, 0);
+  EXPECT_NE(std::string(panoptes_last_error()).find("time nan; expected a finite simulation time"), std::string::npos)
+      << panoptes_last_error();
+  EXPECT_EQ(panoptes_snapshot(s_, HUGE_VAL), PANOPTES_ERROR_USAGE);
+  EXPECT_EQ(panoptes_snapshot(s_, 1.0), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_process(s_, 3, 0.5, &taken), PANOPTES_ERROR_USAGE);
+  EXPECT_NE(std::string(panoptes_last_error()).find("time 0.5 is not after the previous snapshot's time 1"), std::string::npos)
+      << panoptes_last_error();
+  EXPECT_EQ(panoptes_process(s_, 6, 2.0, &taken), PANOPTES_OK) << panoptes_last_error();
   EXPECT_EQ(taken, 1);
   EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
 }

@@ -14,6 +14,7 @@
 !   call panoptes_halo(viz, valid_lo, valid_hi)                         ! optional: ghosts kept up to date
 !   do step = ...
 !     call panoptes_field(viz, 'T', v, layout='zxy')  ! v(k,i,j): z fastest; sections and padding allowed
+!                                                     ! (optional args: ierr, layout; or 'zxy' 4th)
 !     call panoptes_step(viz, step, time)             ! integer(4|8) step, real(4|8) time
 !   end do
 !   call panoptes_close(viz)
@@ -172,8 +173,13 @@ module panoptes
   end interface
   !> Binds a field: a real(4) or real(8) 3-D array (or section) INCLUDING its stored ghost layers, in the
   !> axis order `layout` (default 'xyz': first index x).
+  !> Optional arguments: ierr 4th and layout 5th, as before layout existed (old code passes ierr
+  !> positionally), or by keyword in any order; field_r4_order / field_r8_order take the layout 4th
+  !> positionally, as issue 28's module did: `call panoptes_field(viz, 'T', v, 'zxy'[, ierr])`. The two
+  !> kinds of specifics differ in the type of the 4th argument and in its name (`order` is required
+  !> there, and the others have no `order`), so every call resolves to exactly one.
   interface panoptes_field
-    module procedure field_r4, field_r8
+    module procedure field_r4, field_r8, field_r4_order, field_r8_order
   end interface
   !> Renders a snapshot if the schedule asks for one at (step, time): integer(4|8) step, real(4|8) time.
   interface panoptes_step
@@ -372,7 +378,7 @@ contains
                                   extents, strides), ierr)
   end subroutine
 
-  subroutine field_r4(s, name, a, layout, ierr)
+  subroutine field_r4(s, name, a, ierr, layout)
     type(panoptes_t), intent(in) :: s
     character(len=*), intent(in) :: name
     real(real32), target, intent(inout) :: a(:, :, :)
@@ -392,7 +398,7 @@ contains
     call bind_array(s, name, p, F32, layout, n, st, ierr)
   end subroutine
 
-  subroutine field_r8(s, name, a, layout, ierr)
+  subroutine field_r8(s, name, a, ierr, layout)
     type(panoptes_t), intent(in) :: s
     character(len=*), intent(in) :: name
     real(real64), target, intent(inout) :: a(:, :, :)
@@ -410,6 +416,24 @@ contains
       if (n(3) > 1) st(3) = distance(p, c_loc(a(1, 1, 2)), 8)
     end if
     call bind_array(s, name, p, F64, layout, n, st, ierr)
+  end subroutine
+
+  subroutine field_r4_order(s, name, a, order, ierr)
+    type(panoptes_t), intent(in) :: s
+    character(len=*), intent(in) :: name
+    real(real32), target, intent(inout) :: a(:, :, :)
+    character(len=*), intent(in) :: order
+    integer, intent(out), optional :: ierr
+    call field_r4(s, name, a, ierr, order)
+  end subroutine
+
+  subroutine field_r8_order(s, name, a, order, ierr)
+    type(panoptes_t), intent(in) :: s
+    character(len=*), intent(in) :: name
+    real(real64), target, intent(inout) :: a(:, :, :)
+    character(len=*), intent(in) :: order
+    integer, intent(out), optional :: ierr
+    call field_r8(s, name, a, ierr, order)
   end subroutine
 
   subroutine do_step(s, step, time, taken, ierr)

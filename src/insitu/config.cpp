@@ -116,7 +116,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   only_keys(c, root, "", allowed);
   SessionConfig s;
   if (const auto* o = table(c, root, "output")) {
-    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "title", "units", "time_units", "field_units"});
+    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "resume_complete", "title", "units", "time_units", "field_units"});
     s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
     // `overwrite = true/false` is the key's old spelling: it still means mode "overwrite"/"create".
     if (o->get("mode") && o->get("overwrite"))
@@ -132,6 +132,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
         c.fail("output.mode", "\"" + m + "\"; expected \"create\", \"overwrite\" or \"resume\"");
       }
     }
+    s.resume_complete = boolean(c, *o, "resume_complete", "output.", false);
     s.title = str(c, *o, "title", "output.", s.title);
     s.units = str(c, *o, "units", "output.", "");
     s.time_units = str(c, *o, "time_units", "output.", "");
@@ -323,7 +324,8 @@ const char* config_keys_help() {
             mode = "create" (refuse a directory that holds a database) | "overwrite" (replace it) |
             "resume" (continue it after a checkpoint restart: its snapshots stay, snapshots repeated by
             the restarted run (time <= the last written time) are skipped, the movies go on; rig, tasks,
-            grid, image and video settings must be the ones it was written with);
+            grid, image, video settings and schedule must be the ones it was written with; a complete
+            database is refused unless resume_complete = true, which appends to the finished run);
             overwrite = true | false is the old spelling of mode = "overwrite" | "create"
 [image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box);
             compass = true (360-degree frames: horizon, a tick every 45 degrees, N/E/S/W)

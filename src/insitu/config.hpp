@@ -65,7 +65,9 @@ enum class OutputMode {
   overwrite,  ///< replace it
   /// Continue it after a checkpoint restart: the snapshots it holds stay, snapshots the restarted run
   /// repeats (time ≤ the last one written) are skipped, and the movies go on from there. The rig,
-  /// tasks, grid, image and video settings must be the ones it was written with.
+  /// tasks, grid, image, video settings and schedule must be the ones it was written with. Only an
+  /// interrupted database is continued; a complete one (its run finished) is refused unless
+  /// SessionConfig::resume_complete says to append to it.
   resume
 };
 /// "create" / "overwrite" / "resume".
@@ -103,6 +105,10 @@ enum class ScaleSharing {
 struct SessionConfig {
   std::string output_dir = "panoptes_out";
   OutputMode mode = OutputMode::create;
+  /// [output] resume_complete: mode = "resume" may continue a database whose run finished (extend a
+  /// finished run from its last checkpoint). Off by default: a rerun into the same directory would
+  /// otherwise skip every snapshot (their times are all in the database) and keep the old movies.
+  bool resume_complete = false;
   std::string title = "in-situ visualization";
   std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
   std::string command_line;

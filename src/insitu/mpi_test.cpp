@@ -2,6 +2,7 @@
 //   insitu_mpi_test write DIR   — renders a known field (slabs along z, double data without ghosts for
 //       one field, float data with 2 ghost layers for the other) and checks every finished frame on its
 //       owner rank against the same field rendered directly on the whole grid (max difference ≤ 1/255).
+//   insitu_mpi_test refusals DIR — one rank's bad fields are refused by every rank, without a hang.
 //   insitu_mpi_test compare DIR1 DIR2...  — every database is complete and every frame of every stream
 //       matches the first database's with PSNR ≥ 45 dB (rank independence).
 #include <mpi.h>
@@ -202,6 +203,66 @@ int compare(const std::vector<std::string>& dirs) {
   return worst >= 45 ? 0 : 1;
 }
 
+// Refusals of one rank's own arguments (issue 42): rank 1 hands a field whose stride of 2^62 floats
+// overflows 64-bit offsets, then omits a field, then gives a NaN time to process() on a due step, then
+// a time that does not increase; every rank must refuse each snapshot (before, the refusing rank left
+// and the others waited for it in the snapshot's collectives: this test timed out), nothing is
+// written, and the same session then takes good snapshots.
+int refusals(const std::string& dir) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const render::GridGeometry g = test_grid();
+  insitu::SessionConfig cfg = insitu::parse_session_config_text(kConfig, "mpi refusals");
+  cfg.output_dir = dir;
+  const insitu::LocalBlock block = insitu::LocalBlock::slab(g, 2, size, rank, 2);
+  const std::int64_t nx = g.dims[0], ny = g.dims[1];
+  const std::int64_t nz = block.extent[2] + block.ghost_lo[2] + block.ghost_hi[2];
+  std::vector<float> a(std::size_t(nx * ny * nz), 0.5f), b(a.size(), 0.25f);
+  const std::int64_t first = block.ghost_lo[2] * nx * ny;  // the first owned point
+  const insitu::FieldInput good_a{"a", a.data() + first, insitu::ScalarType::f32, {0, 0, 0}};
+  const insitu::FieldInput good_b{"b", b.data() + first, insitu::ScalarType::f32, {0, 0, 0}};
+  const insitu::FieldInput huge_b{"b", b.data() + first, insitu::ScalarType::f32, {1, nx, std::int64_t(1) << 62}};
+  insitu::Session s(cfg, g, block, MPI_COMM_WORLD);
+  int failures = 0;
+  auto expect_refused = [&](const std::vector<insitu::FieldInput>& fields, const std::string& want, double t,
+                            bool process = false) {
+    try {
+      if (process)
+        s.process(0, t, fields);
+      else
+        s.snapshot(t, fields);
+      std::fprintf(stderr, "rank %d: FAIL: the snapshot at %g was taken\n", rank, t);
+      ++failures;
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      if (what.find(want) == std::string::npos) {
+        std::fprintf(stderr, "rank %d: FAIL: \"%s\" does not say \"%s\"\n", rank, what.c_str(), want.c_str());
+        ++failures;
+      }
+    }
+  };
+  const bool bad = rank == 1 % size;  // rank 1, or rank 0 alone
+  const std::string other = "rank 1 refused its time or fields";
+  expect_refused({good_a, bad ? huge_b : good_b}, bad ? "reach further than 64-bit offsets" : other, 0);
+  if (bad) expect_refused({good_a}, "field \"b\" (read by a task) was not given", 0);
+  else expect_refused({good_a, good_b}, other, 0);
+  expect_refused({good_a, good_b}, bad ? "time nan; expected a finite" : other, bad ? NAN : 0.0, true);
+  if (s.snapshots() != 0) ++failures;
+  s.snapshot(0, {good_a, good_b});
+  expect_refused({good_a, good_b}, bad ? "time 0 is not after the previous snapshot's time 0" : other, bad ? 0.0 : 1.0);
+  s.snapshot(1, {good_a, good_b});
+  s.finalize();
+  if (rank == 0) {
+    const auto db = store::Database::open(dir);
+    if (db.frame_count() != 2 || db.status() != store::Status::complete) ++failures;
+  }
+  int all = failures;
+  MPI_Allreduce(&failures, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  if (rank == 0) std::printf("refusals: %s\n", all ? "FAILED" : "every rank refused each bad snapshot; the good one was taken");
+  return all ? 1 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -210,6 +271,7 @@ int main(int argc, char** argv) {
   try {
     const std::string mode = argc > 1 ? argv[1] : "";
     if (mode == "write" && argc == 3) rc = write(argv[2]);
+    else if (mode == "refusals" && argc == 3) rc = refusals(argv[2]);
     else if (mode == "compare" && argc >= 4) rc = compare(std::vector<std::string>(argv + 2, argv + argc));
     else std::fprintf(stderr, "usage: insitu_mpi_test write DIR | compare DIR1 DIR2...\n");
   } catch (const std::exception& e) {

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/number_text.hpp"
 
 namespace panoptes::insitu {
 
@@ -40,6 +41,33 @@ std::string message_of(std::exception_ptr e) {
   }
 }
 
+// What resume may not continue, checked against the database's manifest before the store opens it:
+// a database whose run finished (unless resume_complete), and another schedule than it was written
+// with (the store compares what the manifest records of the images, not the session's schedule).
+void refuse_resume(const SessionConfig& cfg, const store::Manifest& now) {
+  struct stat st{};
+  const std::string man = cfg.output_dir + "/panoptes.json";
+  if (::lstat(man.c_str(), &st) != 0) return;  // nothing to resume: the store starts a new database
+  const store::Manifest old = store::read_manifest(man);
+  if (old.status == store::Status::complete && !cfg.resume_complete) {
+    const int n = old.frames_written;
+    const std::string last = n > 0 && std::size_t(n) <= old.times.size()
+                                 ? " up to time " + number_text(old.times[std::size_t(n) - 1])
+                                 : "";
+    throw FileError(cfg.output_dir, "holds a complete database (its run finished: " + std::to_string(n) + " snapshots" + last +
+                                        "); [output] mode = \"resume\" continues only an interrupted run, and this run's "
+                                        "snapshots up to that time would be skipped, leaving the old movies. Set mode = "
+                                        "\"overwrite\" to replace it, write to another [output] dir, or set [output] "
+                                        "resume_complete = true to append to the finished run");
+  }
+  const auto was = old.provenance.extra.find(kScheduleNote);
+  const auto is = now.provenance.extra.find(kScheduleNote);
+  if (was != old.provenance.extra.end() && is != now.provenance.extra.end() && was->second != is->second)
+    throw FileError(cfg.output_dir, "cannot resume this database: the schedule ([schedule]) differs (" + was->second +
+                                        " in the database, " + is->second +
+                                        " in this run); a resumed run must use the configuration it was written with");
+}
+
 }  // namespace
 
 std::string format_references(const std::vector<double>& refs) {
@@ -50,6 +78,15 @@ std::string format_references(const std::vector<double>& refs) {
     out += (out.empty() ? "" : " ") + std::string(buf);
   }
   return out;
+}
+
+std::string schedule_text(const ScheduleConfig& schedule) {
+  if (schedule.every_time > 0) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "every_time = %.17g", schedule.every_time);
+    return buf;
+  }
+  return "every_steps = " + std::to_string(schedule.every_steps);
 }
 
 std::vector<double> parse_references(const std::string& text) {
@@ -69,6 +106,7 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
       store::WriterOptions o;
       o.owned_cameras = owned;
       if (cfg.mode == OutputMode::resume) {
+        refuse_resume(cfg, manifest);
         out.writer.emplace(store::DatabaseWriter::resume(cfg.output_dir, manifest, o));
         const store::Manifest& m = out.writer->manifest();
         out.frames = m.frames_written;

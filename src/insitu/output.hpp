@@ -19,6 +19,11 @@ namespace panoptes::insitu {
 /// Provenance note in which the session keeps the running references of relative windows
 /// (every field's, whatever its SessionConfig::reference mode), so that a resumed run goes on with them.
 inline constexpr const char* kRunningMaxNote = "insitu.running_max";
+/// Provenance note holding the schedule ("every_steps = 10" or "every_time = 0.25"): the manifest has
+/// no other place for it, and a resumed run with another schedule would mix two cadences in one movie.
+inline constexpr const char* kScheduleNote = "insitu.schedule";
+/// The kScheduleNote text of a schedule (every_time exactly, %.17g).
+std::string schedule_text(const ScheduleConfig& schedule);
 
 /// A database opened for a session.
 struct SessionOutput {

@@ -202,4 +202,144 @@ TEST(InsituResume, NothingToResumeStartsANewDatabase) {
   fs::remove_all(dir);
 }
 
+std::string refusal_of(insitu::Session& s, double time, int step = -1) {
+  const auto f = field(0);
+  const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
+  try {
+    if (step >= 0)
+      s.process(step, time, in);
+    else
+      s.snapshot(time, in);
+  } catch (const Error& e) {  // insitu::UsageError
+    return e.what();
+  }
+  return "";
+}
+
+// Issue 42, point 5: NaN or ±inf times were stored (as null in the manifest, which no reader then
+// opened) and times going back were stored as given. They are refused at the call, naming the value
+// and the previous time, and the database stays readable with the snapshots taken before.
+TEST(InsituTimes, NonFiniteAndDecreasingTimesAreRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_times_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    const auto f = field(0);
+    const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
+    for (double t : {0.0, 1.0, 2.0}) s.snapshot(t, in);
+    EXPECT_NE(refusal_of(s, NAN).find("snapshot: time nan; expected a finite"), std::string::npos) << refusal_of(s, NAN);
+    EXPECT_NE(refusal_of(s, INFINITY, 3).find("time inf; expected a finite"), std::string::npos) << refusal_of(s, INFINITY, 3);
+    EXPECT_NE(refusal_of(s, -INFINITY).find("time -inf"), std::string::npos);
+    EXPECT_THROW((void)s.due(4, NAN), Error);
+    const std::string back = refusal_of(s, 1.5);
+    EXPECT_NE(back.find("time 1.5 is not after the previous snapshot's time 2"), std::string::npos) << back;
+    EXPECT_NE(refusal_of(s, 2.0, 5).find("time 2 is not after"), std::string::npos);  // equal: not after
+    EXPECT_EQ(s.snapshots(), 3);
+    s.snapshot(4.0, in);
+  }  // destroyed without finalize: interrupted, and readable
+  const auto db = store::Database::open(dir);
+  ASSERT_EQ(db.frame_count(), 4);
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(db.manifest().frame_time(k), std::vector<double>({0, 1, 2, 4})[std::size_t(k)]);
+  fs::remove_all(dir);
+}
+
+// A resumed run repeats the steps since its checkpoint: times at or before the database's last one
+// are skipped until it writes its first new snapshot; after that, a time going back is refused.
+TEST(InsituTimes, ResumeSkipsRepeatedTimesOnlyBeforeItsFirstNewSnapshot) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_times_resume_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const auto f = field(0);
+  const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    for (int step = 0; step < 3; ++step) s.process(step, time_of(step), in);
+  }  // interrupted after t = 0, 0.2, 0.4
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+    EXPECT_FALSE(s.process(1, time_of(1), in));  // repeated: skipped, no error
+    EXPECT_FALSE(s.process(2, time_of(2), in));
+    EXPECT_TRUE(s.process(3, time_of(3), in));
+    const std::string back = refusal_of(s, 0.5, 4);
+    EXPECT_NE(back.find("time 0.5 is not after the previous snapshot's time 0.6"), std::string::npos) << back;
+    EXPECT_NE(back.find("a resumed run skips only"), std::string::npos) << back;
+    EXPECT_TRUE(s.process(4, time_of(4), in));
+    s.finalize();
+  }
+  EXPECT_EQ(store::Database::open(dir).frame_count(), 5);
+  fs::remove_all(dir);
+}
+
+std::string resume_refusal(const insitu::SessionConfig& c) {
+  try {
+    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+// Issue 42, point 4: mode = "resume" on a FINISHED database took it (one info line, exit 0) and
+// skipped every snapshot of the rerun, whose times were all in the database: a rerun with a changed
+// source kept the old movies. A complete database is refused, naming the directory and the options.
+TEST(InsituResume, RefusesACompleteDatabase) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_complete_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  run(dir, insitu::OutputMode::create, 0);  // finished: complete, kSteps snapshots
+  const std::string why = resume_refusal(config(dir, insitu::OutputMode::resume));
+  EXPECT_NE(why.find(dir.string() + ": holds a complete database (its run finished: 6 snapshots up to time 1)"),
+            std::string::npos) << why;
+  EXPECT_NE(why.find("mode = \"overwrite\""), std::string::npos) << why;
+  EXPECT_NE(why.find("another [output] dir"), std::string::npos) << why;
+  EXPECT_NE(why.find("resume_complete = true"), std::string::npos) << why;
+  const auto db = store::Database::open(dir);  // untouched
+  EXPECT_EQ(db.status(), store::Status::complete);
+  EXPECT_EQ(db.frame_count(), kSteps);
+  fs::remove_all(dir);
+}
+
+// ... unless the configuration asks for it: [output] resume_complete = true appends to the finished run.
+TEST(InsituResume, ResumeCompleteAppendsToAFinishedRun) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_append_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  run(dir, insitu::OutputMode::create, 0);
+  EXPECT_TRUE(insitu::parse_session_config_text(std::string(kConfig) + "[output]\nresume_complete = true\n", "t").resume_complete);
+  insitu::SessionConfig c = config(dir, insitu::OutputMode::resume);
+  c.resume_complete = true;
+  {
+    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    EXPECT_EQ(s.snapshots(), kSteps);
+    const auto f = field(time_of(kSteps));
+    EXPECT_TRUE(s.process(kSteps, time_of(kSteps), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
+    s.finalize();
+  }
+  EXPECT_EQ(store::Database::open(dir).frame_count(), kSteps + 1);
+  fs::remove_all(dir);
+}
+
+// Issue 42, point 4: a changed every_steps (or every_time) on resume was accepted silently; it is
+// named like every other change, and the database is left as it was.
+TEST(InsituResume, RefusesAnotherSchedule) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_resume_schedule_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    const auto f = field(0);
+    s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }  // interrupted
+  insitu::SessionConfig steps = config(dir, insitu::OutputMode::resume);
+  steps.schedule.every_steps = 2;
+  const std::string a = resume_refusal(steps);
+  EXPECT_NE(a.find("the schedule ([schedule]) differs (every_steps = 1 in the database, every_steps = 2 in this run)"),
+            std::string::npos) << a;
+  insitu::SessionConfig time = config(dir, insitu::OutputMode::resume);
+  time.schedule.every_steps = 0;
+  time.schedule.every_time = 0.25;
+  const std::string b = resume_refusal(time);
+  EXPECT_NE(b.find("every_steps = 1 in the database, every_time = 0.25 in this run"), std::string::npos) << b;
+  insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+  EXPECT_EQ(s.snapshots(), 1);
+  s.finalize();
+  fs::remove_all(dir);
+}
+
 }  // namespace

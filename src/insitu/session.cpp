@@ -23,6 +23,7 @@
 #include "core/stop_request.hpp"
 #include "core/log.hpp"
 #include "core/number_text.hpp"
+#include "core/strided.hpp"
 #include "insitu/halo.hpp"
 #include "insitu/output.hpp"
 #include "insitu/resources.hpp"
@@ -90,9 +91,12 @@ struct Session::Impl {
   std::vector<int> owned;
   int snapshots = 0;
   double next_time = 0;
-  // Resume: the time of the last snapshot written; the restarted run's snapshots at or before it
-  // (repeated after a checkpoint restart) are skipped, so times stay increasing.
+  // The time of the last snapshot written (this run's or, after a resume, the database's): snapshot
+  // times must increase. Resume: until the restarted run writes its first snapshot, its times at or
+  // before the database's last one are the steps it repeats since its checkpoint and are skipped;
+  // once it has written one, a time that goes back is a mistake like in any run.
   bool resumed = false;
+  int written = 0;  // snapshots written by this run
   double last_time = -INFINITY;
   bool finalized = false;
   FrameObserver observer;
@@ -133,10 +137,17 @@ struct Session::Impl {
 
   void init();
   bool repeated(double time) const {
-    return resumed && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
+    return resumed && written == 0 && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
+  }
+  // NaN or ±inf would be stored as null in the manifest, which then no reader accepts.
+  static void check_finite(const char* call, double time) {
+    if (!std::isfinite(time))
+      throw UsageError(std::string(call) + ": time " + number_text(time) + "; expected a finite simulation time");
   }
   void check_resources();
   store::Manifest make_manifest() const;
+  std::exception_ptr time_refusal(double time) const;
+  std::exception_ptr field_refusal(const std::vector<FieldInput>& fields) const;
   void load_fields(const std::vector<FieldInput>& fields);
   double global_percentile(int field);
   double window_reference(int field);
@@ -285,6 +296,7 @@ store::Manifest Session::Impl::make_manifest() const {
   man.provenance.version = panoptes::kVersion;
   man.provenance.command_line = cfg.command_line;
   man.provenance.extra["mpi_ranks"] = std::to_string(size);
+  man.provenance.extra[kScheduleNote] = schedule_text(cfg.schedule);
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
   man.domain.origin = grid.origin;
   man.domain.spacing = grid.spacing;
@@ -330,6 +342,45 @@ store::Manifest Session::Impl::make_manifest() const {
 
 // Copies (and converts) every field to float32 over this rank's required point range: the points
 // its arrays hold valid values for are read there, the others come from their owners (halo.hpp).
+// This rank's fields, checked before the snapshot's first collective (the caller agrees on the
+// outcome with the other ranks, so a refusal on one rank cannot leave the others waiting): every field
+// a task reads is given, and its strides address the ghosted block without overflowing 64-bit offsets
+// (FieldInput carries no size; a wrapped offset would read plane 0 for every z, or far outside).
+// This rank's snapshot time: finite, and after the previous snapshot's (a resumed run's repeats were
+// skipped before). Checked with the fields, before the snapshot's first collective.
+std::exception_ptr Session::Impl::time_refusal(double time) const {
+  if (!std::isfinite(time))
+    return std::make_exception_ptr(UsageError("snapshot: time " + number_text(time) + "; expected a finite simulation time"));
+  if (std::isfinite(last_time) && !(time > last_time))
+    return std::make_exception_ptr(UsageError(
+        "snapshot: time " + number_text(time) + " is not after the previous snapshot's time " + number_text(last_time) +
+        "; snapshot times must increase" +
+        (resumed && written > 0 ? " (a resumed run skips only the times it repeats before its first new snapshot)" : "")));
+  return nullptr;
+}
+
+std::exception_ptr Session::Impl::field_refusal(const std::vector<FieldInput>& fields) const {
+  for (const std::string& name : field_names) {
+    const FieldInput* in = nullptr;
+    for (const FieldInput& x : fields)
+      if (x.name == name) in = &x;
+    if (!in || !in->data)
+      return std::make_exception_ptr(Error("snapshot: field \"" + name + "\" (read by a task) was not given or has no data"));
+    const LocalBlock& lb = block;
+    const std::array<std::int64_t, 3> st = halo::field_strides(lb, in->stride);
+    const std::array<std::int64_t, 3> n{std::int64_t(lb.extent[0]) + lb.ghost_lo[0] + lb.ghost_hi[0],
+                                        std::int64_t(lb.extent[1]) + lb.ghost_lo[1] + lb.ghost_hi[1],
+                                        std::int64_t(lb.extent[2]) + lb.ghost_lo[2] + lb.ghost_hi[2]};
+    const std::int64_t elem = in->type == ScalarType::f64 ? 8 : 4;
+    if (!strided_reach(n, st, elem, {lb.ghost_lo[0], lb.ghost_lo[1], lb.ghost_lo[2]}))
+      return std::make_exception_ptr(UsageError(
+          "snapshot: field \"" + name + "\": strides (" + std::to_string(st[0]) + ", " + std::to_string(st[1]) + ", " +
+          std::to_string(st[2]) + ") over the ghosted block (" + std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " +
+          std::to_string(n[2]) + ") reach further than 64-bit offsets can address; expected the strides of an array in memory"));
+  }
+  return nullptr;
+}
+
 void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   const BlockInfo& b = me();
   const Box& req = b.has_brick ? b.required : b.owned;
@@ -338,7 +389,7 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   for (std::size_t f = 0; f < field_names.size(); ++f) {
     for (const FieldInput& in : fields)
       if (in.name == field_names[f]) inputs[f] = &in;
-    if (!inputs[f] || !inputs[f]->data)
+    if (!inputs[f] || !inputs[f]->data)  // refused by field_refusal() before the snapshot's collectives
       throw Error("snapshot: field \"" + field_names[f] + "\" (read by a task) was not given or has no data");
     buffers[f].resize(std::size_t(req.size()));
   }
@@ -646,6 +697,7 @@ Session::~Session() {
 
 bool Session::due(std::int64_t step, double time) const {
   const ScheduleConfig& s = impl_->cfg.schedule;
+  Impl::check_finite("due", time);
   if (impl_->finalized) return false;
   if (s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots) return false;
   if (impl_->repeated(time)) return false;
@@ -659,6 +711,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   if (m.finalized) throw Error("snapshot: the session is finalized");
   // [output] mode = "resume": a restarted run repeats the steps since its checkpoint; what the
   // database already holds is not written twice (the same time on every rank: the same decision).
+  // NaN is never a repeat: it is refused below.
   if (m.repeated(time)) {
     if (m.rank == 0)
       log::info(m.cfg.output_dir + ": snapshot at time " + number_text(time) + " skipped: the resumed database already holds "
@@ -670,13 +723,23 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
   // does): every rank stops before this snapshot; the writer's destructor marks the database
   // interrupted with the snapshots taken so far.
-  int stop = stop_requested();
+  // The time and the fields are this rank's own arguments (another rank's may be fine): every rank
+  // learns in the same reduction whether any refused its own, and then all refuse this snapshot
+  // instead of waiting for that rank in the snapshot's collectives.
+  std::exception_ptr refusal = m.time_refusal(time);
+  if (!refusal) refusal = m.field_refusal(fields);
+  int agree[2] = {stop_requested(), refusal ? m.rank + 1 : 0};
 #ifdef PANOPTES_HAVE_MPI
-  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, m.comm);
+  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, agree, 2, MPI_INT, MPI_MAX, m.comm);
 #endif
+  const int stop = agree[0];
   if (stop)
     throw Interrupted(stop, m.cfg.output_dir + ": stopped by " + signal_name(stop) + " before snapshot " +
                                 std::to_string(m.snapshots) + "; the database is marked interrupted");
+  if (refusal) std::rethrow_exception(refusal);
+  if (agree[1])
+    throw Error("snapshot: rank " + std::to_string(agree[1] - 1) + " refused its time or fields (its message says why); no rank "
+                "took this snapshot");
   auto t0 = Clock::now();
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());
@@ -695,6 +758,7 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   m.time.copy += since(t0);
   m.render_snapshot(m.snapshots);
   ++m.snapshots;
+  ++m.written;
   m.last_time = time;
   if (m.cfg.schedule.every_time > 0)
     m.next_time = (std::floor(time / m.cfg.schedule.every_time + 1e-9) + 1) * m.cfg.schedule.every_time;
@@ -702,6 +766,18 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
 }
 
 bool Session::process(std::int64_t step, double time, const std::vector<FieldInput>& fields) {
+  if (!std::isfinite(time)) {
+    // due() cannot answer for such a time. Under an every_steps schedule the step decides: a due step
+    // takes the time into snapshot(), which refuses it on every rank (one rank's NaN then cannot leave
+    // the others waiting there); a step that is not due, or an every_time schedule, refuses it here.
+    const ScheduleConfig& s = impl_->cfg.schedule;
+    if (s.every_steps > 0 && step % s.every_steps == 0 && !impl_->finalized &&
+        !(s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots)) {
+      snapshot(time, fields);  // throws
+      return false;
+    }
+    Impl::check_finite("process", time);
+  }
   if (!due(step, time)) return false;
   snapshot(time, fields);
   return true;

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/image.hpp"
 #include "insitu/config.hpp"
 #include "insitu/overhead.hpp"
@@ -30,6 +31,13 @@
 #endif
 
 namespace panoptes::insitu {
+
+/// A bad argument of a call (a time that is not finite, or not after the previous snapshot's):
+/// refused before anything is written, the database stays as it was. The C API returns it as
+/// PANOPTES_ERROR_USAGE.
+struct UsageError : Error {
+  using Error::Error;
+};
 
 /// Element type of a simulation field.
 enum class ScalarType { f32, f64 };
@@ -118,11 +126,14 @@ class Session {
   /// True when the schedule asks for a snapshot at this step / simulation time (same answer on every
   /// rank given the same arguments). Steps count from 0; with schedule.every_steps = N, steps 0, N,
   /// 2N… are due; with every_time = Δt, the first step whose time reaches 0, Δt, 2Δt… (each once).
+  /// Throws UsageError for a time that is not finite.
   bool due(std::int64_t step, double time) const;
   /// Renders and stores one snapshot of `fields` (must include every field a task reads) at
   /// simulation time `time`. Collective. Throws Error on missing fields or exhausted max_snapshots.
   /// After [output] mode = "resume", a snapshot at or before the last time written (a step the
   /// restarted run repeats) is skipped (due() is false for it): the database keeps the first one.
+  /// Throws UsageError, writing nothing, for a time that is not finite or not after the previous
+  /// snapshot's (other than such a repeat): the manifest would hold null or times out of order.
   void snapshot(double time, const std::vector<FieldInput>& fields);
   /// due() then snapshot(); returns whether a snapshot was taken.
   bool process(std::int64_t step, double time, const std::vector<FieldInput>& fields);

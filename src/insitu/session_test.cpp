@@ -201,6 +201,26 @@ TEST(InsituSession, MissingFieldIsAnError) {
   fs::remove_all(dir);
 }
 
+// Issue 42, point 6: a FieldInput stride of 2^62 floats wrapped (2^64 bytes) and read plane 0 for every
+// z; strides whose reach overflows 64-bit offsets are refused at the snapshot, naming the field.
+TEST(InsituSession, StridesThatOverflowAreRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("insitu_strides_" + std::to_string(::getpid()));
+  insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+  const auto f = field(0);
+  const std::int64_t nx = grid().dims[0], ny = grid().dims[1];
+  try {
+    s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {1, nx, std::int64_t(1) << 62}}});
+    ADD_FAILURE() << "a stride of 2^62 was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("field \"f\": strides (1, " + std::to_string(nx) + ", 4611686018427387904)"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_EQ(s.snapshots(), 0);
+  s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {1, nx, nx * ny}}});
+  s.finalize();
+  fs::remove_all(dir);
+}
+
 TEST(InsituSession, SnapshotsScheduleAndFinalize) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_sched_" + std::to_string(::getpid()));
   auto cfg = small_config(dir);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/strided.hpp"
 #include "camera/rig_spec.hpp"
 #include "grid/grid_description.hpp"
 #include "insitu/grid_adapter.hpp"
@@ -178,6 +179,12 @@ class PySession {
                     " bytes, not a multiple of its element size; pass numpy.ascontiguousarray(a)");
       stride[a] = s / item;
     }
+    // NumPy allows any strides (as_strided): an array whose reach overflows 64-bit offsets would wrap
+    // around to another address at every read.
+    if (!strided_reach({shape[2], shape[1], shape[0]}, stride, item))
+      throw Error("set_field: field \"" + name + "\" has strides (" + std::to_string(array.strides(0)) + ", " +
+                  std::to_string(array.strides(1)) + ", " + std::to_string(array.strides(2)) +
+                  ") bytes that reach further than 64-bit offsets can address; expected the strides of an array in memory");
     insitu::FieldInput in;
     in.name = name;
     const std::int64_t shift = b.ghost_lo[0] * stride[0] + b.ghost_lo[1] * stride[1] + b.ghost_lo[2] * stride[2];

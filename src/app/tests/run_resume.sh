@@ -88,6 +88,17 @@ out=$("$bin" info --json killed --decode) || fail "info --decode of the resumed 
 grep -E '"status": *"complete"' <<<"$out" >/dev/null || fail "resumed database not complete: $out"
 grep -E '"frames": *12\b' <<<"$out" >/dev/null || fail "resumed database does not have 12 frames: $out"
 
+# Issue 42, point 4: the same rerun on the now complete database is refused (it used to print one
+# info line, exit 0 and keep the old movies: every snapshot of the rerun was "already written").
+set +e
+msg=$("$bin" run tiny.toml --out killed --resume -q 2>&1); rc=$?
+set -e
+[ "$rc" -ne 0 ] || fail "a resume of a complete database was accepted"
+grep -F 'holds a complete database' <<<"$msg" >/dev/null && grep -F 'resume_complete = true' <<<"$msg" >/dev/null ||
+  fail "the refusal of a complete database does not say so: $msg"
+out=$("$bin" info --json killed) || fail "info of the refused database failed: $out"
+grep -E '"status": *"complete"' <<<"$out" >/dev/null || fail "the refused resume changed the database: $out"
+
 # Same times, same decoded pictures (the Cinema export decodes every frame of every movie to PNG).
 tf=$(tr -d ' \n' < full/panoptes.json | grep -Eo '"times":\[[^]]*\]')
 tk=$(tr -d ' \n' < killed/panoptes.json | grep -Eo '"times":\[[^]]*\]')

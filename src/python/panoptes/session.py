@@ -73,7 +73,8 @@ class Session:
 
     def set_field(self, name, array):
         """Binds a float32/float64 array of shape (nz, ny, nx) of the block INCLUDING its ghost layers.
-        The array is not copied: the session reads it at the next process()/snapshot()."""
+        The array is not copied: the session reads it at the next process()/snapshot(). Any strides
+        (views, slices, as_strided) are honoured; strides whose reach overflows 64-bit offsets raise Error."""
         self._s.set_field(name, array)
 
     def due(self, step, time):
@@ -81,11 +82,12 @@ class Session:
         return self._s.due(int(step), float(time))
 
     def process(self, step, time):
-        """Renders and stores a snapshot if the schedule asks for one; returns whether it did."""
+        """Renders and stores a snapshot if the schedule asks for one; returns whether it did. A time that
+        is not finite, or a snapshot time not after the previous snapshot's, raises Error (nothing written)."""
         return self._s.process(int(step), float(time))
 
     def snapshot(self, time):
-        """Renders and stores a snapshot now, whatever the schedule (a forced snapshot)."""
+        """Renders and stores a snapshot now, whatever the schedule (a forced snapshot). Times as process()."""
         self._s.snapshot(float(time))
 
     def finalize(self):

@@ -113,3 +113,38 @@ def test_set_halo_is_checked_against_the_stored_ghosts(tmp_path):
     with pytest.raises(panoptes.Error, match=r"set_halo: valid ghost layers 3 below / 1 above on axis z; expected -1"):
         s.set_halo((0, 0, 3), (0, 0, 1))
     s.set_halo((0, 0, 1), (-1, -1, 1), edges_valid=False)
+
+
+def test_times_must_be_finite_and_increasing(tmp_path):
+    """Issue 42, point 5: NaN / inf times used to return normally and leave null in the manifest (no
+    reader opened the database); times going back were stored. Now panoptes.Error, nothing written."""
+    s = panoptes.Session(HEAT_TOML.format(dir=tmp_path / "d"))  # every_steps = 2
+    s.set_grid((NX, NY, NZ))
+    s.set_block((0, 0, 0), (NX, NY, NZ))
+    s.set_field("T", blob((NZ, NY, NX), (12, 10, 8)).astype(np.float32))
+    for bad in (float("nan"), float("inf"), -float("inf")):
+        with pytest.raises(panoptes.Error, match="expected a finite simulation time"):
+            s.process(0, bad)
+    assert s.process(0, 1.0)
+    with pytest.raises(panoptes.Error, match="time 0.5 is not after the previous snapshot's time 1"):
+        s.process(2, 0.5)
+    with pytest.raises(panoptes.Error, match="time 1 is not after"):
+        s.snapshot(1.0)
+    assert s.process(4, 2.0)
+    s.finalize()
+    np.testing.assert_allclose(panoptes.open(tmp_path / "d").times, [1.0, 2.0])
+
+
+def test_strides_that_overflow_are_refused(tmp_path):
+    """Issue 42, point 6: a view whose strides reach past 64-bit offsets (numpy's as_strided allows any)
+    was bound and read at wrapped addresses; now set_field refuses it."""
+    s = panoptes.Session(HEAT_TOML.format(dir=tmp_path / "d"))
+    s.set_grid((NX, NY, NZ))
+    s.set_block((0, 0, 0), (NX, NY, NZ))
+    T = blob((NZ, NY, NX), (12, 10, 8)).astype(np.float32)
+    huge = np.lib.stride_tricks.as_strided(T, shape=T.shape, strides=(2**62, T.strides[1], T.strides[2]))
+    with pytest.raises(panoptes.Error, match="reach further than 64-bit offsets can address"):
+        s.set_field("T", huge)
+    s.set_field("T", T)
+    assert s.process(0, 0.0)
+    s.finalize()
