@@ -217,6 +217,17 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
                    st.time.composite, st.time.encode, tty ? "  " : "\n");
     }
   }
+  // [[receiver]] / [receiver_line] (issue 42: accepted and then ignored before): their seismograms, as
+  // `panoptes seismic` writes them, in the database's own seismograms/ folder; also when stopped early
+  // (what was recorded so far). Collective: rank 0 gathers every trace.
+  const std::size_t receivers = rc.solver.receivers.size();
+  if (receivers > 0) {
+    const std::string dir = cfg.output_dir + "/seismograms";
+    solver.write_seismograms(dir);
+    if (root)
+      std::printf("seismograms: %zu receiver%s -> %s/<name>.csv (time,vx,vy,vz)\n", receivers, receivers == 1 ? "" : "s",
+                  dir.c_str());
+  }
   if (stop_signal) {
     // The session's destructor flushes every movie and marks the database interrupted (removing the
     // lock); every snapshot taken so far was checkpointed and stays readable.

@@ -67,9 +67,26 @@ check_complete tiny_db
 if "$bin" run tiny.toml > again.log 2>&1; then echo "FAIL: existing database overwritten"; exit 1; fi
 "$bin" run tiny.toml --overwrite -q > /dev/null
 
+# Issue 42: [[receiver]] tables are not ignored: `run` writes their seismograms as `seismic` does, into
+# the database's seismograms/ folder (before, the table was accepted and nothing was written).
+check_seismograms() {  # DB
+  local csv=$1/seismograms/top.csv
+  [ -f "$csv" ] || { echo "FAIL: $1 has no seismogram for receiver 'top'"; ls -R "$1" | head; exit 1; }
+  [ "$(head -n 1 "$csv")" = "time,vx,vy,vz" ] || { echo "FAIL: $csv header: $(head -n 1 "$csv")"; exit 1; }
+  [ "$(wc -l < "$csv")" = 41 ] || { echo "FAIL: $csv has $(wc -l < "$csv") lines, expected 1 + 40 steps"; exit 1; }
+  awk -F, 'NR > 1 && ($2 != 0 || $3 != 0 || $4 != 0) { moved = 1 } END { exit !moved }' "$csv" ||
+    { echo "FAIL: $csv records no motion"; exit 1; }
+}
+printf '[[receiver]]\nname = "top"\nposition = [1400.0, 1200.0, 0.0]\n' | cat tiny.toml - > rec.toml
+"$bin" run rec.toml --out rec_db -q > rec.log 2>&1 || { cat rec.log; echo "FAIL: run with a receiver"; exit 1; }
+check_seismograms rec_db
+grep -q "seismograms: 1 receiver" rec.log || { cat rec.log; echo "FAIL: the run does not say where the seismograms are"; exit 1; }
+
 if command -v mpirun > /dev/null; then
   mpirun --oversubscribe -np 2 "$bin" run tiny.toml --out tiny_db2 -q > mpi.log 2>&1 || { cat mpi.log; echo "FAIL: mpirun"; exit 1; }
   check_complete tiny_db2
+  mpirun --oversubscribe -np 2 "$bin" run rec.toml --out rec_db2 -q > mpi_rec.log 2>&1 || { cat mpi_rec.log; echo "FAIL: mpirun with a receiver"; exit 1; }
+  check_seismograms rec_db2
 fi
 
 expect_error() {  # $1 = sed expression applied to tiny.toml, $2 = expected message part
