@@ -177,6 +177,7 @@ CommandRegistration reg([](CLI::App& root) {
       return;
     }
     opt->overhead_note = kOverheadNote;
+    opt->existing_database_advice = "add --overwrite to replace it, or give another --out";
     opt->command_line = "panoptes demo --out " + opt->out + (opt->overwrite ? " --overwrite" : "");
     run_seismic_insitu(kDemoConfig, "embedded demo configuration", ".", *opt);
   });

@@ -31,6 +31,7 @@ void run(const Args& a) {
   o.command_line = "panoptes import-cinema " + a.in + " " + a.out + (a.group_by.empty() ? "" : " --group-by " + a.group_by) +
                    (a.angles.empty() ? "" : " --angles " + a.angles) + (a.azimuth_zero.empty() ? "" : " --azimuth-zero " + a.azimuth_zero);
   o.overwrite = a.overwrite;
+  o.overwrite_option = "--overwrite";
   o.threads = a.threads;
   if (a.crf >= 0) o.video.crf = a.crf;
   o.video.validate();

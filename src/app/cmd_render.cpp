@@ -205,6 +205,7 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   cfg.mode = a.overwrite ? insitu::OutputMode::overwrite : insitu::OutputMode::create;
   cfg.title = a.title.empty() ? "panoptes render " + first_file : a.title;
   cfg.program = "panoptes render";
+  cfg.existing_database_advice = "add --overwrite to replace it, or give another --out";
   cfg.command_line = command_line;
   cfg.rig = a.rig;
   (void)camera::RigSpec::parse(a.rig);  // a bad --rig is reported before any volume is read

@@ -123,6 +123,10 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   if (options.resume) cfg.mode = insitu::OutputMode::resume;
   cfg.validate();
   cfg.program = "panoptes run";
+  cfg.existing_database_advice = !options.existing_database_advice.empty()
+                                     ? options.existing_database_advice
+                                     : "add --overwrite (or [output] mode = \"overwrite\") to replace it, or --resume "
+                                       "(mode = \"resume\") to continue it after a restart";
   cfg.command_line = options.command_line;
   cfg.units = "m";
   // The solver works in SI: times in s, velocities in m/s, so phi_p = div v and phi_s = |curl v| are in 1/s.

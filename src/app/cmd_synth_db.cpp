@@ -42,6 +42,7 @@ void run(const Args& a, const std::string& command_line) {
   o.width = (*size)[0];
   o.height = (*size)[1];
   o.overwrite = a.overwrite;
+  o.overwrite_option = "--overwrite";
   if (!a.lattice.empty()) {
     const auto l = parse_dims_text(a.lattice, 3, 4);
     if (!l || (*l)[0] < 1 || (*l)[1] < 1 || (*l)[2] < 1)

@@ -13,6 +13,8 @@ struct SeismicRunOptions {
   std::string command_line;
   bool force = false;  ///< start even when the memory estimate exceeds what a rank has available
   std::string overhead_note;  ///< printed under the in-situ overhead line (the demo explains its ratio)
+  /// What the refusal of an existing database advises (the command's own options); empty: run's.
+  std::string existing_database_advice;
 };
 
 /// Runs the solver with in-situ visualization from TOML text (defined in cmd_run.cpp).

@@ -477,7 +477,10 @@ ImportReport import_cinema(const fs::path& cdb, const fs::path& out, const Impor
   ImportPlan plan = plan_import(cdb, o);
   const store::Manifest& m = plan.manifest;
   const int nc = m.camera_count(), nt = m.task_count(), nf = int(m.times.size());
-  store::DatabaseWriter writer = store::DatabaseWriter::create(out, m, o.overwrite);
+  store::WriterOptions w;
+  w.overwrite = o.overwrite;
+  w.overwrite_option = o.overwrite_option;
+  store::DatabaseWriter writer = store::DatabaseWriter::create(out, m, w);
   for (int f = 0; f < nf; ++f) writer.set_time(f, m.times[std::size_t(f)]);
 
   const std::int64_t streams = std::int64_t(nc) * nt, total = streams * nf;

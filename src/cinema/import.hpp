@@ -23,6 +23,7 @@ struct ImportOptions {
   std::string command_line;       ///< recorded in the provenance
   video::VideoSettings video;     ///< encoder settings of every movie
   bool overwrite = false;
+  std::string overwrite_option;  ///< named by the refusal of an existing database (store::WriterOptions)
   int threads = 0;                ///< streams encoded in parallel (0 = hardware concurrency)
   /// The phi/theta convention ("paraview", "cinema-python", "ascent", "elevation"); empty = recognise
   /// the producer (cinema/conventions.hpp) and refuse when it cannot be told.

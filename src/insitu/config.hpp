@@ -112,6 +112,9 @@ struct SessionConfig {
   std::string title = "in-situ visualization";
   std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
   std::string command_line;
+  /// What to do about a database already in output_dir, as the refusal says it (issue 44: a command
+  /// reading no TOML was told to set a TOML key). Empty: the [output] mode keys, as a TOML user has.
+  std::string existing_database_advice;
   std::string units;                  ///< length unit of the grid, for the manifest
   std::string time_units;             ///< unit of the snapshot times, for the manifest (e.g. "s")
   /// Unit of each field's values by field name, for the manifest's colour legends (e.g. phi_p: "1/s").

@@ -118,8 +118,11 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
         const std::string man = cfg.output_dir + "/panoptes.json";
         // The store's own refusal names its C++ option; a C, Fortran or Python user has this key.
         if (cfg.mode == OutputMode::create && ::lstat(man.c_str(), &st) == 0)
-          throw FileError(cfg.output_dir, "already holds a Panoptes database (panoptes.json); set [output] mode = "
-                                          "\"overwrite\" to replace it, or mode = \"resume\" to continue it after a restart");
+          throw FileError(cfg.output_dir, "already holds a Panoptes database (panoptes.json); " +
+                                              (cfg.existing_database_advice.empty()
+                                                   ? std::string("set [output] mode = \"overwrite\" to replace it, or mode = "
+                                                                 "\"resume\" to continue it after a restart")
+                                                   : cfg.existing_database_advice));
         o.overwrite = cfg.mode == OutputMode::overwrite;
         out.writer.emplace(store::DatabaseWriter::create(cfg.output_dir, manifest, o));
       }

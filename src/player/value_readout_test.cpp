@@ -214,7 +214,7 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
 // takes twice give no reading, and the text names value, unit and resolution.
 TEST(ValueReadout, BoundsAmbiguityAndText) {
   store::Manifest m;
-  m.fields = {{"vz", "m/s", {2.0}}};
+  m.fields = {{"vz", "m/s", {2.0}, ""}};
   store::TaskEntry t;
   t.method = "slice", t.name = "slice", t.fields = {"vz"};
   t.parameters = {{"axis", "z"}, {"position", 0.5}, {"window", {-1.0, 1.0}}, {"relative", true},

@@ -301,8 +301,10 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   if (::fstatat(impl->dir_fd.get(), kManifestFileName, &manifest_stat, AT_SYMLINK_NOFOLLOW) == 0) {
     if (!options.overwrite) {
       impl->release_lock();
-      throw FileError(dir.string(), "already holds a Panoptes database (panoptes.json); refusing to overwrite it "
-                                    "(use --overwrite / WriterOptions::overwrite to replace it)");
+      throw FileError(dir.string(), "already holds a Panoptes database (panoptes.json); refusing to overwrite it (" +
+                                        (options.overwrite_option.empty() ? std::string("WriterOptions::overwrite")
+                                                                          : options.overwrite_option) +
+                                        " replaces it)");
     }
     // Only what the old manifest lists goes (owned_files.hpp): its movies, the directories that
     // become empty, its camera table; a user's file beside them, or a link's target, stays.

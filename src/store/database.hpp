@@ -39,6 +39,9 @@ struct WriterOptions {
   /// False on the non-root ranks of a distributed run: no manifest, no lock, no existence check (the
   /// root created the directory; call create() there only after the root's create() returned).
   bool writes_manifest = true;
+  /// How the refusal of an existing database says to replace it: the caller's own option (a
+  /// command's "--overwrite"); empty = this struct's field, for C++ callers (issue 44).
+  std::string overwrite_option;
 };
 
 /// Writes a database. Not thread-safe except append(): appends to *different* streams may run

@@ -136,7 +136,12 @@ TEST(Database, ExistingDatabaseIsRefusedUnlessOverwrite) {
   write_db(dir.path, sample_manifest(2, 2), 2);
   const std::string msg = error_of([&] { DatabaseWriter::create(dir.path, sample_manifest(1, 1)); });
   EXPECT_CONTAINS(msg, "already holds a Panoptes database");
-  EXPECT_CONTAINS(msg, "--overwrite");
+  EXPECT_CONTAINS(msg, "(WriterOptions::overwrite replaces it)");  // a C++ caller's option
+  WriterOptions cli;
+  cli.overwrite_option = "--overwrite";  // a command's (issue 44: synth-db named the C++ setting)
+  const std::string cli_msg = error_of([&] { DatabaseWriter::create(dir.path, sample_manifest(1, 1), cli); });
+  EXPECT_CONTAINS(cli_msg, "(--overwrite replaces it)");
+  EXPECT_EQ(cli_msg.find("WriterOptions"), std::string::npos) << cli_msg;
   // Nothing was touched: the old database still reads.
   expect_stamps(Database::open(dir.path), 1, 1, 2);
 }

@@ -80,9 +80,9 @@ TEST(DatabaseResume, SeveralWritersEachContinueTheirOwnCameras) {
   const Manifest m = sample_manifest(3, 2);
   write_interrupted(dir.path, m);
   // A restart on two "ranks": the root owns camera 0 and writes the manifest, the other cameras 1, 2.
-  DatabaseWriter root = DatabaseWriter::resume(dir.path, m, {false, {0}, true});
+  DatabaseWriter root = DatabaseWriter::resume(dir.path, m, {false, {0}, true, ""});
   const int frames = root.manifest().frames_written;
-  DatabaseWriter other = DatabaseWriter::resume(dir.path, m, {false, {1, 2}, false}, frames);
+  DatabaseWriter other = DatabaseWriter::resume(dir.path, m, {false, {1, 2}, false, ""}, frames);
   for (int f = 3; f < 5; ++f) {
     for (int t = 0; t < 2; ++t) {
       root.append(0, t, synthetic_frame(0, t, f, 64, 64));

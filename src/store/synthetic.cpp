@@ -154,7 +154,10 @@ Image synthetic_frame(int camera, int task, int frame, int width, int height) {
 void write_synthetic_database(const std::filesystem::path& dir, const SyntheticOptions& o,
                               const std::function<void(std::int64_t, std::int64_t)>& progress) {
   Manifest m = synthetic_manifest(o);
-  DatabaseWriter writer = DatabaseWriter::create(dir, m, o.overwrite);
+  WriterOptions w;
+  w.overwrite = o.overwrite;
+  w.overwrite_option = o.overwrite_option;
+  DatabaseWriter writer = DatabaseWriter::create(dir, m, w);
   const std::int64_t total = m.stream_count();
   int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   threads = int(std::min<std::int64_t>(threads, total));

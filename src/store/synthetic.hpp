@@ -21,6 +21,7 @@ struct SyntheticOptions {
   int width = 64, height = 64;
   video::VideoSettings video;   ///< encoder settings of every stream
   bool overwrite = false;
+  std::string overwrite_option;  ///< named by the refusal of an existing database (WriterOptions)
   int threads = 0;              ///< streams encoded in parallel (0 = hardware concurrency)
   std::string title = "synthetic database";
   std::string command_line;     ///< recorded in the provenance

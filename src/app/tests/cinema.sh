@@ -22,6 +22,7 @@ grep -Eq '"status": *"complete"' <<<"$info" >/dev/null || fail "imported databas
 # An existing database is refused; a bad Cinema database is one error line naming file and line.
 if "$panoptes" import-cinema "$tmp/x.cdb" "$tmp/back" 2>"$tmp/err"; then fail "overwrote without --overwrite"; fi
 grep -q "^panoptes: error: .*already holds a Panoptes database" "$tmp/err" || fail "bad message: $(cat "$tmp/err")"
+grep -q "(--overwrite replaces it)" "$tmp/err" || fail "the refusal does not name --overwrite: $(cat "$tmp/err")"  # issue 44
 printf 'time,phi,theta,FILE\n0,0,north,image/c0/t0/f0.jpg\n' >"$tmp/x.cdb/data.csv"
 if "$panoptes" import-cinema "$tmp/x.cdb" "$tmp/bad" 2>"$tmp/err"; then fail "accepted a non-numeric theta"; fi
 [ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "error is not one line: $(cat "$tmp/err")"

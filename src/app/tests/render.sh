@@ -41,6 +41,9 @@ if "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 48x40 --out "$t
   fail "overwrote an existing database"
 fi
 grep -q "panoptes: error:" "$tmp/err.txt" || fail "no error line"
+# Issue 44: the advice names this command's option, not a TOML key render never reads.
+grep -q -- "add --overwrite" "$tmp/err.txt" || fail "the refusal does not name --overwrite: $(cat "$tmp/err.txt")"
+grep -q "\[output\]" "$tmp/err.txt" && fail "render's refusal names a TOML key: $(cat "$tmp/err.txt")"
 "$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:4 --size 48x40 --out "$tmp/db" --overwrite > /dev/null
 # One value per --task: a volume after --task is still the input.
 "$panoptes" render --task iso:3 "$tmp/sphere.vtk" --rig fibonacci:2 --size 32x32 --out "$tmp/db2" > "$tmp/out.txt"

@@ -65,6 +65,7 @@ check_complete tiny_db
 
 # An existing database is refused unless --overwrite.
 if "$bin" run tiny.toml > again.log 2>&1; then echo "FAIL: existing database overwritten"; exit 1; fi
+grep -q -- "add --overwrite" again.log || { cat again.log; echo "FAIL: the refusal does not name --overwrite"; exit 1; }
 "$bin" run tiny.toml --overwrite -q > /dev/null
 
 # Issue 42: [[receiver]] tables are not ignored: `run` writes their seismograms as `seismic` does, into

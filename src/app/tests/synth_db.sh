@@ -19,6 +19,9 @@ grep -Eq '"status": ?"complete"' "$tmp/db/panoptes.json" || fail "status not com
 if "$panoptes" synth-db "$tmp/db" --cameras 1 --tasks 1 2>"$tmp/err"; then fail "overwrote without --overwrite"; fi
 [ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "error is not one line: $(cat "$tmp/err")"
 grep -q "^panoptes: error: .*already holds a Panoptes database" "$tmp/err" || fail "bad message: $(cat "$tmp/err")"
+# Issue 44: the advice is the command's option, not a C++ setting.
+grep -q "(--overwrite replaces it)" "$tmp/err" || fail "the refusal does not name --overwrite: $(cat "$tmp/err")"
+grep -q "WriterOptions" "$tmp/err" && fail "the refusal names a C++ setting: $(cat "$tmp/err")"
 [ "$(find "$tmp/db/movies" -name '*.mp4' | wc -l)" -eq 6 ] || fail "refused run touched the movies"
 "$panoptes" synth-db "$tmp/db" --cameras 1 --tasks 1 --frames 2 --overwrite >/dev/null
 [ "$(find "$tmp/db/movies" -name '*.mp4' | wc -l)" -eq 1 ] || fail "--overwrite left old movies"
