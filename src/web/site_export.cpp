@@ -201,8 +201,15 @@ SiteExport export_site(const fs::path& database, const fs::path& out_arg, const 
   const bool exists = fs::exists(out, ec);
   if (exists && !fs::is_directory(out, ec)) throw FileError(out_arg.string(), "exists and is not a directory");
   const bool empty = !exists || fs::is_empty(out, ec);
-  if (!empty && !overwrite)
-    throw FileError(out_arg.string(), "exists and is not empty (use --overwrite to replace the exported files)");
+  if (!empty && !overwrite) {
+    // --overwrite replaces only a previous export's files (its listing); advising it for a folder of
+    // the user's own sent them in a circle (issue 44: the suggested option then refused too).
+    if (fs::exists(out / kSiteListingFileName, ec))
+      throw FileError(out_arg.string(), "holds an earlier export-web (use --overwrite to replace its files)");
+    throw FileError(out_arg.string(), "exists, is not empty and was not written by export-web (no " +
+                                          std::string(kSiteListingFileName) +
+                                          "): choose another output directory, or an empty or new one");
+  }
   fs::create_directories(out.parent_path(), ec);
   store::FileHandle out_fd;
   std::set<std::string> owned;

@@ -39,6 +39,13 @@ grep -q "^panoptes: error: .*site/db: exists and was not written by export-web" 
 
 # An OUT no export-web wrote is not ours to overwrite.
 mkdir "$tmp/other" && echo x > "$tmp/other/index.html"
+# Issue 44: without --overwrite the refusal does not advise --overwrite for it (that refuses too).
+if "$panoptes" export-web "$tmp/A" "$tmp/other" 2>"$tmp/err" >/dev/null; then fail "wrote into a foreign OUT"; fi
+grep -q -- "--overwrite" "$tmp/err" && { cat "$tmp/err"; fail "advises --overwrite for a foreign OUT"; }
+grep -q "not written by export-web" "$tmp/err" || { cat "$tmp/err"; fail "unclear refusal of a foreign OUT"; }
+# ... while for an earlier export it does.
+if "$panoptes" export-web "$tmp/A" "$tmp/site" 2>"$tmp/err" >/dev/null; then fail "replaced an export without --overwrite"; fi
+grep -q -- "use --overwrite" "$tmp/err" || { cat "$tmp/err"; fail "no --overwrite advice for an earlier export"; }
 if "$panoptes" export-web "$tmp/A" "$tmp/other" --overwrite 2>"$tmp/err" >/dev/null; then fail "overwrote a foreign OUT"; fi
 grep -q "panoptes-site" "$tmp/err" || { cat "$tmp/err"; fail "unclear refusal of a foreign OUT"; }
 [ "$(cat "$tmp/other/index.html")" = x ] || fail "the foreign index.html changed"
