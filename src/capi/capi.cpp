@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/strided.hpp"
@@ -305,13 +306,20 @@ void set_field_layout(panoptes_session* s, const std::string& call, const char* 
       std::string msg = call + ": field \"" + name + "\" has shape " + shape_text(got) + "; the block with its stored ghosts is " +
                         shape_text(n) + " points (x, y, z), which in layout " + lay + " is the shape " + shape_text(want);
       // A hint when the array fits the block in another axis order (the usual mistake: z fastest).
+      // Every order that fits is named: when two extents are equal the shape cannot tell their axes
+      // apart, and naming only the first sent a user to a layout that was silently wrong (issue 42).
       static const char* const orders[] = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx"};
+      std::vector<std::string> fits;
       for (const char* o : orders) {
         const auto ax = parse_layout(o, call);
-        if (std::array<long long, 3>{n[ax[0]], n[ax[1]], n[ax[2]]} == got && ax != axis) {
-          msg += std::string("; the array fits layout \"") + o + "\": is that its axis order?";
-          break;
-        }
+        if (std::array<long long, 3>{n[ax[0]], n[ax[1]], n[ax[2]]} == got && ax != axis) fits.push_back(o);
+      }
+      if (fits.size() == 1) msg += "; the array fits layout \"" + fits[0] + "\": is that its axis order?";
+      if (fits.size() > 1) {
+        msg += "; the array fits layouts ";
+        for (std::size_t i = 0; i < fits.size(); ++i)
+          msg += (i == 0 ? "\"" : i + 1 == fits.size() ? "\" and \"" : "\", \"") + fits[i];
+        msg += "\" alike (its shape cannot tell their axes apart): give the one that is the array's axis order";
       }
       throw UsageError(msg);
     }

@@ -106,6 +106,20 @@ TEST_F(Capi, LayoutWithACountChecksTheBuffer) {
   EXPECT_EQ(panoptes_finalize(s_), PANOPTES_OK);
 }
 
+// Issue 42: with two equal extents the shape fits two axis orders; the refusal names both instead of
+// proposing the first (which a user followed into a silently wrong picture).
+TEST_F(Capi, AShapeThatFitsSeveralLayoutsNamesThemAll) {
+  const int dims[3] = {8, 6, 4}, zero[3] = {0, 0, 0}, ghosts[3] = {0, 2, 0};
+  ASSERT_EQ(panoptes_set_block(s_, zero, dims, ghosts, zero), PANOPTES_OK) << panoptes_last_error();  // 8 x 8 x 4
+  std::vector<double> T(256, 0.5);
+  const long long ext[3] = {4, 8, 8}, st[3] = {1, 32, 4};  // z fastest: (z, ?, ?) with x and y both 8
+  EXPECT_EQ(panoptes_set_field_layout(s_, "T", T.data(), PANOPTES_FLOAT64, "xyz", ext, st), PANOPTES_ERROR_USAGE);
+  const std::string msg = panoptes_last_error();
+  EXPECT_NE(msg.find("fits layouts \"zxy\" and \"zyx\" alike"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("is that its axis order"), std::string::npos) << msg;
+  EXPECT_EQ(panoptes_set_field_layout(s_, "T", T.data(), PANOPTES_FLOAT64, "zxy", ext, st), PANOPTES_OK) << panoptes_last_error();
+}
+
 TEST_F(Capi, LayoutShapesAreCheckedAndNamed) {
   std::vector<double> T(224, 0.5);
   // A C array V[x][y][z] (z fastest) declared as such: extents per dimension (x, y, z), strides to match.
