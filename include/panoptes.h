@@ -100,7 +100,8 @@ int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data
  * "xyz" for V(i,j,k)); extents[d] = points along dimension d, which must equal the block's owned + stored
  * ghost points on that axis; strides[d] = elements between neighbours along dimension d (any sign, not 0);
  * data = the element at index 0 of every dimension. A shape that does not fit the block is refused with a
- * message naming both shapes. The Fortran module passes its arrays (sections included) through this call.
+ * message naming both shapes. layout NULL or "" means "xyz" where the shape fits no other order, and is
+ * refused (naming every order it fits) where it does: a ghosted cube cannot tell "xyz" from "zxy". The Fortran module passes its arrays (sections included) through this call.
  * Strides whose reach overflows 64-bit offsets are refused by every set_field call. Prefer
  * panoptes_set_field_layout_n, which also checks the buffer's size. */
 int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,

@@ -296,6 +296,11 @@ void set_field_layout(panoptes_session* s, const std::string& call, const char* 
   {
     need(s && name && extents && strides, call + ": null session, name, extents or strides");
     need(s->block.has_value(), call + ": call panoptes_set_block first");
+    // No layout (NULL or ""; the Fortran module's panoptes_field without layout=): "xyz", but only
+    // where the shape tells it from every other order (issue 42: a z-fastest array on a ghosted cube
+    // fitted "xyz" too and was taken for it without a word).
+    const bool defaulted = !layout || !*layout;
+    if (defaulted) layout = "xyz";
     const auto axis = parse_layout(layout, call);
     const std::string lay = std::string("\"") + layout + "\"";
     const auto n = ghosted_extent(*s->block);
@@ -322,6 +327,21 @@ void set_field_layout(panoptes_session* s, const std::string& call, const char* 
         msg += "\" alike (its shape cannot tell their axes apart): give the one that is the array's axis order";
       }
       throw UsageError(msg);
+    }
+    if (defaulted) {
+      std::vector<std::string> fits;
+      for (const char* o : {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx"}) {
+        const auto ax = parse_layout(o, call);
+        if (std::array<long long, 3>{n[ax[0]], n[ax[1]], n[ax[2]]} == got) fits.push_back(o);
+      }
+      if (fits.size() > 1) {
+        std::string list;
+        for (std::size_t i = 0; i < fits.size(); ++i) list += (i ? ", \"" : "\"") + fits[i] + "\"";
+        throw UsageError(call + ": field \"" + name + "\" has shape " + shape_text(got) + ", which fits the block " +
+                         shape_text(n) + " (x, y, z) in the layouts " + list +
+                         " alike: the shape cannot tell its axis order, so give it (Fortran: layout='xyz' for a(i,j,k), "
+                         "layout='zxy' for a z-fastest v(k,i,j))");
+      }
     }
     need(data, call + ": field \"" + std::string(name) + "\": null data");
     std::array<std::int64_t, 3> st{};

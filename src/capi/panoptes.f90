@@ -372,7 +372,8 @@ contains
     integer(c_long_long), intent(in) :: extents(3), strides(3)
     integer, intent(out), optional :: ierr
     character(len=8) :: order
-    order = 'xyz'
+    ! Without layout= the C side takes 'xyz' only where the shape rules out every other order.
+    order = ''
     if (present(layout)) order = layout
     call check(c_set_field_layout(s%handle, trim(name)//c_null_char, data, type, trim(order)//c_null_char, &
                                   extents, strides), ierr)
