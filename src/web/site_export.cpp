@@ -3,11 +3,14 @@
 #include "player/keys_json.hpp"
 
 #include <dirent.h>
+#include <signal.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -31,10 +34,38 @@ namespace {
 // it but the ones it makes), and moved into OUT only once the whole site is there.
 class Staging {
  public:
+  /// ".NAME.export-web.HOST.PID." : the staging directories of exports into NAME made on this host.
+  static std::string prefix(const std::string& name) {
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) != 0 || !*host) std::snprintf(host, sizeof host, "localhost");
+    for (char* c = host; *c; ++c)
+      if (*c == '/' || *c == '.') *c = '_';
+    return "." + name + ".export-web." + host + ".";
+  }
+  /// Removes the staging directories a killed export into NAME left beside it (issue 44: a SIGKILL left
+  /// its hidden copy there for good): those of this host whose process no longer exists. Another
+  /// host's (a shared file system) and a live export's are left alone.
+  static void remove_dead(const fs::path& parent, const std::string& name) {
+    const std::string pre = prefix(name);
+    std::error_code ec;
+    for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string file = it->path().filename().string();
+      if (file.compare(0, pre.size(), pre) != 0 || !it->is_directory(ec) || it->is_symlink(ec)) continue;
+      const std::string rest = file.substr(pre.size());
+      const auto dot = rest.find('.');
+      char* endp = nullptr;
+      const long pid = std::strtol(rest.c_str(), &endp, 10);
+      if (dot == std::string::npos || endp != rest.c_str() + dot || pid <= 0) continue;
+      if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to ask): keep
+      std::error_code rm;
+      fs::remove_all(it->path(), rm);  // removes links themselves, never what they point to
+    }
+  }
   Staging(const fs::path& parent, const std::string& name) {
+    remove_dead(parent, name);
     std::random_device rd;
     for (int attempt = 0;; ++attempt) {
-      dir_ = parent / ("." + name + ".export-web." + std::to_string(::getpid()) + "." + std::to_string(rd()));
+      dir_ = parent / (prefix(name) + std::to_string(::getpid()) + "." + std::to_string(rd()));
       if (::mkdir(dir_.c_str(), 0700) == 0) break;
       if (errno != EEXIST || attempt > 8)
         throw FileError(dir_.string(), std::string("cannot create the staging directory: ") + std::strerror(errno));

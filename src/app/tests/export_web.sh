@@ -55,6 +55,25 @@ if (ulimit -f 64; "$panoptes" export-web "$tmp/B" "$tmp/site2") 2>"$tmp/err" >/d
 [ ! -e "$tmp/site2" ] || fail "a failed export left $tmp/site2"
 ! ls -A "$tmp" | grep -q "export-web" || fail "a failed export left its staging directory"
 
+# Issue 44: a SIGKILLed export leaves its hidden staging directory beside OUT; the next export into the
+# same OUT removes it (this host's, dead process), and keeps a live export's. The leftovers are made as
+# a killed run leaves them (a pid that has exited; the same name pattern), so the check is exact.
+host=$(hostname | tr './' '__')
+sleep 0 & dead=$!; wait "$dead" || true
+mkdir -p "$tmp/.site4.export-web.$host.$dead.1/api" && echo '{}' > "$tmp/.site4.export-web.$host.$dead.1/api/database.json"
+mkdir "$tmp/.site4.export-web.$host.$$.2"  # this shell's pid: alive
+"$panoptes" export-web "$tmp/A" "$tmp/site4" >/dev/null || fail "export beside a dead staging directory failed"
+[ ! -e "$tmp/.site4.export-web.$host.$dead.1" ] || fail "a killed export's staging directory was left beside OUT"
+[ -d "$tmp/.site4.export-web.$host.$$.2" ] || fail "a live export's staging directory was removed"
+rmdir "$tmp/.site4.export-web.$host.$$.2"
+# And a real kill: whatever it left, the next export leaves no staging directory of a dead process.
+"$panoptes" synth-db "$tmp/K" --cameras 24 --tasks 2 --frames 40 --size 128x128 --gop 1 >/dev/null
+"$panoptes" export-web "$tmp/K" "$tmp/site5" >/dev/null 2>&1 & victim=$!
+sleep 0.3; kill -9 "$victim" 2>/dev/null || true; wait "$victim" 2>/dev/null || true
+rm -rf "$tmp/site5"
+"$panoptes" export-web "$tmp/A" "$tmp/site5" >/dev/null || fail "export after a killed one failed"
+! ls -A "$tmp" | grep -q "^\.site5\.export-web" || fail "a killed export's staging directory is still there: $(ls -A "$tmp")"
+
 # OUT named with a trailing slash, existing and empty (the README's `export-web out/demo site/`): the
 # staging directory goes beside it, not inside it.
 mkdir "$tmp/site3"
