@@ -70,7 +70,9 @@ int panoptes_set_grid_spherical(panoptes_session* s, const int dims[3], const do
 int panoptes_set_grid_yinyang(panoptes_session* s, const int dims[3], const double* r, const double* theta,
                               const double* phi);
 /** Yin-Yang: the patch (0 = Yin, 1 = Yang) that the following panoptes_set_block and panoptes_set_field* calls
- * describe. A rank may describe a block of each patch (select, set block and fields, select the other, ...). */
+ * describe. A rank may describe a block of each patch (select, set block and fields, select the other, ...).
+ * After the first snapshot the blocks are fixed, but a patch that has one may be selected again to re-bind
+ * its fields (a rank holding both patches: select 0, set its fields, select 1, set its fields, snapshot). */
 int panoptes_set_patch(panoptes_session* s, int patch);
 /** Non-uniform grids: points along the longest axis of the uniform grid the fields are resampled onto
  * (0 = the source's largest dimension, the default) and the value of points outside the grid's domain (a

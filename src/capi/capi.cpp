@@ -419,12 +419,20 @@ int panoptes_set_grid_yinyang(panoptes_session* s, const int dims[3], const doub
 int panoptes_set_patch(panoptes_session* s, int patch) {
   return guarded(s, [&] {
     need(s, "panoptes_set_patch: null session");
-    need(!s->session, "panoptes_set_patch: the blocks cannot change after the first snapshot");
     need(s->source && s->source->kind == grid::GridKind::yinyang,
          "panoptes_set_patch: only a Yin-Yang grid has patches (call panoptes_set_grid_yinyang first)");
     need(patch == 0 || patch == 1,
          "panoptes_set_patch: patch " + std::to_string(patch) + "; expected 0 (Yin) or 1 (Yang)");
     if (patch == s->patch) return;
+    // After the first snapshot the blocks are fixed, but a rank holding both patches must still be able
+    // to re-bind each patch's fields every step (issue 42: refused, Yin kept rendering step 0's array).
+    // So selecting a patch stays allowed; only one that had no block then would be a new block.
+    if (s->session) {
+      const auto it = s->other_patches.find(patch);
+      need(it != s->other_patches.end() && it->second.block.has_value(),
+           "panoptes_set_patch: patch " + std::to_string(patch) +
+               " had no block on this rank at the first snapshot; the blocks cannot change after it");
+    }
     s->other_patches[s->patch] = {s->block, s->fields};
     panoptes_session::PatchState next = s->other_patches[patch];
     s->other_patches.erase(patch);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -80,7 +81,53 @@ TEST_F(CapiGrid, YinYangFromOneProcessRendersAndIsRecorded) {
   const std::string m = manifest();
   EXPECT_NE(m.find("\"grid\":\"yinyang 6x16x36, r in [0.4, 1], 2 patches\""), std::string::npos) << m.substr(0, 600);
   EXPECT_NE(m.find("\"dims\":[40,40,40]"), std::string::npos) << m.substr(0, 600);
-  EXPECT_EQ(panoptes_set_patch(s_, 1), PANOPTES_ERROR_USAGE);  // after the first snapshot
+  // After the first snapshot a patch with a block may be selected again (to re-bind its fields), but
+  // no block may change.
+  EXPECT_EQ(panoptes_set_patch(s_, 0), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_set_block(s_, zero, dims, zero, zero), PANOPTES_ERROR_USAGE);
+}
+
+// Issue 42, point 7: a rank holding both patches re-binds each patch's fields every step. Before,
+// panoptes_set_patch was refused after the first snapshot, set_field bound only the selected patch
+// (Yang), and Yin rendered step 0's array without an error. Here only Yin changes at step 1 (x3):
+// the frame's reference (99.9th percentile, per snapshot) must follow it.
+TEST_F(CapiGrid, BothPatchesOfOneRankAreReboundEveryStep) {
+  panoptes_destroy(s_);
+  const std::string relative = "[output]\ndir = \"" + dir_.string() + "\"\n[image]\nwidth = 32\nheight = 32\n[rig]\n"
+                               "spec = \"fibonacci:2\"\n[render]\nreference = \"snapshot\"\n[schedule]\nevery_steps = 1\n"
+                               "[[task]]\nname = \"T\"\ntype = \"volume\"\nfield = \"T\"\npreset = \"p-wave\"\n";
+  ASSERT_EQ(panoptes_create(relative.c_str(), 0, PANOPTES_COMM_WORLD, &s_), PANOPTES_OK) << panoptes_last_error();
+  const int dims[3] = {6, 16, 36}, zero[3] = {0, 0, 0};
+  ASSERT_EQ(panoptes_set_grid_yinyang(s_, dims, r_.data(), t_.data(), p_.data()), PANOPTES_OK) << panoptes_last_error();
+  ASSERT_EQ(panoptes_set_resample(s_, 40, 0.0), PANOPTES_OK) << panoptes_last_error();
+  std::vector<double> yin0, yang, yin1;
+  for (int k = 0; k < 36; ++k)
+    for (int j = 0; j < 16; ++j)
+      for (int i = 0; i < 6; ++i) {
+        const double x = r_[std::size_t(i)] * std::sin(t_[std::size_t(j)]) * std::cos(p_[std::size_t(k)]);
+        yin0.push_back(std::fabs(x));
+        yang.push_back(std::fabs(x));
+        yin1.push_back(3 * std::fabs(x));  // a new array, as a code's next step
+      }
+  for (int patch : {0, 1}) {
+    ASSERT_EQ(panoptes_set_patch(s_, patch), PANOPTES_OK) << panoptes_last_error();
+    ASSERT_EQ(panoptes_set_block(s_, zero, dims, zero, zero), PANOPTES_OK);
+    std::vector<double>& v = patch == 0 ? yin0 : yang;
+    ASSERT_EQ(panoptes_set_field_n(s_, "T", v.data(), PANOPTES_FLOAT64, nullptr, (long long)v.size()), PANOPTES_OK);
+  }
+  ASSERT_EQ(panoptes_snapshot(s_, 0.0), PANOPTES_OK) << panoptes_last_error();
+  ASSERT_EQ(panoptes_set_patch(s_, 0), PANOPTES_OK) << panoptes_last_error();
+  EXPECT_EQ(panoptes_set_block(s_, zero, dims, zero, zero), PANOPTES_ERROR_USAGE);  // the blocks stay fixed
+  ASSERT_EQ(panoptes_set_field_n(s_, "T", yin1.data(), PANOPTES_FLOAT64, nullptr, (long long)yin1.size()), PANOPTES_OK);
+  ASSERT_EQ(panoptes_set_patch(s_, 1), PANOPTES_OK) << panoptes_last_error();
+  ASSERT_EQ(panoptes_snapshot(s_, 1.0), PANOPTES_OK) << panoptes_last_error();
+  ASSERT_EQ(panoptes_finalize(s_), PANOPTES_OK) << panoptes_last_error();
+  const std::string m = manifest();
+  const auto at = m.find("\"references\":[");
+  ASSERT_NE(at, std::string::npos) << m.substr(0, 600);
+  double r0 = 0, r1 = 0;
+  ASSERT_EQ(std::sscanf(m.c_str() + at, "\"references\":[%lf,%lf", &r0, &r1), 2) << m.substr(at, 80);
+  EXPECT_GT(r1, 1.5 * r0) << "Yin's new array did not reach the picture: references " << r0 << ", " << r1;
 }
 
 TEST_F(CapiGrid, BadGridsAndBlocksAreRefusedWithTheirReason) {

@@ -100,11 +100,18 @@ class PySession {
 
   /// Yin-Yang: the patch (0 = Yin, 1 = Yang) the following set_block/set_field calls describe.
   void set_patch(int patch) {
-    need_no_session("set_patch", "blocks");
     if (!source_ || source_->kind != grid::GridKind::yinyang)
       throw Error("set_patch: only a Yin-Yang grid has patches (call set_grid_yinyang first)");
     if (patch != 0 && patch != 1) throw Error("set_patch: patch " + std::to_string(patch) + "; expected 0 (Yin) or 1 (Yang)");
     if (patch == patch_) return;
+    // After the first snapshot the blocks are fixed, but a process holding both patches re-binds each
+    // one's fields every step (issue 42, point 7), so a patch that had a block may still be selected.
+    if (session_) {
+      const auto it = other_patches_.find(patch);
+      if (it == other_patches_.end() || !it->second.block)
+        throw Error("set_patch: patch " + std::to_string(patch) +
+                    " had no block in this process at the first snapshot; the blocks cannot change after it");
+    }
     other_patches_[patch_] = {block_, fields_};
     PatchState next = other_patches_[patch];
     other_patches_.erase(patch);

@@ -100,6 +100,30 @@ def test_yinyang_both_patches_in_one_process_equals_the_c_api(tmp_path):
     assert "yinyang 6x16x36" in (tmp_path / "py" / "panoptes.json").read_text()
 
 
+def test_yinyang_one_process_rebinds_both_patches_every_step(tmp_path):
+    """Issue 42, point 7: a process holding both patches binds each patch's new arrays every step.
+    set_patch was refused after the first snapshot and Yin kept rendering step 0's array."""
+    lib = capi_lib()
+    r, theta, phi = yinyang_coordinates()
+    steps = [(t, [shell_field(r, theta, phi, t, yang=p == 1) for p in (0, 1)]) for t in (0.3, 0.6)]
+    s = panoptes.Session(TOML.format(dir=tmp_path / "py"))
+    s.set_grid_yinyang(r, theta, phi)
+    s.set_resample(40)
+    for i, (t, fields) in enumerate(steps):
+        for p in (0, 1):
+            s.set_patch(p)
+            if i == 0:
+                s.set_block((0, 0, 0), (len(r), len(theta), len(phi)))
+            s.set_field("T", fields[p])  # a new array of this step
+        s.snapshot(t)
+    with pytest.raises(panoptes.Error, match="cannot change"):
+        s.set_block((0, 0, 0), (len(r), len(theta), len(phi)))
+    s.finalize()
+    grid_reference.render(lib, TOML.format(dir=tmp_path / "c"), "yinyang", (r, theta, phi), steps, points=40)
+    worst, _ = grid_reference.compare(tmp_path / "c", tmp_path / "py")
+    assert worst == 0
+
+
 def test_rectilinear_equals_the_c_api(tmp_path):
     lib = capi_lib()
     x = np.cumsum(np.linspace(0.5, 1.5, 20)) - 7
