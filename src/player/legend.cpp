@@ -216,17 +216,24 @@ std::string legend_range_text(const LegendBar& bar) {
   return legend_number(bar.lo) + " .. " + legend_number(bar.hi) + unit + rel;
 }
 
-std::string legend_scale_text(const LegendBar& bar, const std::string& shared_with) {
+std::string legend_scale_mode_text(const LegendBar& bar, const std::string& shared_with) {
   if (bar.scale.empty()) return "";
   std::string s = bar.scale == "running" ? "running max" : bar.scale == "snapshot" ? "per snapshot" : bar.scale;
   if (bar.shared) s += shared_with.empty() ? ", shared scale" : ", shared with " + shared_with;
-  // A change smaller than the legend's 3 digits is no change to the reader.
-  if (bar.change > 0 && std::abs(bar.change - 1) >= 0.005) {
-    char buf[48];
-    std::snprintf(buf, sizeof buf, ": x%.3g since the previous frame", bar.change);
-    s += buf;
-  }
   return s;
+}
+
+std::string legend_change_text(const LegendBar& bar) {
+  // A change smaller than the legend's 3 digits is no change to the reader.
+  if (bar.scale.empty() || !(bar.change > 0) || std::abs(bar.change - 1) < 0.005) return "";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "x%.3g since the previous frame", bar.change);
+  return buf;
+}
+
+std::string legend_scale_text(const LegendBar& bar, const std::string& shared_with) {
+  const std::string mode = legend_scale_mode_text(bar, shared_with), change = legend_change_text(bar);
+  return change.empty() ? mode : mode + ": " + change;
 }
 
 std::string time_text(const store::Manifest& m, double time) {

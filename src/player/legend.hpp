@@ -60,6 +60,10 @@ std::string legend_range_text(const LegendBar& bar);
 /// What the scale follows and whether it just changed, e.g. "running max", "per snapshot: x2.3 since
 /// the previous frame", "fixed", "running max, shared with phi_s"; "" for an absolute window.
 std::string legend_scale_text(const LegendBar& bar, const std::string& shared_with = "");
+/// Its two parts, for front ends that draw them on two lines: the mode ("running max, shared with
+/// phi_s") and the change ("x2.3 since the previous frame"; "" when the scale did not change).
+std::string legend_scale_mode_text(const LegendBar& bar, const std::string& shared_with = "");
+std::string legend_change_text(const LegendBar& bar);
 /// "t = 4.2 s" (time and the manifest's time unit; no unit when it has none).
 std::string time_text(const store::Manifest& manifest, double time);
 

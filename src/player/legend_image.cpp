@@ -70,10 +70,9 @@ int draw_legend(Image& im, const store::Manifest& m, int task, int frame) {
     std::string other;
     for (const LegendBar& o : bars)
       if (&o != &b) other = o.field;
-    const std::string s = legend_scale_text(b, other);
-    const auto cut = s.find(": x");
-    if (!s.empty()) r.scale = "scale: " + s.substr(0, cut);
-    if (cut != std::string::npos) r.change = s.substr(cut + 2);
+    const std::string mode = legend_scale_mode_text(b, other);
+    if (!mode.empty()) r.scale = "scale: " + mode;
+    r.change = legend_change_text(b);
     width = std::max({width, t.width(r.title), t.width(r.scale), t.width(r.change)});
     rows.push_back(std::move(r));
   }

@@ -287,19 +287,18 @@ void Hud::draw_legend(const HudInfo& info, float vw, float vh) {
     std::string other;
     for (const player::LegendBar& o : bars)
       if (&o != &bar) other = o.field;
-    const std::string scale = player::legend_scale_text(bar, other);
-    if (!scale.empty()) {
-      // The mode in grey, the change (if any) on its own line in amber: one line would make the
-      // legend twice as wide over the picture.
-      const auto cut = scale.find(": x");
+    // The mode in grey, the change (if any) on its own line in amber: one line would make the
+    // legend twice as wide over the picture.
+    const std::string mode = player::legend_scale_mode_text(bar, other), change = player::legend_change_text(bar);
+    if (!mode.empty()) {
       ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.62f, 0.66f, 0.74f, 1));
-      ImGui::TextUnformatted(("scale: " + scale.substr(0, cut)).c_str());
+      ImGui::TextUnformatted(("scale: " + mode).c_str());
       ImGui::PopStyleColor();
-      if (cut != std::string::npos) {
-        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.78f, 0.3f, 1));
-        ImGui::TextUnformatted(scale.substr(cut + 2).c_str());
-        ImGui::PopStyleColor();
-      }
+    }
+    if (!change.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.78f, 0.3f, 1));
+      ImGui::TextUnformatted(change.c_str());
+      ImGui::PopStyleColor();
     }
   }
   ImGui::End();

@@ -48,15 +48,23 @@ function windowBar(db, task, field, p, windowKey, relativeKey, tfKey, frame) {
   return bar;
 }
 
-/// As legend_scale_text() in C++: "running max", "per snapshot: x2.3 since the previous frame", ...
-export function legendScaleText(bar, sharedWith = "") {
+/// As legend_scale_mode_text() in C++: "running max", "per snapshot, shared with phi_s", ...
+export function legendScaleModeText(bar, sharedWith = "") {
   if (!bar.scale) return "";
   let s = bar.scale === "running" ? "running max" : bar.scale === "snapshot" ? "per snapshot" : bar.scale;
   if (bar.shared) s += sharedWith ? `, shared with ${sharedWith}` : ", shared scale";
-  if (scaleChanged(bar)) s += `: x${Number(bar.change.toPrecision(3))} since the previous frame`;
   return s;
 }
-const scaleChanged = (bar) => bar.change > 0 && Math.abs(bar.change - 1) >= 0.005;
+/// As legend_change_text(): "x2.3 since the previous frame", "" when the scale did not change.
+export function legendChangeText(bar) {
+  if (!bar.scale || !(bar.change > 0) || Math.abs(bar.change - 1) < 0.005) return "";
+  return `x${Number(bar.change.toPrecision(3))} since the previous frame`;
+}
+/// As legend_scale_text() in C++: the two joined, "per snapshot: x2.3 since the previous frame".
+export function legendScaleText(bar, sharedWith = "") {
+  const mode = legendScaleModeText(bar, sharedWith), change = legendChangeText(bar);
+  return change ? `${mode}: ${change}` : mode;
+}
 
 /// The bars of task `t` at `frame` (see LegendBar in src/player/legend.hpp).
 export function taskLegend(db, t, frame) {
@@ -104,14 +112,14 @@ export function timeText(db, t) {
 // reference changed since the previous frame, by what factor (drawn in amber).
 function scaleLines(bar, bars) {
   const other = bars.find((o) => o !== bar);
-  const text = legendScaleText(bar, other ? other.field : "");
-  if (!text) return [];
+  const mode = legendScaleModeText(bar), change = legendChangeText(bar), lines = [];
   // One phrase a line: the canvas is 240 CSS pixels wide, and the whole text took 60 characters.
-  const cut = text.indexOf(": x"), head = cut < 0 ? text : text.slice(0, cut);
-  const shared = head.indexOf(", shared");
-  const lines = [{ text: `scale: ${shared < 0 ? head : head.slice(0, shared)}`, changed: false }];
-  if (shared >= 0) lines.push({ text: head.slice(shared + 2), changed: false });
-  if (cut >= 0) lines.push({ text: text.slice(cut + 2), changed: true });
+  if (mode) {
+    const shared = mode.indexOf(", shared");
+    lines.push({ text: `scale: ${shared < 0 ? mode : mode.slice(0, shared)}`, changed: false });
+    if (shared >= 0) lines.push({ text: other ? `shared with ${other.field}` : "shared scale", changed: false });
+  }
+  if (change) lines.push({ text: change, changed: true });
   return lines;
 }
 
