@@ -184,8 +184,10 @@ TEST(ValueReadout, ReadsTheFieldBackFromAnH264SliceWithinTheColourMapsResolution
         ++bounds;
         bound_steps = std::max(bound_steps, v.kind == ValueReading::Kind::below ? (t.value - r.lo) / res : (r.hi - t.value) / res);
         // A bound says the value is at or beyond the window's end: true within the worst error.
-        if (interior) EXPECT_TRUE(v.kind == ValueReading::Kind::below ? t.value <= r.lo + 16 * res : t.value >= r.hi - 16 * res)
-            << "pixel (" << x << ", " << y << ") true " << t.value;
+        if (interior) {
+          EXPECT_TRUE(v.kind == ValueReading::Kind::below ? t.value <= r.lo + 16 * res : t.value >= r.hi - 16 * res)
+              << "pixel (" << x << ", " << y << ") true " << t.value;
+        }
         continue;
       }
       ++read;
