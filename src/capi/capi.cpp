@@ -18,6 +18,7 @@
 #include "core/version.hpp"
 #include "grid/grid_description.hpp"
 #include "insitu/grid_adapter.hpp"
+#include "insitu/rank_agreement.hpp"
 #include "insitu/session.hpp"
 
 using namespace panoptes;
@@ -30,6 +31,19 @@ struct panoptes_session {
   std::optional<insitu::LocalBlock> block;
   std::map<std::string, insitu::FieldInput> fields;
   std::unique_ptr<insitu::Session> session;
+  // Agreements before the session exists (panoptes_create, the first snapshot's start), and a call of
+  // this rank's that failed since the last collective call: the next one is refused on every rank
+  // (issue 42: a field one rank could not bind left the others waiting, or kept its stale binding).
+  // Keyed by what the call sets ("grid", "block", "field T", ...): a later call that sets it right
+  // clears the failure.
+  insitu::RankAgreement agreement;
+  std::map<std::string, std::string> failed_calls;
+  std::string failures() const {
+    std::string all;
+    for (const auto& [what, message] : failed_calls)
+      all += (all.empty() ? "" : "; ") + ("field \"" + what.substr(6) + "\" is not bound: its binding failed (" + message + ")");
+    return all;
+  }
   // A non-uniform grid (panoptes_set_grid_rectilinear / _spherical / _yinyang): the blocks and fields
   // of the patch not selected by panoptes_set_patch wait in `other_patches`; the adapter resamples
   // them onto the uniform grid the session renders.
@@ -102,15 +116,23 @@ void report(const panoptes_session* s, const std::string& message) {
   std::fflush(stderr);
 }
 
+// A field binding's failure is remembered until the next collective call, which every rank then refuses
+// (C and Fortran codes often ignore ierr; the binding is gone, not stale). The other setters leave their
+// state as it was when they fail, and the session's start agrees on what is missing: their key is "".
+std::string field_key(const char* name) { return std::string("field ") + (name ? name : ""); }
+
 // Runs f, turning exceptions into a return code, the thread's last error and one printed line.
+// A call that sets `key` on this rank only has its failure remembered (and a success forgets an
+// earlier failure of the same key): the next collective call is refused on every rank.
 template <class F>
-int guarded(const panoptes_session* s, F&& f) {
+int guarded(panoptes_session* s, F&& f, const std::string& key) {
   int code = PANOPTES_OK;
   std::optional<insitu::OverheadMeter::Scope> counted;
   if (s && s->meter) counted.emplace(*s->meter);
   try {
     f();
     g_error.clear();
+    if (s && !key.empty()) s->failed_calls.erase(key);
     return PANOPTES_OK;
   } catch (const ConfigError& e) {
     g_error = e.what();
@@ -129,6 +151,7 @@ int guarded(const panoptes_session* s, F&& f) {
     code = PANOPTES_ERROR_RUN;
   }
   report(s, g_error);
+  if (s && !key.empty()) s->failed_calls[key] = g_error;
   return code;
 }
 
@@ -150,18 +173,41 @@ std::vector<insitu::GridBlock> grid_blocks(const panoptes_session* s) {
   return v;
 }
 
+#ifdef PANOPTES_HAVE_MPI
+MPI_Comm comm_of(int fortran_comm) {
+  return fortran_comm == PANOPTES_COMM_WORLD ? MPI_COMM_WORLD : MPI_Comm_f2c(fortran_comm);
+}
+#endif
+
+// The session, built at the first collective call. Its preconditions and this rank's failed calls
+// are agreed with the other ranks first: a rank that cannot start refuses the call on every rank
+// (naming itself) instead of leaving them in the session's first collective.
 insitu::Session& session_of(panoptes_session* s) {
   need(s, "null session");
-  if (s->session) return *s->session;
-  need(s->grid.has_value() || s->source.has_value(),
-       "panoptes_set_grid (or _rectilinear, _spherical, _yinyang) must be called before the first snapshot");
-  need(s->block.has_value() || (s->source && !grid_blocks(s).empty()),
-       "panoptes_set_block must be called before the first snapshot");
+  if (s->session) {
+    if (!s->failed_calls.empty()) {
+      s->session->refuse_next_call(s->failures());
+      s->failed_calls.clear();
+    }
+    return *s->session;
+  }
+  std::exception_ptr local;
+  try {
+    need(s->failed_calls.empty(), s->failures());
+    need(s->grid.has_value() || s->source.has_value(),
+         "panoptes_set_grid (or _rectilinear, _spherical, _yinyang) must be called before the first snapshot");
+    need(s->block.has_value() || (s->source && !grid_blocks(s).empty()),
+         "panoptes_set_block must be called before the first snapshot");
+  } catch (...) {
+    local = std::current_exception();
+  }
+  s->failed_calls.clear();
+  s->agreement.agree(insitu::CallRecord{}, local, insitu::Failure::refused);
 #ifdef PANOPTES_HAVE_MPI
   int init = 0;
   MPI_Initialized(&init);
   if (init) {
-    MPI_Comm comm = s->fortran_comm == PANOPTES_COMM_WORLD ? MPI_COMM_WORLD : MPI_Comm_f2c(s->fortran_comm);
+    const MPI_Comm comm = comm_of(s->fortran_comm);
     if (s->source) {
       s->config.source_grid = s->source->summary();
       s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample, comm);
@@ -217,7 +263,7 @@ int set_source_grid(panoptes_session* s, const char* call, grid::GridKind kind, 
     }
     s->source = std::move(g);
     s->grid.reset();
-  });
+  }, "");
 }
 
 std::string shape_text(const std::array<long long, 3>& v) {
@@ -280,7 +326,10 @@ void bind_field(panoptes_session* s, const std::string& call, const char* name, 
 // The common checks of the set_field calls; returns the strides per axis (default: contiguous x-fastest).
 std::array<std::int64_t, 3> field_strides(panoptes_session* s, const std::string& call, const char* name, const void* data,
                                           int type, const long long strides[3]) {
-  need(s && name && data, call + ": null session, name or data");
+  need(s && name, call + ": null session or name");
+  // A binding that fails leaves none (not the previous step's array: a stale picture, issue 42).
+  s->fields.erase(name);
+  need(data, call + ": field \"" + std::string(name) + "\": null data");
   need(type == PANOPTES_FLOAT32 || type == PANOPTES_FLOAT64,
        call + ": type " + std::to_string(type) + "; expected PANOPTES_FLOAT32 or PANOPTES_FLOAT64");
   need(s->block.has_value(), call + ": call panoptes_set_block first");
@@ -294,7 +343,9 @@ void set_field_layout(panoptes_session* s, const std::string& call, const char* 
                       const char* layout, const long long extents[3], const long long strides[3],
                       std::optional<long long> count) {
   {
-    need(s && name && extents && strides, call + ": null session, name, extents or strides");
+    need(s && name, call + ": null session or name");
+    s->fields.erase(name);  // a binding that fails leaves none (not a stale one)
+    need(extents && strides, call + ": field \"" + std::string(name) + "\": null extents or strides");
     need(s->block.has_value(), call + ": call panoptes_set_block first");
     // No layout (NULL or ""; the Fortran module's panoptes_field without layout=): "xyz", but only
     // where the shape tells it from every other order (issue 42: a z-fastest array on a ghosted cube
@@ -360,30 +411,40 @@ extern "C" {
 
 int panoptes_create(const char* config, int config_is_file, int fortran_comm, panoptes_session** out) {
   return guarded(nullptr, [&] {
-    need(config && out, "panoptes_create: null config or output pointer");
+    need(out, "panoptes_create: null output pointer");
     *out = nullptr;
     auto s = std::make_unique<panoptes_session>();
     insitu::OverheadMeter::Scope counted(*s->meter);  // reading the configuration is Panoptes' too
     s->fortran_comm = fortran_comm;
+    std::exception_ptr local;
+    try {
+      need(config, "panoptes_create: null config");
+      try {
+        s->config = config_is_file ? insitu::load_session_config(config)
+                                   : insitu::parse_session_config_text(config, "configuration text");
+        s->config.validate();
+      } catch (const std::exception& e) {
+        throw ConfigError(e.what());
+      }
+    } catch (...) {
+      local = std::current_exception();
+    }
 #ifdef PANOPTES_HAVE_MPI
     int init = 0;
     MPI_Initialized(&init);
     if (init) {
-      MPI_Comm comm = fortran_comm == PANOPTES_COMM_WORLD ? MPI_COMM_WORLD : MPI_Comm_f2c(fortran_comm);
+      const MPI_Comm comm = comm_of(fortran_comm);
       MPI_Comm_rank(comm, &s->rank);
       MPI_Comm_size(comm, &s->ranks);
+      // Collective: a rank whose configuration is refused makes every rank's panoptes_create fail (the
+      // others would start a session and wait for it at the first snapshot).
+      s->agreement = insitu::RankAgreement(comm, s->config.mpi_timeout);
     }
 #endif
-    try {
-      s->config = config_is_file ? insitu::load_session_config(config)
-                                 : insitu::parse_session_config_text(config, "configuration text");
-      s->config.validate();
-    } catch (const std::exception& e) {
-      throw ConfigError(e.what());
-    }
+    s->agreement.agree(insitu::CallRecord{}, local, insitu::Failure::failed);
     s->config.program = "panoptes C API";
     *out = s.release();
-  });
+  }, "");
 }
 
 int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origin[3], const double spacing[3]) {
@@ -398,7 +459,7 @@ int panoptes_set_grid(panoptes_session* s, const int dims[3], const double origi
     }
     s->grid = g;
     s->source.reset();
-  });
+  }, "");
 }
 
 int panoptes_set_grid_rectilinear(panoptes_session* s, const int dims[3], const double* x, const double* y,
@@ -439,7 +500,7 @@ int panoptes_set_patch(panoptes_session* s, int patch) {
     s->block = next.block;
     s->fields = next.fields;
     s->patch = patch;
-  });
+  }, "");
 }
 
 int panoptes_set_resample(panoptes_session* s, int longest_axis_points, double outside_value) {
@@ -451,7 +512,7 @@ int panoptes_set_resample(panoptes_session* s, int longest_axis_points, double o
              " points; expected 2 to 4096 along the longest axis (0 = the source's largest dimension)");
     need(std::isfinite(outside_value), "panoptes_set_resample: the outside value is not finite");
     s->resample = {longest_axis_points, float(outside_value)};
-  });
+  }, "");
 }
 
 int panoptes_set_block(panoptes_session* s, const int offset[3], const int extent[3], const int ghost_lo[3],
@@ -470,7 +531,7 @@ int panoptes_set_block(panoptes_session* s, const int offset[3], const int exten
     }
     s->block = b;
     s->fields.clear();  // bound against the old block's shape
-  });
+  }, "");
 }
 
 int panoptes_set_halo(panoptes_session* s, const int valid_lo[3], const int valid_hi[3], int edges_valid) {
@@ -490,7 +551,7 @@ int panoptes_set_halo(panoptes_session* s, const int valid_lo[3], const int vali
       b.valid_hi[a] = hi;
     }
     b.edges_valid = edges_valid != 0;
-  });
+  }, "");
 }
 
 int panoptes_set_field(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3]) {
@@ -499,7 +560,7 @@ int panoptes_set_field(panoptes_session* s, const char* name, const void* data, 
     // {0, 0, 0} always meant what NULL means here (FieldInput's "contiguous x-fastest"), and codes pass it.
     const bool contiguous = strides && strides[0] == 0 && strides[1] == 0 && strides[2] == 0;
     bind_field(s, call, name, data, type, field_strides(s, call, name, data, type, contiguous ? nullptr : strides));
-  });
+  }, field_key(name));
 }
 
 int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data, int type, const long long strides[3],
@@ -507,21 +568,21 @@ int panoptes_set_field_n(panoptes_session* s, const char* name, const void* data
   return guarded(s, [&] {
     const std::string call = "panoptes_set_field_n";
     bind_field(s, call, name, data, type, field_strides(s, call, name, data, type, strides), count);
-  });
+  }, field_key(name));
 }
 
 int panoptes_set_field_layout(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
                               const long long extents[3], const long long strides[3]) {
   return guarded(s, [&] {
     set_field_layout(s, "panoptes_set_field_layout", name, data, type, layout, extents, strides, std::nullopt);
-  });
+  }, field_key(name));
 }
 
 int panoptes_set_field_layout_n(panoptes_session* s, const char* name, const void* data, int type, const char* layout,
                                 const long long extents[3], const long long strides[3], long long count) {
   return guarded(s, [&] {
     set_field_layout(s, "panoptes_set_field_layout_n", name, data, type, layout, extents, strides, count);
-  });
+  }, field_key(name));
 }
 
 int panoptes_process(panoptes_session* s, long long step, double time, int* taken) {
@@ -530,18 +591,18 @@ int panoptes_process(panoptes_session* s, long long step, double time, int* take
     insitu::Session& ss = session_of(s);
     const bool t = ss.process(step, time, inputs(s));
     if (taken) *taken = t ? 1 : 0;
-  });
+  }, "");
 }
 
 int panoptes_due(panoptes_session* s, long long step, double time, int* due) {
   return guarded(s, [&] {
     need(due, "panoptes_due: null output pointer");
     *due = session_of(s).due(step, time) ? 1 : 0;
-  });
+  }, "");
 }
 
 int panoptes_snapshot(panoptes_session* s, double time) {
-  return guarded(s, [&] { session_of(s).snapshot(time, inputs(s)); });
+  return guarded(s, [&] { session_of(s).snapshot(time, inputs(s)); }, "");
 }
 
 int panoptes_finalize(panoptes_session* s) {
@@ -555,7 +616,7 @@ int panoptes_finalize(panoptes_session* s) {
       const std::string report = insitu::overhead_report(ss.overhead());
       if (ss.rank() == 0) std::fprintf(stderr, "panoptes: %s", report.c_str());
     }
-  });
+  }, "");
 }
 
 void panoptes_destroy(panoptes_session* s) {

@@ -94,6 +94,8 @@ void SessionConfig::validate() const {
     throw Error("schedule: give exactly one of every_steps (> 0) or every_time (> 0)");
   if (schedule.every_time < 0 || !std::isfinite(schedule.every_time))
     throw Error("schedule.every_time: expected a finite number > 0");
+  if (!(mpi_timeout >= 0.1 && mpi_timeout <= 86400))
+    throw Error("resources.mpi_timeout: " + std::to_string(mpi_timeout) + "; expected 0.1 .. 86400 seconds");
   if (schedule.max_snapshots < 0) throw Error("schedule.max_snapshots: expected 0 (unlimited) or more");
   if (!(percentile > 0 && percentile <= 1)) throw Error("render.percentile: expected a value in (0, 1]");
   if (reference == ReferenceMode::fixed)
@@ -260,8 +262,9 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.render.iso_antialias = boolean(c, *r, "iso_antialias", "render.", true);
   }
   if (const auto* r = table(c, root, "resources")) {
-    only_keys(c, *r, "resources", {"check_memory"});
+    only_keys(c, *r, "resources", {"check_memory", "mpi_timeout"});
     s.check_memory = boolean(c, *r, "check_memory", "resources.", true);
+    s.mpi_timeout = num(c, *r, "mpi_timeout", "resources.", s.mpi_timeout);
   }
   if (const auto* t = root.get("task")) {
     const auto* a = t->as_array();
@@ -342,9 +345,12 @@ const char* config_keys_help() {
 [video]     crf = 20, preset = "superfast", gop = 1, threads = 1, fps = 30 (H.264 in fragmented MP4);
             playback_fps = 0 (the player's preferred rate; 0 = fps)
 [render]    sample_distance = 0.5 (voxels); percentile = 0.999 (quantile of |field| over the whole grid:
-            the reference "ref" of relative windows); reference = "snapshot" (this snapshot's quantile)
-            | "running-max" (running maximum over snapshots: colours comparable across frames, but
-            decaying waves fade); skip_empty = true; termination_alpha = 0.998;
+            the reference "ref" of relative windows); reference = "running" (the largest reference so
+            far: colours mean the same in every frame, a decaying wave darkens) | "snapshot" (each
+            snapshot's own quantile: every frame fills the colour map, brightness is not comparable);
+            [render.field.NAME] reference = "fixed", value = V (a physical reference in the field's
+            units); share_scale = "units" (two-field pictures of fields with the same unit on one scale)
+            | "none"; skip_empty = true; termination_alpha = 0.998;
             adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
             corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
@@ -352,7 +358,9 @@ const char* config_keys_help() {
             iso_antialias = true (isosurface silhouettes get partial coverage from rays that graze or
             nearly miss them: no stair steps; false = every pixel hit or missed, as before)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
-            available: MemAvailable or the cgroup limit; false = panoptes run --force)
+            available: MemAvailable or the cgroup limit; false = panoptes run --force);
+            mpi_timeout = 120 (seconds a rank waits in a Panoptes call for the other ranks before every
+            waiting rank reports them missing: no job hangs inside Panoptes)
 [[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |
             "isosurface" | "slice"; field = "name" (volume2: fields = ["a", "b"])
   volume:     preset = "hot" (p-wave, s-wave, diverging, grayscale, hot, rainbow); extinction_scale = 1;

@@ -145,6 +145,10 @@ struct SessionConfig {
   /// Refuse to start when the estimated memory of a rank exceeds what it has available ([resources]
   /// check_memory; false = `--force`, for people who know better than the estimate).
   bool check_memory = true;
+  /// Seconds a rank waits in a session call for the other ranks before it reports them missing
+  /// ([resources] mpi_timeout; rank_agreement.hpp). Ranks in step arrive within a step's imbalance;
+  /// only a rank that stopped calling Panoptes is waited for this long.
+  double mpi_timeout = 120;
 
   /// Checks ranges and consistency (not the grid); throws panoptes::Error naming the key.
   void validate() const;

@@ -243,7 +243,7 @@ int refusals(const std::string& dir) {
     }
   };
   const bool bad = rank == 1 % size;  // rank 1, or rank 0 alone
-  const std::string other = "rank 1 refused its time or fields";
+  const std::string other = "rank 1 refused";
   expect_refused({good_a, bad ? huge_b : good_b}, bad ? "reach further than 64-bit offsets" : other, 0);
   if (bad) expect_refused({good_a}, "field \"b\" (read by a task) was not given", 0);
   else expect_refused({good_a, good_b}, other, 0);

@@ -26,6 +26,7 @@
 #include "core/strided.hpp"
 #include "insitu/halo.hpp"
 #include "insitu/output.hpp"
+#include "insitu/rank_agreement.hpp"
 #include "insitu/resources.hpp"
 #include "insitu/task_plan.hpp"
 #include "render/renderer.hpp"
@@ -80,6 +81,11 @@ struct Session::Impl {
 #ifdef PANOPTES_HAVE_MPI
   MPI_Comm comm = MPI_COMM_NULL;
 #endif
+  // Every collective call starts with an agreement of the ranks (rank_agreement.hpp).
+  RankAgreement agreement;
+  std::string stopped;          // why the session cannot go on (every later call throws it)
+  std::string caller_refusal;   // the caller's own failure, refused on every rank at the next call
+  std::string deferred_failure; // this rank's failure after an agreement, reported at the next one
   std::vector<BlockInfo> blocks;  // per rank
   halo::Exchange exchange;        // reads the trusted points, fetches the others
   std::vector<std::string> field_names;
@@ -136,6 +142,11 @@ struct Session::Impl {
   }
 
   void init();
+  int agree(Call call, CallRecord record, std::exception_ptr error = nullptr, Failure severity = Failure::none,
+            int stop = 0);
+  std::array<double, kShapeValues> shape() const;
+  bool due_here(std::int64_t step, double time) const;
+  void take_snapshot(double time, const std::vector<FieldInput>& fields);
   bool repeated(double time) const {
     return resumed && written == 0 && std::isfinite(last_time) && time <= last_time + 1e-9 * std::fabs(last_time);
   }
@@ -156,9 +167,68 @@ struct Session::Impl {
   void checkpoint(double time);
 };
 
+// Every rank's call starts here: a session that stopped throws at once (its ranks agreed on that, or
+// a late rank learns it at this call's agreement); the caller's refusal and this rank's failure since
+// the last call are told to every rank now.
+int Session::Impl::agree(Call call, CallRecord record, std::exception_ptr error, Failure severity, int stop) {
+  if (!stopped.empty()) throw Error(stopped);
+  record.call = call;
+  record.snapshots = snapshots;
+  if (!error && !deferred_failure.empty()) {
+    error = std::make_exception_ptr(Error(deferred_failure));
+    severity = Failure::failed;
+  } else if (!error && !caller_refusal.empty()) {
+    error = std::make_exception_ptr(UsageError(caller_refusal));
+    severity = Failure::refused;
+  }
+  caller_refusal.clear();
+  try {
+    return agreement.agree(record, error, severity, stop);
+  } catch (const AgreementError& e) {
+    if (e.stops()) stopped = std::string("the session stopped: ") + e.what();
+    throw;
+  } catch (const std::exception& e) {
+    if (severity == Failure::failed) stopped = std::string("the session stopped: ") + e.what();
+    throw;
+  }
+}
+
+// What every rank must describe alike: the global grid and a digest of the configuration's fields
+// that shape the database (a rank reading another file would write other movies into it).
+std::array<double, kShapeValues> Session::Impl::shape() const {
+  std::array<double, kShapeValues> v{};
+  for (int a = 0; a < 3; ++a) {
+    v[std::size_t(a)] = grid.dims[a];
+    v[std::size_t(3 + a)] = grid.origin[a];
+    v[std::size_t(6 + a)] = grid.spacing[a];
+  }
+  std::string text = cfg.output_dir + '\n' + cfg.rig + '\n' + std::to_string(cfg.width) + 'x' + std::to_string(cfg.height) +
+                     '\n' + to_string(cfg.mode) + '\n' + cfg.projection;
+  for (const TaskConfig& t : cfg.tasks) {
+    text += '\n' + t.name + ':' + render::to_string(t.kind);
+    for (const std::string& f : t.fields) text += ':' + f;
+  }
+  // 48 bits: exact in a double, which the agreement compares.
+  v[kShapeValues - 1] = double(std::hash<std::string>{}(text) & ((std::uint64_t(1) << 48) - 1));
+  return v;
+}
+
 void Session::Impl::init() {
-  cfg.validate();
-  grid.validate();
+  // The first agreement: a rank whose configuration or grid is refused, or that describes another
+  // grid or configuration than the others, stops every rank here instead of leaving them waiting in
+  // the block exchange below (issue 42).
+  {
+    std::exception_ptr local;
+    try {
+      cfg.validate();
+      grid.validate();
+    } catch (...) {
+      local = std::current_exception();
+    }
+    CallRecord start;
+    if (!local) start.shape = shape();
+    agree(Call::start, start, local, Failure::failed);
+  }
   // Every rank's block, for ownership, bricks and the ghost exchange.
   const std::array<int, halo::kPackedInts> mine = halo::pack_block(block);
   std::vector<int> all(halo::kPackedInts * std::size_t(size));
@@ -603,6 +673,10 @@ void Session::Impl::render_snapshot(int frame) {
 }
 
 void Session::Impl::encode_batch() {
+  // After a failed append this rank encodes no more (its movies are incomplete), but it goes on with
+  // the snapshot's exchanges: the other ranks wait for its partial images, and the snapshot's last
+  // agreement tells them all of the failure (issue 42: a full disk on one rank hung the others).
+  if (!deferred_failure.empty()) batch_n = 0;
   if (batch_n == 0) return;
   const auto t0 = Clock::now();
   const int K = int(plan.size());
@@ -621,7 +695,11 @@ void Session::Impl::encode_batch() {
       if (!error) error = std::current_exception();
     }
   }
-  if (error) std::rethrow_exception(error);
+  if (error) {
+    deferred_failure = "encoding on rank " + std::to_string(rank) + " failed: " + exception_message(error);
+    batch_n = 0;
+    return;
+  }
   frames_encoded += std::int64_t(batch_n) * K;
   batch_n = 0;
   time.encode += since(t0);
@@ -630,23 +708,40 @@ void Session::Impl::encode_batch() {
 void Session::Impl::checkpoint(double t) {
   auto t0 = Clock::now();
   int frames = INT_MAX;
-  if (writer) {
-    writer->flush();
-    if (!owned.empty()) frames = writer->complete_frames();
+  std::exception_ptr local;
+  try {
+    if (writer) {
+      writer->flush();
+      if (!owned.empty()) frames = writer->complete_frames();
+    }
+  } catch (...) {
+    local = std::current_exception();
   }
+  // Every rank's encoding and flushing went well, or every rank learns which failed (this rank's
+  // failed appends are in deferred_failure, which agree() reports).
+  CallRecord r;
+  r.time = t;
+  r.compare_time = true;
+  agree(Call::frames, r, local, Failure::failed);
 #ifdef PANOPTES_HAVE_MPI
   if (size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, comm);
 #endif
   if (rank == 0) {
-    writer->set_time(snapshots - 1, t);
-    {  // every field's running maximum, so a resumed run continues the scale whatever its mode
-      std::vector<double> refs;
-      for (const render::RunningMax& r : references) refs.push_back(r.value());
-      writer->set_note(kRunningMaxNote, format_references(refs));
+    try {
+      writer->set_time(snapshots - 1, t);
+      {  // every field's running maximum, so a resumed run continues the scale whatever its mode
+        std::vector<double> refs;
+        for (const render::RunningMax& ref : references) refs.push_back(ref.value());
+        writer->set_note(kRunningMaxNote, format_references(refs));
+      }
+      for (std::size_t f = 0; f < last_references.size(); ++f)
+        writer->set_field_reference(snapshots - 1, int(f), last_references[f]);
+      writer->checkpoint(frames == INT_MAX ? snapshots : frames);
+    } catch (const std::exception& e) {
+      // The other ranks have returned: they learn of it at their next call.
+      deferred_failure = std::string("rank 0 could not write the manifest: ") + e.what();
+      throw;
     }
-    for (std::size_t f = 0; f < last_references.size(); ++f)
-      writer->set_field_reference(snapshots - 1, int(f), last_references[f]);
-    writer->checkpoint(frames == INT_MAX ? snapshots : frames);
   }
   time.checkpoint += since(t0);
 }
@@ -678,6 +773,9 @@ Session::Session(const SessionConfig& config, const render::GridGeometry& grid, 
   impl_->cfg = config;
   impl_->grid = grid;
   impl_->block = block;
+  // The agreements' own communicator first: its duplication waits at most the timeout for every rank,
+  // so a rank that never starts its session cannot hang the others in the duplication below.
+  impl_->agreement = RankAgreement(comm, config.mpi_timeout);
   MPI_Comm_dup(comm, &impl_->comm);
   MPI_Comm_rank(impl_->comm, &impl_->rank);
   MPI_Comm_size(impl_->comm, &impl_->size);
@@ -695,24 +793,68 @@ Session::~Session() {
 #endif
 }
 
-bool Session::due(std::int64_t step, double time) const {
-  const ScheduleConfig& s = impl_->cfg.schedule;
-  Impl::check_finite("due", time);
-  if (impl_->finalized) return false;
-  if (s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots) return false;
-  if (impl_->repeated(time)) return false;
+// The schedule's answer on this rank (the agreement before it made every rank's arguments and state alike).
+bool Session::Impl::due_here(std::int64_t step, double time) const {
+  const ScheduleConfig& s = cfg.schedule;
+  if (finalized) return false;
+  if (s.max_snapshots > 0 && snapshots >= s.max_snapshots) return false;
+  if (repeated(time)) return false;
   if (s.every_steps > 0) return step % s.every_steps == 0;
-  return time >= impl_->next_time - 1e-9 * s.every_time;
+  return time >= next_time - 1e-9 * s.every_time;
+}
+
+namespace {
+std::exception_ptr finite_refusal(const char* call, double time) {
+  if (std::isfinite(time)) return nullptr;
+  return std::make_exception_ptr(UsageError(std::string(call) + ": time " + number_text(time) +
+                                            "; expected a finite simulation time"));
+}
+}  // namespace
+
+bool Session::due(std::int64_t step, double time) const {
+  Impl& m = *impl_;
+  OverheadMeter::Scope counted(*m.meter);
+  // Collective (issue 42): ranks that disagree here (another step or time, a skipped call) would take
+  // different snapshots and wait for each other in the next one.
+  CallRecord r;
+  r.step = step;
+  r.time = time;
+  r.compare_time = true;
+  m.agree(Call::due, r, finite_refusal("due", time), Failure::refused);
+  return m.due_here(step, time);
 }
 
 void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   Impl& m = *impl_;
   OverheadMeter::Scope counted(*m.meter);  // also when it throws
+  m.take_snapshot(time, fields);
+}
+
+void Session::Impl::take_snapshot(double time, const std::vector<FieldInput>& fields) {
+  Impl& m = *this;
   if (m.finalized) throw Error("snapshot: the session is finalized");
   // [output] mode = "resume": a restarted run repeats the steps since its checkpoint; what the
   // database already holds is not written twice (the same time on every rank: the same decision).
   // NaN is never a repeat: it is refused below.
-  if (m.repeated(time)) {
+  const bool repeat = m.repeated(time);
+  // The time and the fields are this rank's own arguments (another rank's may be fine): every rank
+  // learns in the snapshot's agreement whether any refused its own, and then all refuse this snapshot
+  // instead of waiting for that rank in the snapshot's collectives. SIGINT/SIGTERM (when the program
+  // installed core/stop_request.hpp's handlers, as `panoptes run` does) is agreed there too: every
+  // rank stops before this snapshot; the writer's destructor marks the database interrupted.
+  std::exception_ptr refusal;
+  if (!repeat) {
+    refusal = m.time_refusal(time);
+    if (!refusal) refusal = m.field_refusal(fields);
+  }
+  CallRecord r;
+  r.time = time;
+  r.compare_time = true;
+  const int stop = m.agree(Call::snapshot, r, refusal, Failure::refused, stop_requested());
+  if (stop)
+    throw Interrupted(stop, m.cfg.output_dir + ": stopped by " + signal_name(stop) + " before snapshot " +
+                                std::to_string(m.snapshots) + "; the database is marked interrupted");
+  if (repeat) {
     if (m.rank == 0)
       log::info(m.cfg.output_dir + ": snapshot at time " + number_text(time) + " skipped: the resumed database already holds "
                 "snapshots up to time " + number_text(m.last_time));
@@ -720,26 +862,6 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
   }
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
-  // SIGINT/SIGTERM (when the program installed core/stop_request.hpp's handlers, as `panoptes run`
-  // does): every rank stops before this snapshot; the writer's destructor marks the database
-  // interrupted with the snapshots taken so far.
-  // The time and the fields are this rank's own arguments (another rank's may be fine): every rank
-  // learns in the same reduction whether any refused its own, and then all refuse this snapshot
-  // instead of waiting for that rank in the snapshot's collectives.
-  std::exception_ptr refusal = m.time_refusal(time);
-  if (!refusal) refusal = m.field_refusal(fields);
-  int agree[2] = {stop_requested(), refusal ? m.rank + 1 : 0};
-#ifdef PANOPTES_HAVE_MPI
-  if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, agree, 2, MPI_INT, MPI_MAX, m.comm);
-#endif
-  const int stop = agree[0];
-  if (stop)
-    throw Interrupted(stop, m.cfg.output_dir + ": stopped by " + signal_name(stop) + " before snapshot " +
-                                std::to_string(m.snapshots) + "; the database is marked interrupted");
-  if (refusal) std::rethrow_exception(refusal);
-  if (agree[1])
-    throw Error("snapshot: rank " + std::to_string(agree[1] - 1) + " refused its time or fields (its message says why); no rank "
-                "took this snapshot");
   auto t0 = Clock::now();
   m.load_fields(fields);
   std::vector<double> ref(m.field_names.size());
@@ -766,34 +888,40 @@ void Session::snapshot(double time, const std::vector<FieldInput>& fields) {
 }
 
 bool Session::process(std::int64_t step, double time, const std::vector<FieldInput>& fields) {
-  if (!std::isfinite(time)) {
-    // due() cannot answer for such a time. Under an every_steps schedule the step decides: a due step
-    // takes the time into snapshot(), which refuses it on every rank (one rank's NaN then cannot leave
-    // the others waiting there); a step that is not due, or an every_time schedule, refuses it here.
-    const ScheduleConfig& s = impl_->cfg.schedule;
-    if (s.every_steps > 0 && step % s.every_steps == 0 && !impl_->finalized &&
-        !(s.max_snapshots > 0 && impl_->snapshots >= s.max_snapshots)) {
-      snapshot(time, fields);  // throws
-      return false;
-    }
-    Impl::check_finite("process", time);
-  }
-  if (!due(step, time)) return false;
-  snapshot(time, fields);
+  Impl& m = *impl_;
+  OverheadMeter::Scope counted(*m.meter);
+  // One agreement every step (a few microseconds): a rank that skips a step's call, or passes another
+  // step or time, is named at once instead of leaving the others waiting in the next snapshot (issue
+  // 42). A time that is not finite is refused on every rank (due() cannot answer for it).
+  CallRecord r;
+  r.step = step;
+  r.time = time;
+  r.compare_time = true;
+  m.agree(Call::process, r, finite_refusal("process", time), Failure::refused);
+  if (!m.due_here(step, time)) return false;
+  m.take_snapshot(time, fields);
   return true;
 }
+
+void Session::refuse_next_call(const std::string& message) { impl_->caller_refusal = message; }
 
 void Session::finalize() {
   Impl& m = *impl_;
   if (m.finalized) return;
-  m.finalized = true;
   {
     OverheadMeter::Scope counted(*m.meter);
     int frames = INT_MAX;
-    if (m.writer && !m.owned.empty()) {
-      m.writer->flush();
-      frames = m.writer->complete_frames();
+    std::exception_ptr local;
+    try {
+      if (m.writer && !m.owned.empty()) {
+        m.writer->flush();
+        frames = m.writer->complete_frames();
+      }
+    } catch (...) {
+      local = std::current_exception();
     }
+    m.agree(Call::finalize, CallRecord{}, local, Failure::failed);
+    m.finalized = true;
 #ifdef PANOPTES_HAVE_MPI
     if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, m.comm);
 #endif
@@ -850,7 +978,8 @@ std::vector<RankOverhead> Session::overhead() const {
                                   mine.elapsed_wall_s};
   std::vector<double> all(values, values + kValues);
 #ifdef PANOPTES_HAVE_MPI
-  const Impl& m = *impl_;
+  Impl& m = *impl_;
+  m.agree(Call::report, CallRecord{});
   if (m.size > 1) {
     all.resize(kValues * std::size_t(m.size));
     MPI_Allgather(values, kValues, MPI_DOUBLE, all.data(), kValues, MPI_DOUBLE, m.comm);
@@ -865,7 +994,8 @@ std::vector<RankOverhead> Session::overhead() const {
 SessionStats Session::reduced_stats() const {
   SessionStats s = stats();
 #ifdef PANOPTES_HAVE_MPI
-  const Impl& m = *impl_;
+  Impl& m = *impl_;
+  m.agree(Call::report, CallRecord{});
   if (m.size > 1) {
     double t[5] = {s.time.copy, s.time.render, s.time.composite, s.time.encode, s.time.checkpoint};
     MPI_Allreduce(MPI_IN_PLACE, t, 5, MPI_DOUBLE, MPI_MAX, m.comm);

@@ -123,10 +123,15 @@ class Session {
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
-  /// True when the schedule asks for a snapshot at this step / simulation time (same answer on every
-  /// rank given the same arguments). Steps count from 0; with schedule.every_steps = N, steps 0, N,
-  /// 2N… are due; with every_time = Δt, the first step whose time reaches 0, Δt, 2Δt… (each once).
-  /// Throws UsageError for a time that is not finite.
+  /// True when the schedule asks for a snapshot at this step / simulation time (collective: the ranks
+  /// agree on the step and time first, rank_agreement.hpp). Steps count from 0; with
+  /// schedule.every_steps = N, steps 0, N, 2N… are due; with every_time = Δt, the first step whose time
+  /// reaches 0, Δt, 2Δt… (each once). Throws UsageError for a time that is not finite.
+  ///
+  /// Every collective call starts with that agreement: when one rank's call fails, or the ranks are out
+  /// of step (another call, step, time or grid), every rank's call throws, naming the rank and its
+  /// message; a rank waits at most [resources] mpi_timeout seconds for the others. A refused argument
+  /// refuses the call on every rank; anything else stops the session (every later call throws).
   bool due(std::int64_t step, double time) const;
   /// Renders and stores one snapshot of `fields` (must include every field a task reads) at
   /// simulation time `time`. Collective. Throws Error on missing fields or exhausted max_snapshots.
@@ -139,6 +144,9 @@ class Session {
   bool process(std::int64_t step, double time, const std::vector<FieldInput>& fields);
   /// Closes every movie and marks the database complete (collective). Idempotent.
   void finalize();
+  /// The caller failed on this rank (a field it could not bind, ...): its next collective call is
+  /// refused on every rank with `message`, naming this rank, instead of using what it holds.
+  void refuse_next_call(const std::string& message);
 
   /// Called on the owner rank with every finished frame before it is encoded (tests, previews).
   using FrameObserver = std::function<void(int camera, int task, int frame, const Image& image)>;

@@ -11,6 +11,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "core/error.hpp"
@@ -18,6 +20,7 @@
 #include "camera/rig_spec.hpp"
 #include "grid/grid_description.hpp"
 #include "insitu/grid_adapter.hpp"
+#include "insitu/rank_agreement.hpp"
 #include "insitu/resources.hpp"
 #include "insitu/session.hpp"
 #include "insitu/task_plan.hpp"
@@ -44,8 +47,13 @@ std::array<int, 3> triple(const std::vector<long long>& v, const char* what, con
 class PySession {
  public:
   PySession(const std::string& config, bool is_file, const py::object& comm) {
-    config_ = is_file ? insitu::load_session_config(config) : insitu::parse_session_config_text(config, "configuration text");
-    config_.validate();
+    std::exception_ptr local;
+    try {
+      config_ = is_file ? insitu::load_session_config(config) : insitu::parse_session_config_text(config, "configuration text");
+      config_.validate();
+    } catch (...) {
+      local = std::current_exception();
+    }
     config_.program = "panoptes Python";
     if (!comm.is_none()) {
 #if defined(PANOPTES_HAVE_MPI4PY)
@@ -59,6 +67,26 @@ class PySession {
       throw Error("Session: a communicator was given, but this Panoptes was built without MPI or without mpi4py");
 #endif
     }
+    // Collective (issue 42): a rank whose configuration is refused makes every rank's Session() raise;
+    // the others would otherwise wait for it at the first snapshot.
+#ifdef PANOPTES_HAVE_MPI
+    int init = 0;
+    MPI_Initialized(&init);
+    if (comm_ || init) {
+      py::gil_scoped_release release;
+      agreement_ = insitu::RankAgreement(comm_ ? *comm_ : MPI_COMM_WORLD, config_.mpi_timeout);
+    }
+#endif
+    py::gil_scoped_release release;
+    agreement_.agree(insitu::CallRecord{}, local, insitu::Failure::failed);
+  }
+
+  /// A call of this process's that raised (a field it could not bind, ...): the next collective call
+  /// is refused on every rank, naming this one, instead of rendering what it holds.
+  /// Keyed by what the call sets ("set_block", "field T", ...): a later call that sets it right clears it.
+  void record_outcome(const std::string& key, const std::string* failure) {
+    if (failure) failed_calls_[key] = *failure;
+    else failed_calls_.erase(key);
   }
 
   void set_grid(const std::vector<long long>& dims, const std::array<double, 3>& origin,
@@ -161,6 +189,7 @@ class PySession {
   /// Binds `array` (shape (nz, ny, nx) of the GHOSTED block, float32 or float64, any strides) without
   /// copying it.
   void set_field(const std::string& name, const py::array& array) {
+    fields_.erase(name);  // a binding that fails leaves none (not the previous step's array)
     if (!block_) throw Error("set_field: call set_block first");
     const insitu::LocalBlock& b = *block_;
     const std::array<py::ssize_t, 3> shape{b.extent[2] + b.ghost_lo[2] + b.ghost_hi[2],
@@ -224,11 +253,25 @@ class PySession {
   }
 
   insitu::Session& session() {
-    if (session_) return *session_;
-    if (!grid_ && !source_) throw Error("set_grid (or set_grid_rectilinear, _spherical, _yinyang) must be called before the first snapshot");
-    if (!block_ && (!source_ || grid_blocks().empty())) throw Error("set_block must be called before the first snapshot");
-    if (source_) config_.source_grid = source_->summary();
+    if (session_) {
+      if (!failed_calls_.empty()) session_->refuse_next_call(failures());
+      failed_calls_.clear();
+      return *session_;
+    }
+    // The preconditions and this process's failed calls, agreed with the other ranks before the
+    // session's first collective (a rank that cannot start refuses the call on every rank).
+    std::exception_ptr local;
+    try {
+      if (!failed_calls_.empty()) throw Error(failures());
+      if (!grid_ && !source_) throw Error("set_grid (or set_grid_rectilinear, _spherical, _yinyang) must be called before the first snapshot");
+      if (!block_ && (!source_ || grid_blocks().empty())) throw Error("set_block must be called before the first snapshot");
+    } catch (...) {
+      local = std::current_exception();
+    }
+    failed_calls_.clear();
     py::gil_scoped_release release;  // collective construction: other ranks may still be in Python
+    agreement_.agree(insitu::CallRecord{}, local, insitu::Failure::refused);
+    if (source_) config_.source_grid = source_->summary();
 #ifdef PANOPTES_HAVE_MPI
     int init = 0;
     MPI_Initialized(&init);
@@ -340,7 +383,38 @@ class PySession {
   std::map<int, PatchState> other_patches_;
   std::unique_ptr<insitu::GridAdapter> adapter_;
   std::unique_ptr<insitu::Session> session_;
+  insitu::RankAgreement agreement_;  // before the session exists
+  std::map<std::string, std::string> failed_calls_;
+  std::string failures() const {
+    std::string all;
+    for (const auto& [what, message] : failed_calls_)
+      all += (all.empty() ? "" : "; ") + ("field \"" + what.substr(6) + "\" is not bound: its binding failed (" + message + ")");
+    return all;
+  }
 };
+
+// A field binding whose failure is remembered for the next collective call (PySession::record_outcome):
+// the other setters leave their state as it was when they fail, and the start agrees on what is missing.
+// `key`: what the call sets; set_field's is "field NAME" (its first argument).
+template <class... A>
+auto recorded(const char* key, void (PySession::*call)(A...)) {
+  return [key, call](PySession& s, A... a) {
+    std::string what = key;
+    if constexpr (sizeof...(A) > 0) {
+      using First = std::decay_t<std::tuple_element_t<0, std::tuple<A...>>>;
+      if constexpr (std::is_same_v<First, std::string>)
+        if (what == "field") what += " " + std::get<0>(std::forward_as_tuple(a...));
+    }
+    try {
+      (s.*call)(std::forward<A>(a)...);
+    } catch (const std::exception& e) {
+      const std::string message = e.what();
+      s.record_outcome(what, &message);
+      throw;
+    }
+    s.record_outcome(what, nullptr);
+  };
+}
 
 }  // namespace
 
@@ -354,7 +428,7 @@ void bind_session(py::module_& m) {
       .def("set_block", &PySession::set_block, py::arg("offset"), py::arg("extent"), py::arg("ghost_lo"),
            py::arg("ghost_hi"))
       .def("set_halo", &PySession::set_halo, py::arg("valid_lo"), py::arg("valid_hi"), py::arg("edges_valid"))
-      .def("set_field", &PySession::set_field, py::arg("name"), py::arg("array"))
+      .def("set_field", recorded("field", &PySession::set_field), py::arg("name"), py::arg("array"))
       .def("due", &PySession::due, py::arg("step"), py::arg("time"))
       .def("process", &PySession::process, py::arg("step"), py::arg("time"))
       .def("snapshot", &PySession::snapshot, py::arg("time"))
