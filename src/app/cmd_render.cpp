@@ -203,6 +203,7 @@ insitu::SessionConfig session_config(const Args& a, const std::string& first_fil
   cfg.outline = !a.no_outline;
   cfg.output_dir = a.out;
   cfg.mode = a.overwrite ? insitu::OutputMode::overwrite : insitu::OutputMode::create;
+  cfg.keep_interrupted = false;  // --overwrite is asked for on the command line
   cfg.title = a.title.empty() ? "panoptes render " + first_file : a.title;
   cfg.program = "panoptes render";
   cfg.existing_database_advice = "add --overwrite to replace it, or give another --out";

@@ -120,6 +120,7 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
   if (!options.out.empty()) cfg.output_dir = options.out;
   if (options.overwrite && options.resume) throw Error("--overwrite and --resume exclude each other");
   if (options.overwrite) cfg.mode = insitu::OutputMode::overwrite;
+  if (options.overwrite) cfg.keep_interrupted = false;  // asked for on the command line: replace it
   if (options.resume) cfg.mode = insitu::OutputMode::resume;
   cfg.validate();
   cfg.program = "panoptes run";

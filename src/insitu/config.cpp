@@ -118,7 +118,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   only_keys(c, root, "", allowed);
   SessionConfig s;
   if (const auto* o = table(c, root, "output")) {
-    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "resume_complete", "title", "units", "time_units", "field_units"});
+    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "resume_complete", "keep_interrupted", "title", "units", "time_units", "field_units"});
     s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
     // `overwrite = true/false` is the key's old spelling: it still means mode "overwrite"/"create".
     if (o->get("mode") && o->get("overwrite"))
@@ -135,6 +135,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
       }
     }
     s.resume_complete = boolean(c, *o, "resume_complete", "output.", false);
+    s.keep_interrupted = boolean(c, *o, "keep_interrupted", "output.", true);
     s.title = str(c, *o, "title", "output.", s.title);
     s.units = str(c, *o, "units", "output.", "");
     s.time_units = str(c, *o, "time_units", "output.", "");
@@ -324,7 +325,8 @@ const char* config_keys_help() {
 [output]    dir = "panoptes_out" (database directory); title = "in-situ visualization";
             units = "" (length unit of the grid); time_units = "" (unit of the snapshot times, e.g. "s");
             field_units = {} (unit of each field's values, e.g. { phi_p = "1/s" }: the players' colour legends);
-            mode = "create" (refuse a directory that holds a database) | "overwrite" (replace it) |
+            mode = "create" (refuse a directory that holds a database) | "overwrite" (replace it; an
+            interrupted one is kept beside as DIR.interrupted-N unless keep_interrupted = false) |
             "resume" (continue it after a checkpoint restart: its snapshots stay, snapshots repeated by
             the restarted run (time <= the last written time) are skipped, the movies go on; rig, tasks,
             grid, image, video settings and schedule must be the ones it was written with; a complete

@@ -109,6 +109,10 @@ struct SessionConfig {
   /// finished run from its last checkpoint). Off by default: a rerun into the same directory would
   /// otherwise skip every snapshot (their times are all in the database) and keep the old movies.
   bool resume_complete = false;
+  /// [output] keep_interrupted: mode = "overwrite" over an INTERRUPTED database keeps it beside, as
+  /// DIR.interrupted-N, instead of deleting it (issue 42: a restart meant to resume lost part 1 of its
+  /// run without a word). The commands' explicit --overwrite sets it false.
+  bool keep_interrupted = true;
   std::string title = "in-situ visualization";
   std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
   std::string command_line;

@@ -96,6 +96,37 @@ std::vector<double> parse_references(const std::string& text) {
   return v;
 }
 
+// mode = "overwrite" over an interrupted run: that run's snapshots are the only copy of its movies (a
+// restart that meant "resume" would delete them), so they are kept beside, renamed (one rename, nothing
+// copied), and the log says where and how to resume instead.
+namespace {
+void keep_interrupted(const SessionConfig& cfg) {
+  struct stat st{};
+  const std::string man = cfg.output_dir + "/panoptes.json";
+  if (::lstat(man.c_str(), &st) != 0) return;
+  store::Manifest old;
+  try {
+    old = store::read_manifest(man);
+  } catch (const std::exception&) {
+    return;  // not a readable database: overwrite replaces it as before
+  }
+  if (old.status != store::Status::interrupted || old.frames_written <= 0) return;
+  std::string kept;
+  for (int n = 1; n < 1000 && kept.empty(); ++n) {
+    const std::string candidate = cfg.output_dir + ".interrupted-" + std::to_string(n);
+    if (::lstat(candidate.c_str(), &st) != 0) kept = candidate;
+  }
+  if (kept.empty() || std::rename(cfg.output_dir.c_str(), kept.c_str()) != 0)
+    throw FileError(cfg.output_dir, "holds an interrupted run (" + std::to_string(old.frames_written) +
+                                        " snapshots) that mode = \"overwrite\" would delete, and it could not be kept "
+                                        "beside; set [output] mode = \"resume\" to continue it, or keep_interrupted = false to "
+                                        "delete it");
+  log::warn(cfg.output_dir + " held an interrupted run (" + std::to_string(old.frames_written) +
+            " snapshots): mode = \"overwrite\" starts a new database and keeps that run as " + kept +
+            " (a restart that should continue it sets [output] mode = \"resume\"; keep_interrupted = false deletes it)");
+}
+}  // namespace
+
 SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifest& manifest,
                                   const std::vector<int>& owned, const OutputGroup& g) {
   SessionOutput out;
@@ -124,6 +155,7 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
                                                                  "\"resume\" to continue it after a restart")
                                                    : cfg.existing_database_advice));
         o.overwrite = cfg.mode == OutputMode::overwrite;
+        if (o.overwrite && cfg.keep_interrupted) keep_interrupted(cfg);
         out.writer.emplace(store::DatabaseWriter::create(cfg.output_dir, manifest, o));
       }
     } catch (...) {

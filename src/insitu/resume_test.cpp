@@ -343,3 +343,42 @@ TEST(InsituResume, RefusesAnotherSchedule) {
 }
 
 }  // namespace
+
+// mode = "overwrite" over an interrupted run keeps it beside (issue 42, point 8: a restart from step 50
+// with "overwrite" deleted part 1 without a word); a complete database is replaced as before, and
+// keep_interrupted = false (the commands' --overwrite) deletes an interrupted one.
+TEST(InsituResume, OverwriteKeepsAnInterruptedRunBeside) {
+  const fs::path base = fs::temp_directory_path() / ("insitu_keep_" + std::to_string(::getpid()));
+  fs::remove_all(base);
+  fs::create_directories(base);
+  const fs::path dir = base / "db", kept = base / "db.interrupted-1";
+  {
+    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    for (int step = 0; step < 2; ++step) {
+      const auto f = field(time_of(step));
+      s.process(step, time_of(step), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+    }
+  }  // no finalize: interrupted
+  ASSERT_EQ(store::Database::open(dir).status(), store::Status::interrupted);
+  run(dir, insitu::OutputMode::overwrite, 3);  // the restart that should have resumed
+  ASSERT_TRUE(fs::exists(kept / "panoptes.json"));
+  EXPECT_EQ(store::Database::open(kept).frame_count(), 2);
+  EXPECT_EQ(store::Database::open(kept).status(), store::Status::interrupted);
+  EXPECT_EQ(store::Database::open(dir).frame_count(), kSteps - 3);
+  // Complete: replaced, nothing kept.
+  run(dir, insitu::OutputMode::overwrite, 4);
+  EXPECT_FALSE(fs::exists(base / "db.interrupted-2"));
+  EXPECT_EQ(store::Database::open(dir).frame_count(), kSteps - 4);
+  // keep_interrupted = false: deleted.
+  {
+    insitu::SessionConfig c = config(dir, insitu::OutputMode::overwrite);
+    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    const auto f = field(0);
+    s.process(0, 0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+  }
+  insitu::SessionConfig c = config(dir, insitu::OutputMode::overwrite);
+  c.keep_interrupted = false;
+  { insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid())); }
+  EXPECT_FALSE(fs::exists(base / "db.interrupted-2"));
+  fs::remove_all(base);
+}
