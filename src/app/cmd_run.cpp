@@ -182,6 +182,13 @@ void run_seismic_insitu(const std::string& text, const std::string& source, cons
 #endif
   const bool root = solver.rank() == 0;
   const bool tty = ::isatty(STDERR_FILENO);
+  // A replaced database's seismograms are the old run's: they go with it (issue 42: a receiver the new
+  // run no longer has kept its old CSV beside the new movies). Only the .csv files this command writes.
+  if (root && cfg.mode != insitu::OutputMode::resume) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(cfg.output_dir + "/seismograms", ec))
+      if (e.path().extension() == ".csv" && e.is_regular_file()) std::filesystem::remove(e.path(), ec);
+  }
   if (root && !options.quiet)
     std::fprintf(stderr,
                  "panoptes run: %dx%dx%d grid, %d steps of %.3g s on %d rank(s); %d cameras x %d tasks = %d streams of "

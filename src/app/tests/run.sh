@@ -82,6 +82,9 @@ printf '[[receiver]]\nname = "top"\nposition = [1400.0, 1200.0, 0.0]\n' | cat ti
 "$bin" run rec.toml --out rec_db -q > rec.log 2>&1 || { cat rec.log; echo "FAIL: run with a receiver"; exit 1; }
 check_seismograms rec_db
 grep -q "seismograms: 1 receiver" rec.log || { cat rec.log; echo "FAIL: the run does not say where the seismograms are"; exit 1; }
+# A rerun with --overwrite and without that receiver leaves no stale seismogram of the old run.
+"$bin" run tiny.toml --out rec_db --overwrite -q > rec2.log 2>&1 || { cat rec2.log; echo "FAIL: overwrite"; exit 1; }
+[ ! -e rec_db/seismograms/top.csv ] || { echo "FAIL: the old run's seismogram top.csv survived --overwrite"; exit 1; }
 
 if command -v mpirun > /dev/null; then
   mpirun --oversubscribe -np 2 "$bin" run tiny.toml --out tiny_db2 -q > mpi.log 2>&1 || { cat mpi.log; echo "FAIL: mpirun"; exit 1; }
