@@ -293,19 +293,15 @@ void run(const Args& args) {
   // --grid: the volumes hold values at the points of a non-uniform grid, resampled by the in-situ grid
   // stage onto a uniform grid over its bounding box (one process: every patch is one whole block).
   std::optional<app::RenderGrid> source;
-  std::unique_ptr<insitu::GridAdapter> adapter;
   if (!a.grid_file.empty()) {
     if (!a.spacing.empty() || !a.origin.empty())
       throw Error("--grid places the points itself; --spacing and --origin are for uniform volumes");
     source = app::read_render_grid(a.grid_file);
-    std::vector<insitu::GridBlock> blocks;
-    for (int p = 0; p < source->source.patches(); ++p) blocks.push_back(insitu::GridBlock::whole(source->source, p));
-    adapter = std::make_unique<insitu::GridAdapter>(source->source, blocks, source->resample);
-    cfg.source_grid = source->source.summary();
   }
   // The first volume fixes the grid of the whole series.
   app::Volume first = source ? app::Volume{} : app::read_volume(files[0]);
-  render::GridGeometry grid = adapter ? adapter->render_grid() : render::GridGeometry{first.dims, first.origin, first.spacing};
+  render::GridGeometry grid = source ? insitu::GridAdapter::cover(source->source, source->resample)
+                                     : render::GridGeometry{first.dims, first.origin, first.spacing};
   if (series.present()) {
     app::check_volume_against_sidecar(files[0], first, series.first(), series.paths.front());
     grid.spacing = series.first().spacing;
@@ -330,7 +326,12 @@ void run(const Args& args) {
     cfg.check_memory = false;
   }
 
-  insitu::Session session(cfg, grid, adapter ? adapter->render_block() : insitu::LocalBlock::whole(grid));
+  // A source grid: the session's grid stage resamples it (every patch is one whole block here).
+  std::vector<insitu::GridBlock> blocks;
+  if (source)
+    for (int p = 0; p < source->source.patches(); ++p) blocks.push_back(insitu::GridBlock::whole(source->source, p));
+  insitu::Session session = source ? insitu::Session(cfg, source->source, blocks, source->resample)
+                                   : insitu::Session(cfg, grid, insitu::LocalBlock::whole(grid));
   const bool tty = ::isatty(STDERR_FILENO) && !a.quiet;
   const long long total = (long long)files.size() * session.camera_count() * (long long)session.task_count();
   long long done = 0;
@@ -343,13 +344,13 @@ void run(const Args& args) {
   const std::vector<double> times = series.times().value_or(std::vector<double>{});
   auto time_of = [&](std::size_t f) { return times.empty() ? double(f) : times[f]; };
   for (std::size_t f = 0; f < files.size(); ++f) {
-    if (adapter) {
+    if (source) {
       const std::vector<float> values = app::read_grid_volume(files[f], source->source);
       warn_if_not_finite(files[f], values);
       std::vector<insitu::FieldInput> patches;
       for (int p = 0; p < source->source.patches(); ++p)
         patches.push_back({field, values.data() + p * source->source.points_per_patch(), insitu::ScalarType::f32, {0, 0, 0}});
-      session.snapshot(time_of(f), adapter->adapt(patches));
+      session.snapshot(time_of(f), patches);
       continue;
     }
     app::Volume vol = f == 0 ? std::move(first) : app::read_volume(files[f]);

@@ -104,9 +104,7 @@ inline RenderGrid read_render_grid(const std::string& path) {
       c.fail("grid." + names[a], std::to_string(coords[a].size()) + " coordinates; expected 2 to 65535");
   }
   RenderGrid g;
-  g.source = kind == grid::GridKind::rectilinear ? grid::GridDescription::rectilinear(coords[0], coords[1], coords[2])
-             : kind == grid::GridKind::spherical ? grid::GridDescription::spherical(coords[0], coords[1], coords[2])
-                                                 : grid::GridDescription::yinyang(coords[0], coords[1], coords[2]);
+  g.source = grid::GridDescription::of_kind(kind, coords[0], coords[1], coords[2]);
   try {
     g.source.validate();
   } catch (const std::exception& e) {

@@ -55,7 +55,6 @@ struct panoptes_session {
     std::map<std::string, insitu::FieldInput> fields;
   };
   std::map<int, PatchState> other_patches;
-  std::unique_ptr<insitu::GridAdapter> adapter;
   bool finalized = false;  // the overhead report is printed by the first panoptes_finalize only
   // Counts every call on this handle as Panoptes' CPU time, not only the session's own: binding fields,
   // the grid adapter's resampling and the schedule check of panoptes_process run outside the session's
@@ -209,10 +208,7 @@ insitu::Session& session_of(panoptes_session* s) {
   if (init) {
     const MPI_Comm comm = comm_of(s->fortran_comm);
     if (s->source) {
-      s->config.source_grid = s->source->summary();
-      s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample, comm);
-      s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block(), comm,
-                                                     s->meter);
+      s->session = std::make_unique<insitu::Session>(s->config, *s->source, grid_blocks(s), s->resample, comm, s->meter);
     } else {
       s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, comm, s->meter);
     }
@@ -220,27 +216,25 @@ insitu::Session& session_of(panoptes_session* s) {
   }
 #endif
   if (s->source) {
-    s->config.source_grid = s->source->summary();
-    s->adapter = std::make_unique<insitu::GridAdapter>(*s->source, grid_blocks(s), s->resample);
-    s->session = std::make_unique<insitu::Session>(s->config, s->adapter->render_grid(), s->adapter->render_block(),
-                                                   s->meter);
+    s->session = std::make_unique<insitu::Session>(s->config, *s->source, grid_blocks(s), s->resample, s->meter);
   } else {
     s->session = std::make_unique<insitu::Session>(s->config, *s->grid, *s->block, s->meter);
   }
   return *s->session;
 }
 
+// The bound fields; on a source grid one input per field and block, blocks in patch order (as
+// grid_blocks() gave them to the session's grid stage, which resamples them at snapshots only).
 std::vector<insitu::FieldInput> inputs(const panoptes_session* s) {
   std::vector<insitu::FieldInput> v;
-  if (!s->adapter) {
+  if (!s->source) {
     for (const auto& [name, f] : s->fields) v.push_back(f);
     return v;
   }
-  // One input per field and block, blocks in patch order (as grid_blocks() gave them to the adapter).
   for (const auto& [patch, st] : all_patches(s))
     if (st.block)
       for (const auto& [name, f] : st.fields) v.push_back(f);
-  return s->adapter->adapt(v);
+  return v;
 }
 
 // The three non-uniform grid calls: coordinates per axis, validated.
@@ -253,9 +247,7 @@ int set_source_grid(panoptes_session* s, const char* call, grid::GridKind kind, 
       need(dims[d] >= 2 && dims[d] <= 65535, std::string(call) + ": dims[" + std::to_string(d) + "] = " +
                                                  std::to_string(dims[d]) + "; expected 2 to 65535 points");
     std::vector<double> x(a, a + dims[0]), y(b, b + dims[1]), z(c, c + dims[2]);
-    grid::GridDescription g = kind == grid::GridKind::rectilinear ? grid::GridDescription::rectilinear(x, y, z)
-                              : kind == grid::GridKind::spherical ? grid::GridDescription::spherical(x, y, z)
-                                                                  : grid::GridDescription::yinyang(x, y, z);
+    grid::GridDescription g = grid::GridDescription::of_kind(kind, std::move(x), std::move(y), std::move(z));
     try {
       g.validate();
     } catch (const std::exception& e) {

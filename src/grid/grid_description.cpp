@@ -78,6 +78,17 @@ GridDescription GridDescription::yinyang(std::vector<double> r, std::vector<doub
   return d;
 }
 
+GridDescription GridDescription::of_kind(GridKind kind, std::vector<double> a, std::vector<double> b,
+                                         std::vector<double> c) {
+  switch (kind) {
+    case GridKind::rectilinear: return rectilinear(std::move(a), std::move(b), std::move(c));
+    case GridKind::spherical: return spherical(std::move(a), std::move(b), std::move(c));
+    case GridKind::yinyang: return yinyang(std::move(a), std::move(b), std::move(c));
+    case GridKind::uniform: break;
+  }
+  throw Error("a " + std::string(to_string(kind)) + " grid is given by its origin and spacing, not by coordinate arrays");
+}
+
 GridDescription GridDescription::yinyang_standard(std::vector<double> r, int n_theta, int n_phi, double margin_cells) {
   if (n_theta < 2 || n_phi < 2 || !(margin_cells >= 0 && margin_cells < 8))
     throw Error("yinyang: " + std::to_string(n_theta) + " x " + std::to_string(n_phi) + " angles with margin " +

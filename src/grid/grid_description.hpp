@@ -41,6 +41,10 @@ struct GridDescription {
   static GridDescription rectilinear(std::vector<double> x, std::vector<double> y, std::vector<double> z);
   static GridDescription spherical(std::vector<double> r, std::vector<double> theta, std::vector<double> phi);
   static GridDescription yinyang(std::vector<double> r, std::vector<double> theta, std::vector<double> phi);
+  /// The one door from a kind and three coordinate arrays (the C API, Python and `render --grid` all
+  /// come through here; a new kind is one case in this switch, and the compiler names a missing one).
+  /// Throws panoptes::Error for `uniform`, which has an origin and spacing, not coordinates.
+  static GridDescription of_kind(GridKind kind, std::vector<double> a, std::vector<double> b, std::vector<double> c);
   /// The usual Yin-Yang patch: `n_theta` colatitudes over [π/4 − m, 3π/4 + m] and `n_phi`
   /// longitudes over [−3π/4 − m', 3π/4 + m'], where the margins m, m' are `margin_cells` of the
   /// patch's own spacing (an overlap beyond the minimal covering, as codes use for interpolation).

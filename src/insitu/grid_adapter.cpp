@@ -89,6 +89,10 @@ render::GridGeometry cover_of(const grid::GridDescription& g, const ResampleOpti
 
 }  // namespace
 
+render::GridGeometry GridAdapter::cover(const grid::GridDescription& source, const ResampleOptions& options) {
+  return cover_of(source, options);
+}
+
 std::int64_t GridAdapter::Box::size() const {
   std::int64_t s = 1;
   for (int a = 0; a < 3; ++a) s *= std::max(0, hi[a] - lo[a]);

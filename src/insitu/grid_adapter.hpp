@@ -53,6 +53,12 @@ class GridAdapter {
               MPI_Comm comm);
 #endif
 
+  /// The uniform grid a source grid is resampled onto (what render_grid() will be), checking the
+  /// source and the options first: throws panoptes::Error naming the bad value. Local (no collective):
+  /// the session agrees on its outcome before the constructor's collectives.
+  static render::GridGeometry cover(const grid::GridDescription& source, const ResampleOptions& options);
+  /// How many of this rank's blocks each field is given for (adapt()'s `fields`: one input per block).
+  int block_count() const { return int(mine_.size()); }
   /// The uniform grid the session renders, and this rank's slab of it (no ghosts: the session
   /// fetches its ghost points from the neighbouring slabs).
   const render::GridGeometry& render_grid() const { return render_grid_; }

@@ -72,10 +72,10 @@ insitu::SessionConfig config(const fs::path& dir, insitu::OutputMode mode) {
   return c;
 }
 
-render::GridGeometry grid() { return {{20, 18, 16}, {0, 0, 0}, {1, 1, 1}}; }
+render::GridGeometry test_grid() { return {{20, 18, 16}, {0, 0, 0}, {1, 1, 1}}; }
 
 std::vector<float> field(double t) {
-  const render::GridGeometry g = grid();
+  const render::GridGeometry g = test_grid();
   // A wave that grows until the last snapshot before the kill (t = 0.4) and then fades: the frames
   // after the restart depend on the running reference kept across it.
   const double amp = t <= 0.4 ? 1.0 + t : 1.4 - 0.8 * (t - 0.4);
@@ -88,7 +88,7 @@ double time_of(int step) { return 0.2 * step; }
 
 // Steps first..kSteps-1 of the simulation; `kill_in` ≥ 0: SIGKILL in the middle of that snapshot.
 void run(const fs::path& dir, insitu::OutputMode mode, int first, int kill_in = -1) {
-  insitu::Session s(config(dir, mode), grid(), insitu::LocalBlock::whole(grid()));
+  insitu::Session s(config(dir, mode), test_grid(), insitu::LocalBlock::whole(test_grid()));
   if (kill_in >= 0)
     s.set_frame_observer([kill_in](int camera, int, int frame, const Image&) {
       if (frame == kill_in && camera == 2) ::raise(SIGKILL);
@@ -152,7 +152,7 @@ TEST(InsituResume, RefusesAnotherConfigurationNamingWhatDiffers) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_resume_cfg_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   {
-    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
     const auto f = field(0);
     s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }  // destroyed without finalize: interrupted
@@ -166,19 +166,19 @@ TEST(InsituResume, RefusesAnotherConfigurationNamingWhatDiffers) {
   };
   insitu::SessionConfig rig = config(dir, insitu::OutputMode::resume);
   rig.rig = "fibonacci:5";
-  EXPECT_NE(refusal(rig, grid()).find("the rig ([rig]) differs"), std::string::npos) << refusal(rig, grid());
+  EXPECT_NE(refusal(rig, test_grid()).find("the rig ([rig]) differs"), std::string::npos) << refusal(rig, test_grid());
   insitu::SessionConfig task = config(dir, insitu::OutputMode::resume);
   task.tasks[1].isovalues = {0.2, 0.6};
-  EXPECT_NE(refusal(task, grid()).find("task 2 (\"iso 0.5\""), std::string::npos) << refusal(task, grid());
-  render::GridGeometry other = grid();
+  EXPECT_NE(refusal(task, test_grid()).find("task 2 (\"iso 0.5\""), std::string::npos) << refusal(task, test_grid());
+  render::GridGeometry other = test_grid();
   other.dims[0] = 22;
   EXPECT_NE(refusal(config(dir, insitu::OutputMode::resume), other).find("the grid"), std::string::npos);
   insitu::SessionConfig image = config(dir, insitu::OutputMode::resume);
   image.width = 34;
-  EXPECT_NE(refusal(image, grid()).find("image size"), std::string::npos) << refusal(image, grid());
+  EXPECT_NE(refusal(image, test_grid()).find("image size"), std::string::npos) << refusal(image, test_grid());
   // The refusals left the database as it was; the same configuration resumes it.
   {
-    insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::resume), test_grid(), insitu::LocalBlock::whole(test_grid()));
     EXPECT_EQ(s.snapshots(), 1);
     EXPECT_FALSE(s.due(0, 0.0));  // already in the database
     EXPECT_TRUE(s.due(1, 0.2));
@@ -192,7 +192,7 @@ TEST(InsituResume, NothingToResumeStartsANewDatabase) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_resume_new_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   {
-    insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::resume), test_grid(), insitu::LocalBlock::whole(test_grid()));
     EXPECT_EQ(s.snapshots(), 0);
     const auto f = field(0);
     EXPECT_TRUE(s.process(0, 0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
@@ -223,7 +223,7 @@ TEST(InsituTimes, NonFiniteAndDecreasingTimesAreRefused) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_times_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   {
-    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
     const auto f = field(0);
     const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
     for (double t : {0.0, 1.0, 2.0}) s.snapshot(t, in);
@@ -251,11 +251,11 @@ TEST(InsituTimes, ResumeSkipsRepeatedTimesOnlyBeforeItsFirstNewSnapshot) {
   const auto f = field(0);
   const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
   {
-    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
     for (int step = 0; step < 3; ++step) s.process(step, time_of(step), in);
   }  // interrupted after t = 0, 0.2, 0.4
   {
-    insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::resume), test_grid(), insitu::LocalBlock::whole(test_grid()));
     EXPECT_FALSE(s.process(1, time_of(1), in));  // repeated: skipped, no error
     EXPECT_FALSE(s.process(2, time_of(2), in));
     EXPECT_TRUE(s.process(3, time_of(3), in));
@@ -271,7 +271,7 @@ TEST(InsituTimes, ResumeSkipsRepeatedTimesOnlyBeforeItsFirstNewSnapshot) {
 
 std::string resume_refusal(const insitu::SessionConfig& c) {
   try {
-    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(c, test_grid(), insitu::LocalBlock::whole(test_grid()));
     return "";
   } catch (const Error& e) {
     return e.what();
@@ -306,7 +306,7 @@ TEST(InsituResume, ResumeCompleteAppendsToAFinishedRun) {
   insitu::SessionConfig c = config(dir, insitu::OutputMode::resume);
   c.resume_complete = true;
   {
-    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(c, test_grid(), insitu::LocalBlock::whole(test_grid()));
     EXPECT_EQ(s.snapshots(), kSteps);
     const auto f = field(time_of(kSteps));
     EXPECT_TRUE(s.process(kSteps, time_of(kSteps), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
@@ -322,7 +322,7 @@ TEST(InsituResume, RefusesAnotherSchedule) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_resume_schedule_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   {
-    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
     const auto f = field(0);
     s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }  // interrupted
@@ -336,7 +336,7 @@ TEST(InsituResume, RefusesAnotherSchedule) {
   time.schedule.every_time = 0.25;
   const std::string b = resume_refusal(time);
   EXPECT_NE(b.find("every_steps = 1 in the database, every_time = 0.25 in this run"), std::string::npos) << b;
-  insitu::Session s(config(dir, insitu::OutputMode::resume), grid(), insitu::LocalBlock::whole(grid()));
+  insitu::Session s(config(dir, insitu::OutputMode::resume), test_grid(), insitu::LocalBlock::whole(test_grid()));
   EXPECT_EQ(s.snapshots(), 1);
   s.finalize();
   fs::remove_all(dir);
@@ -353,7 +353,7 @@ TEST(InsituResume, OverwriteKeepsAnInterruptedRunBeside) {
   fs::create_directories(base);
   const fs::path dir = base / "db", kept = base / "db.interrupted-1";
   {
-    insitu::Session s(config(dir, insitu::OutputMode::create), grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
     for (int step = 0; step < 2; ++step) {
       const auto f = field(time_of(step));
       s.process(step, time_of(step), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
@@ -372,13 +372,13 @@ TEST(InsituResume, OverwriteKeepsAnInterruptedRunBeside) {
   // keep_interrupted = false: deleted.
   {
     insitu::SessionConfig c = config(dir, insitu::OutputMode::overwrite);
-    insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid()));
+    insitu::Session s(c, test_grid(), insitu::LocalBlock::whole(test_grid()));
     const auto f = field(0);
     s.process(0, 0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }
   insitu::SessionConfig c = config(dir, insitu::OutputMode::overwrite);
   c.keep_interrupted = false;
-  { insitu::Session s(c, grid(), insitu::LocalBlock::whole(grid())); }
+  { insitu::Session s(c, test_grid(), insitu::LocalBlock::whole(test_grid())); }
   EXPECT_FALSE(fs::exists(base / "db.interrupted-2"));
   fs::remove_all(base);
 }

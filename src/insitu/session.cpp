@@ -24,6 +24,8 @@
 #include "core/log.hpp"
 #include "core/number_text.hpp"
 #include "core/strided.hpp"
+#include "grid/grid_description.hpp"
+#include "insitu/grid_adapter.hpp"
 #include "insitu/halo.hpp"
 #include "insitu/output.hpp"
 #include "insitu/rank_agreement.hpp"
@@ -86,6 +88,8 @@ struct Session::Impl {
   std::string stopped;          // why the session cannot go on (every later call throws it)
   std::string caller_refusal;   // the caller's own failure, refused on every rank at the next call
   std::string deferred_failure; // this rank's failure after an agreement, reported at the next one
+  // A grid that is not a uniform box: the grid stage resamples the caller's blocks at each snapshot.
+  std::unique_ptr<GridAdapter> adapter;
   std::vector<BlockInfo> blocks;  // per rank
   halo::Exchange exchange;        // reads the trusted points, fetches the others
   std::vector<std::string> field_names;
@@ -142,6 +146,14 @@ struct Session::Impl {
   }
 
   void init();
+  void start_grid_stage(const grid::GridDescription& source, const std::vector<GridBlock>& blocks,
+                        const ResampleOptions& resample
+#ifdef PANOPTES_HAVE_MPI
+                        ,
+                        MPI_Comm comm  // MPI_COMM_NULL: one process
+#endif
+  );
+  std::exception_ptr grid_field_refusal(const std::vector<FieldInput>& fields) const;
   int agree(Call call, CallRecord record, std::exception_ptr error = nullptr, Failure severity = Failure::none,
             int stop = 0);
   std::array<double, kShapeValues> shape() const;
@@ -783,6 +795,85 @@ Session::Session(const SessionConfig& config, const render::GridGeometry& grid, 
 }
 #endif
 
+// The grid stage's own checks (the source grid, the resampling, the ranks against the cover) are agreed
+// before the adapter's collectives: a rank whose grid is refused stops every rank there.
+void Session::Impl::start_grid_stage(const grid::GridDescription& source, const std::vector<GridBlock>& grid_blocks,
+                                     const ResampleOptions& resample
+#ifdef PANOPTES_HAVE_MPI
+                                     ,
+                                     MPI_Comm user_comm
+#endif
+) {
+  std::exception_ptr local;
+  try {
+    const render::GridGeometry cover = GridAdapter::cover(source, resample);
+    if (agreement.size() > cover.dims[2] - 1)
+      throw Error("grid stage: " + std::to_string(agreement.size()) + " ranks for a uniform cover of " +
+                  std::to_string(cover.dims[2]) + " points along z; expected at most one rank per cell layer (raise the "
+                  "resample points)");
+    cfg.source_grid = source.summary();
+  } catch (...) {
+    local = std::current_exception();
+  }
+  agree(Call::start, CallRecord{}, local, Failure::failed);
+#ifdef PANOPTES_HAVE_MPI
+  if (user_comm != MPI_COMM_NULL)
+    adapter = std::make_unique<GridAdapter>(source, grid_blocks, resample, user_comm);
+  else
+#endif
+    adapter = std::make_unique<GridAdapter>(source, grid_blocks, resample);
+  grid = adapter->render_grid();
+  block = adapter->render_block();
+}
+
+// A grid stage's fields: each field a task reads, once per block of this rank, with data (checked before
+// the snapshot's agreement, like field_refusal()).
+std::exception_ptr Session::Impl::grid_field_refusal(const std::vector<FieldInput>& fields) const {
+  for (const std::string& name : field_names) {
+    int given = 0;
+    for (const FieldInput& x : fields)
+      if (x.name == name && x.data) ++given;
+    if (given != adapter->block_count())
+      return std::make_exception_ptr(Error("snapshot: field \"" + name + "\" (read by a task) was given with data for " +
+                                           std::to_string(given) + " of this rank's " + std::to_string(adapter->block_count()) +
+                                           " block(s); expected one per block"));
+  }
+  return nullptr;
+}
+
+Session::Session(const SessionConfig& config, const grid::GridDescription& source, const std::vector<GridBlock>& blocks,
+                 const ResampleOptions& resample, std::shared_ptr<OverheadMeter> meter)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->meter = meter ? std::move(meter) : std::make_shared<OverheadMeter>();
+  OverheadMeter::Scope counted(*impl_->meter);
+  impl_->cfg = config;
+#ifdef PANOPTES_HAVE_MPI
+  impl_->start_grid_stage(source, blocks, resample, MPI_COMM_NULL);
+  int init = 0;
+  MPI_Initialized(&init);
+  if (init) MPI_Comm_dup(MPI_COMM_SELF, &impl_->comm);
+#else
+  impl_->start_grid_stage(source, blocks, resample);
+#endif
+  impl_->init();
+}
+
+#ifdef PANOPTES_HAVE_MPI
+Session::Session(const SessionConfig& config, const grid::GridDescription& source, const std::vector<GridBlock>& blocks,
+                 const ResampleOptions& resample, MPI_Comm comm, std::shared_ptr<OverheadMeter> meter)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->meter = meter ? std::move(meter) : std::make_shared<OverheadMeter>();
+  OverheadMeter::Scope counted(*impl_->meter);
+  impl_->cfg = config;
+  impl_->agreement = RankAgreement(comm, config.mpi_timeout);
+  impl_->start_grid_stage(source, blocks, resample, comm);
+  MPI_Comm_dup(comm, &impl_->comm);
+  MPI_Comm_rank(impl_->comm, &impl_->rank);
+  MPI_Comm_size(impl_->comm, &impl_->size);
+  impl_->init();
+}
+#endif
+
 Session::~Session() {
 #ifdef PANOPTES_HAVE_MPI
   if (impl_ && impl_->comm != MPI_COMM_NULL) {
@@ -845,7 +936,7 @@ void Session::Impl::take_snapshot(double time, const std::vector<FieldInput>& fi
   std::exception_ptr refusal;
   if (!repeat) {
     refusal = m.time_refusal(time);
-    if (!refusal) refusal = m.field_refusal(fields);
+    if (!refusal) refusal = m.adapter ? m.grid_field_refusal(fields) : m.field_refusal(fields);
   }
   CallRecord r;
   r.time = time;
@@ -863,7 +954,8 @@ void Session::Impl::take_snapshot(double time, const std::vector<FieldInput>& fi
   if (m.cfg.schedule.max_snapshots > 0 && m.snapshots >= m.cfg.schedule.max_snapshots)
     throw Error("snapshot: schedule.max_snapshots = " + std::to_string(m.cfg.schedule.max_snapshots) + " already taken");
   auto t0 = Clock::now();
-  m.load_fields(fields);
+  // The grid stage (collective: it gathers the source points each slab needs) only for a snapshot.
+  m.load_fields(m.adapter ? m.adapter->adapt(fields) : fields);
   std::vector<double> ref(m.field_names.size());
   for (std::size_t f = 0; f < m.field_names.size(); ++f) {
     const FieldScale scale = m.cfg.scale_of(m.field_names[f]);

@@ -30,7 +30,14 @@
 #include <mpi.h>
 #endif
 
+namespace panoptes::grid {
+struct GridDescription;
+}
+
 namespace panoptes::insitu {
+
+struct GridBlock;        // grid_adapter.hpp
+struct ResampleOptions;  // grid_adapter.hpp
 
 /// A bad argument of a call (a time that is not finite, or not after the previous snapshot's):
 /// refused before anything is written, the database stays as it was. The C API returns it as
@@ -118,6 +125,17 @@ class Session {
   /// On communicator `comm` (duplicated internally). Every rank passes the same config and grid.
   Session(const SessionConfig& config, const render::GridGeometry& grid, const LocalBlock& block, MPI_Comm comm,
           std::shared_ptr<OverheadMeter> meter = nullptr);
+#endif
+  /// A grid that is not a uniform box (rectilinear, spherical, Yin-Yang: grid/grid_description.hpp):
+  /// the session owns the grid stage (grid_adapter.hpp), which resamples this rank's `blocks` onto the
+  /// uniform cover it renders, at each snapshot (not at steps that take none). Fields are then given
+  /// once per block, in the blocks' order. Single process.
+  Session(const SessionConfig& config, const grid::GridDescription& source, const std::vector<GridBlock>& blocks,
+          const ResampleOptions& resample, std::shared_ptr<OverheadMeter> meter = nullptr);
+#ifdef PANOPTES_HAVE_MPI
+  /// The same on communicator `comm`: the blocks of all ranks partition every patch.
+  Session(const SessionConfig& config, const grid::GridDescription& source, const std::vector<GridBlock>& blocks,
+          const ResampleOptions& resample, MPI_Comm comm, std::shared_ptr<OverheadMeter> meter = nullptr);
 #endif
   ~Session();
   Session(const Session&) = delete;

@@ -114,9 +114,7 @@ class PySession {
       if (axes[d]->size() < 2 || axes[d]->size() > 65535)
         throw Error(call + ": coordinate array " + std::to_string(d) + " has " + std::to_string(axes[d]->size()) +
                     " entries; expected 2 to 65535 points");
-    grid::GridDescription g = kind == "rectilinear" ? grid::GridDescription::rectilinear(a, b, c)
-                              : kind == "spherical" ? grid::GridDescription::spherical(a, b, c)
-                                                    : grid::GridDescription::yinyang(a, b, c);
+    grid::GridDescription g = grid::GridDescription::of_kind(grid::parse_grid_kind(kind), a, b, c);
     try {
       g.validate();
     } catch (const std::exception& e) {
@@ -271,15 +269,13 @@ class PySession {
     failed_calls_.clear();
     py::gil_scoped_release release;  // collective construction: other ranks may still be in Python
     agreement_.agree(insitu::CallRecord{}, local, insitu::Failure::refused);
-    if (source_) config_.source_grid = source_->summary();
 #ifdef PANOPTES_HAVE_MPI
     int init = 0;
     MPI_Initialized(&init);
     if (comm_ || init) {
       const MPI_Comm c = comm_ ? *comm_ : MPI_COMM_WORLD;
       if (source_) {
-        adapter_ = std::make_unique<insitu::GridAdapter>(*source_, grid_blocks(), resample_, c);
-        session_ = std::make_unique<insitu::Session>(config_, adapter_->render_grid(), adapter_->render_block(), c);
+        session_ = std::make_unique<insitu::Session>(config_, *source_, grid_blocks(), resample_, c);
       } else {
         session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_, c);
       }
@@ -287,8 +283,7 @@ class PySession {
     }
 #endif
     if (source_) {
-      adapter_ = std::make_unique<insitu::GridAdapter>(*source_, grid_blocks(), resample_);
-      session_ = std::make_unique<insitu::Session>(config_, adapter_->render_grid(), adapter_->render_block());
+      session_ = std::make_unique<insitu::Session>(config_, *source_, grid_blocks(), resample_);
     } else {
       session_ = std::make_unique<insitu::Session>(config_, *grid_, *block_);
     }
@@ -354,18 +349,17 @@ class PySession {
     return v;
   }
   // Non-uniform grids: one input per field and block, blocks in patch order (as grid_blocks() gave
-  // them to the adapter), resampled onto this rank's slab. Collective (adapt() exchanges points).
+  // them to the session's grid stage, which resamples them at snapshots only).
   std::vector<insitu::FieldInput> inputs() {
     std::vector<insitu::FieldInput> v;
-    if (!adapter_) {
+    if (!source_) {
       for (const auto& [name, f] : fields_) v.push_back(f.first);
       return v;
     }
     for (const auto& [patch, st] : all_patches())
       if (st.block)
         for (const auto& [name, f] : st.fields) v.push_back(f.first);
-    py::gil_scoped_release release;
-    return adapter_->adapt(v);
+    return v;
   }
 
   insitu::SessionConfig config_;
@@ -381,7 +375,6 @@ class PySession {
   insitu::ResampleOptions resample_;
   int patch_ = 0;
   std::map<int, PatchState> other_patches_;
-  std::unique_ptr<insitu::GridAdapter> adapter_;
   std::unique_ptr<insitu::Session> session_;
   insitu::RankAgreement agreement_;  // before the session exists
   std::map<std::string, std::string> failed_calls_;
