@@ -8,6 +8,8 @@
 #include <thread>
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <vector>
 #include <string>
 
 #include "app/command.hpp"
@@ -29,6 +31,8 @@ struct Args {
   std::string preset, title = "synthetic database";
   bool force = false;
   std::string lattice, projection = "perspective";
+  int shells = 1;
+  std::string axes;  // "3x2x2": value counts of up to 4 parameter axes
 };
 
 void run(const Args& a, const std::string& command_line) {
@@ -49,6 +53,16 @@ void run(const Args& a, const std::string& command_line) {
       throw Error("--lattice \"" + a.lattice + "\": expected NXxNYxNZ with positive counts, e.g. 4x4x3");
     o.lattice = {(*l)[0], (*l)[1], (*l)[2]};
   }
+  if (!a.axes.empty()) {
+    std::optional<std::vector<int>> counts;
+    for (int parts = 1; parts <= 4 && !counts; ++parts) counts = parse_dims_text(a.axes, parts, 5);
+    if (!counts || std::any_of(counts->begin(), counts->end(), [](int n) { return n < 1; }))
+      throw Error("--axes \"" + a.axes + "\": expected 1 to 4 positive value counts, e.g. 3x2x2");
+    o.axes = *counts;
+    o.tasks = 1;
+    for (int n : o.axes) o.tasks = int(checked_product(o.tasks, n, "--axes (tasks)", 65536));
+  }
+  o.shells = a.shells;
   o.projection = a.projection;
   o.threads = a.threads;
   o.title = a.title;
@@ -57,8 +71,9 @@ void run(const Args& a, const std::string& command_line) {
   if (a.crf >= 0) o.video.crf = a.crf;
   if (!a.preset.empty()) o.video.preset = a.preset;
   o.video.validate();
-  const long long cameras = o.lattice[0] > 0 ? (long long)o.lattice[0] * o.lattice[1] * o.lattice[2] : a.cameras;
-  const long long streams = checked_product(cameras, a.tasks, "--cameras x --tasks (movies)", INT_MAX);
+  const long long cameras = o.lattice[0] > 0 ? (long long)o.lattice[0] * o.lattice[1] * o.lattice[2]
+                                              : checked_product(a.cameras, a.shells, "--cameras x --shells", 1 << 24);
+  const long long streams = checked_product(cameras, o.tasks, "--cameras x --tasks (movies)", INT_MAX);
   if (o.width > 16384 || o.height > 16384)
     throw Error("--size \"" + a.size + "\": expected at most 16384 pixels per side");
   if (!a.force) {
@@ -84,7 +99,7 @@ void run(const Args& a, const std::string& command_line) {
   if (tty) std::fprintf(stderr, "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("wrote %s: %d cameras x %d tasks = %lld streams, %d frames of %dx%d each, in %.2f s (%.0f streams/s)\n",
-              a.out.c_str(), int(cameras), a.tasks, streams, a.frames, o.width, o.height, seconds, streams / seconds);
+              a.out.c_str(), int(cameras), o.tasks, streams, a.frames, o.width, o.height, seconds, streams / seconds);
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
@@ -110,6 +125,13 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--title", args->title, "Title stored in the manifest")->capture_default_str();
   sub->add_option("--lattice", args->lattice,
                   "Cameras on an NXxNYxNZ lattice inside the domain with world-axis navigation (replaces --cameras)");
+  sub->add_option("--shells", args->shells,
+                  "Camera shells of the sphere: --cameras on each, 'in'/'out' graph edges between them (not with --lattice)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  sub->add_option("--axes", args->axes,
+                  "Parameter axes as value counts, e.g. 3x2x2 (isovalue, opacity, window, blend): one task per "
+                  "combination (replaces --tasks)");
   sub->add_option("--projection", args->projection, "Projection recorded in the manifest: perspective or equirectangular")
       ->check(CLI::IsMember({"perspective", "equirectangular"}))
       ->capture_default_str();
@@ -120,6 +142,8 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
     const std::string command_line = "panoptes synth-db " + args->out + " --cameras " + std::to_string(args->cameras) + " --tasks " +
                    std::to_string(args->tasks) + " --frames " + std::to_string(args->frames) + " --size " + args->size +
                    (args->lattice.empty() ? "" : " --lattice " + args->lattice) +
+                   (args->shells == 1 ? "" : " --shells " + std::to_string(args->shells)) +
+                   (args->axes.empty() ? "" : " --axes " + args->axes) +
                    (args->projection == "perspective" ? "" : " --projection " + args->projection);
     run(*args, command_line);
   });

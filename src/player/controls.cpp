@@ -1,5 +1,7 @@
 #include "player/controls.hpp"
 
+#include <algorithm>
+
 #include "player/engine.hpp"
 #include "player/headless.hpp"
 
@@ -33,7 +35,8 @@ Operation operation(Action a, ViewMode mode) {
       case Action::camera_right: return Operation::walk_right;
       case Action::axis_up: return Operation::walk_up;
       case Action::axis_down: return Operation::walk_down;
-      case Action::next_axis: return Operation::none;
+      case Action::next_axis:
+      case Action::previous_axis: return Operation::none;
       default: break;
     }
   }
@@ -105,12 +108,35 @@ bool usable(Action a, ViewMode mode, const store::Manifest& m) {
   switch (a) {
     case Action::axis_up:
     case Action::axis_down:
-    case Action::next_axis: return !m.axes.empty();
+    case Action::next_axis:
+    case Action::previous_axis: return !m.axes.empty();
     case Action::shell_in: return any_neighbour(&store::Neighbours::in);
     case Action::shell_out: return any_neighbour(&store::Neighbours::out);
     case Action::face_action: return mode != ViewMode::sphere;
     default: return true;
   }
+}
+
+std::string_view refusal(Action a, ViewMode mode, const store::Manifest* m) {
+  const Operation op = operation(a, mode);
+  if (op == Operation::none) return "this key does nothing inside a lattice or along a path";
+  if (is_walk(op)) return "no camera that way";
+  const KeyBinding* b = binding_of(a);
+  // C in a 360° view is refused by the frame, not the database: the row's text is about fixed views.
+  if (a == Action::face_action && mode != ViewMode::sphere) return "nothing stands out in this frame to turn to";
+  if (op == Operation::front_end) return b ? b->refusal : std::string_view();
+  if (op != Operation::engine) return "";  // a field of view at its limit needs no words
+  // Inside a lattice Z / X step north / south (description()): "shell" would be the wrong word there.
+  if (mode == ViewMode::lattice && (a == Action::shell_in || a == Action::shell_out)) return "no camera that way";
+  if (m && (a == Action::shell_in || a == Action::shell_out)) {
+    const auto several = std::any_of(m->cameras.begin(), m->cameras.end(),
+                                     [&](const store::CameraEntry& c) { return c.labels.shell != m->cameras[0].labels.shell; });
+    if (!several)
+      return "Z / X move between camera shells, and this rig has only one (a rig spec like \"yinyang@2,3\" has two); "
+             "use + / - or the wheel to magnify";
+  }
+  if (m && m->axes.empty() && (a == Action::axis_up || a == Action::axis_down)) return binding_of(Action::next_axis)->refusal;
+  return b ? b->refusal : std::string_view();
 }
 
 bool is_walk(Operation op) { return op >= Operation::walk_forward && op <= Operation::walk_down; }
@@ -130,6 +156,10 @@ Controls::Controls(Engine& engine, Look look)
     : engine_(engine), mode_(view_mode(engine.manifest())), look_(clamped(look)) {}
 
 void Controls::set_look(const Look& look) { look_ = clamped(look); }
+
+std::string_view Controls::refusal(Action action) const {
+  return player::refusal(action, mode_, &engine_.manifest());
+}
 
 bool Controls::walk(Walk w) { return walk_keeping_view(engine_, look_, w); }
 

@@ -54,6 +54,11 @@ std::string_view description(const KeyBinding& binding, ViewMode mode);
 /// no camera of the navigation graph has a closer / farther neighbour, and for C on perspective frames
 /// (there it only says that the views are fixed). The help overlays (window, browser) list usable keys.
 bool usable(Action action, ViewMode mode, const store::Manifest& manifest);
+/// What every front end says when a key's action is refused in `mode` (Controls::apply returned
+/// refused): the binding's own text (keys.cpp), a walk's "no camera that way", the lattice's "does
+/// nothing here", or, with a manifest, the database's reason (one camera shell, no parameter axes).
+/// Empty when a refusal needs no words (a speed or field of view at its limit). keys.json publishes it.
+std::string_view refusal(Action action, ViewMode mode, const store::Manifest* manifest = nullptr);
 /// True for the walk_* operations.
 bool is_walk(Operation op);
 /// The Walk of a walk_* operation.
@@ -76,6 +81,8 @@ class Controls {
   Look& mutable_look() { return look_; }
   /// Applies a key's action as `operation(action, mode())` says.
   Result apply(Action action);
+  /// refusal(action, mode(), the engine's manifest): the text to show when apply(action) was refused.
+  std::string_view refusal(Action action) const;
   /// Walks relative to the view (any mode with a graph); false when there is no camera that way.
   bool walk(Walk walk);
   /// Applies a script command (key= through apply(); look=, walk=, seek=, camera=, ...); false when it

@@ -704,9 +704,12 @@ bool Engine::apply(Action action) {
     case Action::axis_up: return m.axis >= 0 && step_axis(m.axis, 1);
     case Action::axis_down: return m.axis >= 0 && step_axis(m.axis, -1);
     case Action::next_axis:
+    case Action::previous_axis: {
       if (m.axis < 0) return false;
-      m.axis = (m.axis + 1) % int(manifest().axes.size());
+      const int n = int(manifest().axes.size());
+      m.axis = (m.axis + (action == Action::next_axis ? 1 : n - 1)) % n;
       return true;
+    }
     default: return false;
   }
 }

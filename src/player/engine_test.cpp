@@ -108,6 +108,12 @@ TEST_F(EngineTest, StepAxisKeepsTheOtherAxis) {
   ASSERT_TRUE(e.apply(Action::axis_down));
   EXPECT_EQ(e.selection().task, 2);
   EXPECT_FALSE(e.step_axis(5, 1));
+  // Shift+A goes back (issue 43), wrapping as A does: 1 -> 0 -> 1.
+  ASSERT_TRUE(e.apply(Action::previous_axis));
+  EXPECT_EQ(e.active_axis(), 0);
+  ASSERT_TRUE(e.apply(Action::previous_axis));
+  EXPECT_EQ(e.active_axis(), 1);
+  EXPECT_EQ(e.selection().task, 2) << "changing the active axis changes no task";
 }
 
 TEST_F(EngineTest, PlaybackClockAndSwitchingKeepTimeContinuous) {

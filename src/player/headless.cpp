@@ -274,7 +274,9 @@ HeadlessResult run_headless(const std::filesystem::path& dir, const HeadlessOpti
       if (c.kind == ScriptCommand::Kind::end) ended = true;
       const bool applied = controls.run(c);
       if (c.kind != ScriptCommand::Kind::end) {
-        const TraceStep ts{step++, c.line, describe(c), engine.selection(), controls.look()};
+        // A refused key says why, as the window's status line does (the trace compares them).
+        const bool refused_key = c.kind == ScriptCommand::Kind::key && !applied;
+        const TraceStep ts = trace_step(step++, c, engine, controls, refused_key ? std::string(controls.refusal(c.action)) : "");
         if (trace) trace->write(ts);
         result.trace.push_back(ts);
       }

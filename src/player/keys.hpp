@@ -1,7 +1,10 @@
 #pragma once
-// The player's key bindings: one table shared by the window front end (ui) and the headless mode, so
-// a script line `key=Right` does exactly what pressing → does in the window.
+// The player's key bindings: one table shared by every front end (window, headless, Python, and the
+// browser through keys.json), so a script line `key=Right` does exactly what pressing → does in the
+// window. A row is everything a key is: its name with its modifiers, its action, whether holding it
+// repeats, and what the player says when the key changes nothing.
 #include <optional>
+#include <utility>
 #include <span>
 #include <string>
 #include <string_view>
@@ -40,6 +43,7 @@ enum class Action {
   axis_up,         ///< PageUp: step the active parameter axis up, keeping the other axes
   axis_down,       ///< PageDown: step the active parameter axis down
   next_axis,       ///< A: make the next parameter axis the active one
+  previous_axis,   ///< Shift+A: make the previous parameter axis the active one
   // front end only (Engine::apply ignores these)
   zoom_in,         ///< '+' / '=' (and the mouse wheel): magnify around the cursor
   zoom_out,        ///< '-'
@@ -54,19 +58,63 @@ enum class Action {
   face_action,     ///< C: turn a 360° view toward the strongest signal in the shown frame
 };
 
+/// Modifier keys of a binding, as a bit set (spelled in the key's name: "Shift+Tab", "Ctrl+S").
+enum Modifier : unsigned { kNoModifier = 0, kShift = 1, kCtrl = 2, kAlt = 4 };
+
+/// A key name split into its modifiers and the key itself: "Shift+A" = {"A", kShift}. The name is the
+/// only place the modifiers are written, so the script name, the window's match and keys.json agree.
+struct KeyChord {
+  std::string_view base;   ///< the key without modifiers: "A", "Tab", "Period", "+"
+  unsigned modifiers = kNoModifier;
+  bool operator==(const KeyChord&) const = default;
+};
+/// Splits the leading "Shift+", "Ctrl+" and "Alt+" prefixes (in any order) off a key name.
+constexpr KeyChord parse_chord(std::string_view name) {
+  KeyChord c{name, kNoModifier};
+  for (bool more = true; more;) {
+    more = false;
+    for (auto [prefix, bit] : {std::pair<std::string_view, Modifier>{"Shift+", kShift}, {"Ctrl+", kCtrl}, {"Alt+", kAlt}})
+      if (c.base.size() > prefix.size() && c.base.starts_with(prefix)) {
+        c.base.remove_prefix(prefix.size());
+        c.modifiers |= bit;
+        more = true;
+      }
+  }
+  return c;
+}
+
+/// Whether holding a key down repeats its action (navigation, frame steps, speed steps) or acts once
+/// (toggles: a held Space must not flicker between play and pause).
+enum class Repeat { yes, no };
+
 /// One row of the key table.
 struct KeyBinding {
-  std::string_view key;          ///< canonical key name, as written in scripts: "Right", "Shift+Tab", "1"
+  std::string_view key;          ///< canonical key name with its modifiers, as written in scripts: "Right", "Shift+Tab", "1"
   Action action;
-  std::string_view description;  ///< one line for the help overlay and docs/player.md
+  std::string_view description;  ///< one line for the help overlay and docs/ui.md
+  Repeat repeat = Repeat::yes;   ///< whether a held key repeats (SDL's key.repeat, the browser's event.repeat)
+  /// What every front end shows when the engine refuses the action (nothing that way, nothing changed);
+  /// empty: a refusal needs no words (speed at its limit). Database-specific texts: refusal() in controls.hpp.
+  std::string_view refusal = {};
+
+  constexpr KeyChord chord() const { return parse_chord(key); }
+  constexpr bool repeats() const { return repeat == Repeat::yes; }
 };
 
 /// The full key table, in the order the help overlay lists it. Several keys may map to one action.
 std::span<const KeyBinding> key_bindings();
 
-/// The action of a key name (case-sensitive canonical names as in key_bindings(); single letters are
-/// also accepted in lower case, e.g. "l"). std::nullopt for an unknown name.
+/// The binding of a key name (case-sensitive canonical names as in key_bindings(); single letters are
+/// also accepted in lower case, e.g. "l", "Shift+a"). nullptr for an unknown name.
+const KeyBinding* binding_for_key(std::string_view key);
+/// The binding of a key pressed with `modifiers` (a Modifier bit set): the row of exactly that chord;
+/// else, when only Shift is added to a key whose Shift form is not bound, the plain row (Shift+L is L,
+/// as a desktop player does). nullptr if none. Every front end matches keys by this rule.
+const KeyBinding* binding_for_chord(std::string_view base, unsigned modifiers);
+/// binding_for_key(key)'s action; std::nullopt for an unknown name.
 std::optional<Action> action_for_key(std::string_view key);
+/// The first binding of an action in the table (its repeat and refusal are the action's), or nullptr.
+const KeyBinding* binding_of(Action action);
 
 /// Stable lower-case name of an action (e.g. "camera_left"), for statistics and logs.
 std::string_view to_string(Action action);

@@ -13,13 +13,15 @@ namespace panoptes::player {
 namespace {
 
 /// The browser's view of a desktop key name: KeyboardEvent.key values, KeyboardEvent.code values (US
-/// layout) and, for keys whose `key` does not change with Shift, the Shift state they need.
+/// layout) and the modifier state the event must have. Shift is published for keys whose `key` does not
+/// say it (letters, Tab, PageUp, F1...); a character key (".", ">", "+", "[") carries Shift in the
+/// character itself, which is what the layout produced, so there Shift is left to `key` (-1: any).
 struct BrowserKey {
   std::vector<std::string> keys, codes;
   int shift = -1;  // -1: any, 0: without, 1: with
 };
 
-BrowserKey browser_key(std::string_view name) {
+BrowserKey browser_key(const KeyBinding& b) {
   struct Named {
     std::string_view desktop, key, code;
   };
@@ -32,27 +34,27 @@ BrowserKey browser_key(std::string_view name) {
   };
   BrowserKey k;
   for (const auto& n : kNamed)
-    if (n.desktop == name) {
+    if (n.desktop == b.key) {
       k.keys = {std::string(n.key)};
       k.codes = {std::string(n.code)};
       return k;
     }
-  // Named keys that keep their `key` under Shift (Tab, PageUp, F1, ...): the Shift state decides.
-  bool shift = false;
-  if (name.starts_with("Shift+")) shift = true, name.remove_prefix(6);
+  const KeyChord chord = b.chord();
+  const std::string_view name = chord.base;
   if (name.size() == 1 && std::isalpha(static_cast<unsigned char>(name[0]))) {
     const char lower = char(std::tolower(static_cast<unsigned char>(name[0])));
     const char upper = char(std::toupper(static_cast<unsigned char>(name[0])));
-    k.keys = {std::string(1, lower), std::string(1, upper)};
+    k.keys = {std::string(1, lower), std::string(1, upper)};  // Caps Lock changes the case, not the key
     k.codes = {std::string("Key") + upper};
   } else if (name.size() == 1 && std::isdigit(static_cast<unsigned char>(name[0]))) {
     k.keys = {std::string(name)};
     k.codes = {std::string("Digit") + name[0]};
+    return k;  // Shift+1 is "!" on the event: the character decides
   } else {
     k.keys = {std::string(name)};
     k.codes = {std::string(name)};
   }
-  if (name.size() > 1) k.shift = shift ? 1 : 0;  // Tab vs Shift+Tab
+  k.shift = (chord.modifiers & kShift) ? 1 : 0;  // A vs Shift+A, Tab vs Shift+Tab
   return k;
 }
 
@@ -78,22 +80,29 @@ nlohmann::json keys_json(const store::Manifest* manifest) {
   json bindings = json::array();
   json actions = json::object();
   for (const KeyBinding& b : key_bindings()) {
-    const BrowserKey k = browser_key(b.key);
+    const BrowserKey k = browser_key(b);
     json row;
     row["desktop"] = std::string(b.key);
     row["keys"] = k.keys;
     row["codes"] = k.codes;
     if (k.shift >= 0) row["shift"] = k.shift == 1;
+    // Ctrl and Alt are never in `key`: they must always match (absent and false alike).
+    row["ctrl"] = (b.chord().modifiers & kCtrl) != 0;
+    row["alt"] = (b.chord().modifiers & kAlt) != 0;
+    row["repeat"] = b.repeats();
     row["action"] = std::string(to_string(b.action));
     row["front_end_only"] = !is_engine_action(b.action);
-    json modes = json::array(), descriptions = json::object();
+    json modes = json::array(), descriptions = json::object(), refusals = json::object();
     for (ViewMode m : kViewModes) {
+      // What a refused press says, in every mode (also "does nothing here" where the key does nothing).
+      if (const auto why = refusal(b.action, m, manifest); !why.empty()) refusals[std::string(to_string(m))] = std::string(why);
       if (operation(b.action, m) == Operation::none) continue;
       modes.push_back(std::string(to_string(m)));
       descriptions[std::string(to_string(m))] = std::string(description(b, m));
     }
     row["modes"] = std::move(modes);
     row["description"] = std::move(descriptions);
+    row["refusal"] = std::move(refusals);
     bindings.push_back(std::move(row));
     json per_mode = json::object();
     for (ViewMode m : kViewModes) {
@@ -137,6 +146,11 @@ nlohmann::json keys_json(const store::Manifest* manifest) {
       {"short_run", {{"shortest_run_s", kShortestRunSeconds}, {"speed_min", kShortRunSpeedMin}}},
   };
   j["numbering"] = {{"camera_first", 0}, {"frame_first", 0}, {"task_first", 1}};
+  // How a key press finds its binding (player::binding_for_chord), for the browser to do the same.
+  j["match_rule"] =
+      "the binding whose keys hold event.key, whose shift (if given) equals event.shiftKey and whose ctrl and alt "
+      "equal event.ctrlKey and event.altKey; failing that, with Shift alone held, the binding with shift false "
+      "(Shift+L acts as L); Meta matches nothing; a held key (event.repeat) acts only if the binding's repeat";
   return j;
 }
 

@@ -9,8 +9,10 @@
 
 namespace panoptes::player {
 
-/// Version of the keys.json format (docs/web.md); raised when a field changes meaning.
-inline constexpr int kKeysJsonVersion = 1;
+/// Version of the keys.json format (docs/web.md); raised when a field changes meaning. 2 (issue 43):
+/// letters carry `shift` (Shift+A is not A), bindings carry ctrl, alt, repeat and refusal, and a key
+/// pressed with Shift whose Shift form is not bound acts as the plain key (match_rule).
+inline constexpr int kKeysJsonVersion = 2;
 
 /// The keys.json document. With a manifest it also names the database's view mode ("mode").
 nlohmann::json keys_json(const store::Manifest* manifest = nullptr);

@@ -173,6 +173,7 @@ void bind_player(py::module_& m) {
       .def("key", &PyPlayer::key, py::arg("name"))
       .def("walk", &PyPlayer::walk, py::arg("direction"))
       .def_property_readonly("mode", [](PyPlayer& p) { return std::string(player::to_string(p.controls().mode())); })
+      .def_property_readonly("active_axis", [](PyPlayer& p) { return p.engine().active_axis(); })
       .def_property("look",
                     [](PyPlayer& p) {
                       const auto& l = p.controls().look();

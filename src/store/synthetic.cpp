@@ -21,6 +21,9 @@
 namespace panoptes::store {
 
 namespace {
+// Names of the parameter axes of SyntheticOptions::axes, in order.
+constexpr std::array<std::string_view, 4> kAxisNames{"isovalue", "opacity", "window", "blend"};
+
 // The lattice variant (see SyntheticOptions::lattice). Written out here rather than through camera/,
 // which store does not depend on; camera/volume_rigs_test checks the same layout and slots.
 void lattice_cameras(Manifest& m, const std::array<int, 3>& n) {
@@ -57,6 +60,20 @@ Manifest synthetic_manifest(const SyntheticOptions& options) {
       throw Error("synthetic database: lattice of more than 2^24 cameras");
     o.cameras = o.lattice[0] * o.lattice[1] * o.lattice[2];
   }
+  if (o.shells < 1 || (lattice && o.shells != 1)) throw Error("synthetic database: shells must be 1 or more, and 1 with a lattice");
+  if (o.axes.size() > kAxisNames.size())
+    throw Error("synthetic database: at most " + std::to_string(kAxisNames.size()) + " parameter axes");
+  if (!o.axes.empty()) {
+    std::int64_t tasks = 1;
+    for (int n : o.axes) {
+      if (n < 1) throw Error("synthetic database: every parameter axis needs at least one value");
+      tasks = std::min<std::int64_t>(tasks * n, std::int64_t(kStampMaxTask) + 2);  // stops growing past the limit
+    }
+    o.tasks = int(tasks);
+  }
+  if (!lattice && std::int64_t(o.cameras) * o.shells > std::int64_t(kStampMaxCamera) + 1)
+    throw Error("synthetic database: more than 2^24 cameras");
+  if (!lattice) o.cameras *= o.shells;
   if (o.cameras <= 0 || o.tasks <= 0 || o.frames <= 0)
     throw Error("synthetic database: cameras (" + std::to_string(o.cameras) + "), tasks (" + std::to_string(o.tasks) +
                 ") and frames (" + std::to_string(o.frames) + ") must be positive");
@@ -78,40 +95,55 @@ Manifest synthetic_manifest(const SyntheticOptions& options) {
   for (int f = 0; f < o.frames; ++f) m.times.push_back(0.1 * f);
   if (lattice) lattice_cameras(m, o.lattice);
   if (!lattice) m.rig.kind = "fibonacci";
-  if (!lattice) m.rig.parameters = {{"count", o.cameras}, {"radius", 3.0}, {"note", "synthetic; graph is a ring by index"}};
+  const int per_shell = o.cameras / o.shells;
+  if (!lattice) m.rig.parameters = {{"count", per_shell}, {"radius", 3.0}, {"note", "synthetic; graph is a ring by index"}};
+  if (!lattice && o.shells > 1) m.rig.parameters["shells"] = o.shells;
   if (o.projection != "perspective") m.rig.parameters["projection"] = o.projection;
   const double golden = M_PI * (3 - std::sqrt(5.0));
-  for (int c = 0; c < (lattice ? 0 : o.cameras); ++c) {
-    const double z = 1 - (2.0 * c + 1) / o.cameras, r = std::sqrt(std::max(0.0, 1 - z * z));
+  for (int id = 0; id < (lattice ? 0 : o.cameras); ++id) {
+    const int shell = id / per_shell, c = id % per_shell;
+    const double radius = 3 / (1 + 0.5 * shell);
+    const double z = 1 - (2.0 * c + 1) / per_shell, r = std::sqrt(std::max(0.0, 1 - z * z));
     const double phi = golden * c;
     CameraEntry e;
-    e.id = c;
-    e.position = {3 * r * std::cos(phi), 3 * r * std::sin(phi), 3 * z};
+    e.id = id;
+    e.position = {radius * r * std::cos(phi), radius * r * std::sin(phi), radius * z};
     e.look_at = {0, 0, 0};
     e.up = {0, 0, 1};
     e.fov_y_deg = 30;
     e.labels.patch = "fibonacci";
     e.labels.lat_deg = std::asin(z) * 180 / M_PI;
     e.labels.lon_deg = std::remainder(phi * 180 / M_PI, 360.0);
+    e.labels.shell = shell;
     m.cameras.push_back(e);
     Neighbours n;
-    if (o.cameras > 1) {
-      n.left = (c + o.cameras - 1) % o.cameras;
-      n.right = (c + 1) % o.cameras;
+    if (per_shell > 1) {
+      n.left = shell * per_shell + (c + per_shell - 1) % per_shell;
+      n.right = shell * per_shell + (c + 1) % per_shell;
     }
+    if (shell + 1 < o.shells) n.in = id + per_shell;
+    if (shell > 0) n.out = id - per_shell;
     m.graph.neighbours.push_back(n);
   }
-  ParameterAxis axis{"isovalue", {}, ""};
-  for (int t = 0; t < o.tasks; ++t) axis.values.push_back(double(t + 1) / (o.tasks + 1));
-  m.axes.push_back(axis);
+  const std::vector<int> counts = o.axes.empty() ? std::vector<int>{o.tasks} : o.axes;
+  for (std::size_t a = 0; a < counts.size(); ++a) {
+    ParameterAxis axis{std::string(kAxisNames[a]), {}, ""};
+    for (int i = 0; i < counts[a]; ++i) axis.values.push_back(double(i + 1) / (counts[a] + 1));
+    m.axes.push_back(axis);
+  }
   for (int t = 0; t < o.tasks; ++t) {
     TaskEntry e;
     e.id = t;
-    e.name = "isovalue " + std::to_string(t);
     e.method = "synthetic";
     e.fields = {"synthetic"};
-    e.parameters = {{"isovalue", axis.values[std::size_t(t)]}};
-    e.axes = {{"isovalue", t}};
+    e.parameters = nlohmann::json::object();
+    // The first axis varies fastest: task t sits at index (t / stride) % count on each axis.
+    for (std::size_t a = 0, stride = 1; a < counts.size(); stride *= std::size_t(counts[a]), ++a) {
+      const int i = int((std::size_t(t) / stride) % std::size_t(counts[a]));
+      e.name += (a ? " " : "") + m.axes[a].name + " " + std::to_string(i);
+      e.parameters[m.axes[a].name] = m.axes[a].values[std::size_t(i)];
+      e.axes.push_back({m.axes[a].name, i});
+    }
     m.tasks.push_back(e);
   }
   return m;
@@ -173,7 +205,8 @@ void write_synthetic_database(const std::filesystem::path& dir, const SyntheticO
         next = total;
         break;
       }
-      const int camera = int(s / o.tasks), task = int(s % o.tasks);
+      const int tasks = int(m.tasks.size());
+      const int camera = int(s / tasks), task = int(s % tasks);
       try {
         for (int f = 0; f < o.frames; ++f) {
           draw_synthetic_frame(img, camera, task, f);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/image.hpp"
 #include "store/manifest.hpp"
@@ -30,13 +31,22 @@ struct SyntheticOptions {
   /// and the world-axis graph of camera/volume_rigs.hpp (right/left = ±x, in/out = ±y, up/down = ±z).
   /// `cameras` is ignored then.
   std::array<int, 3> lattice{0, 0, 0};
+  /// Camera shells of the sphere (issue 43: Z / X in key tests): `cameras` per shell, shell s at radius
+  /// 3 / (1 + s/2) (0 = outermost), camera id s·cameras + c, graph in/out = same c one shell closer /
+  /// farther. 1 with a lattice.
+  int shells = 1;
+  /// Value counts of the parameter axes ("isovalue", "opacity", "window", "blend"), the first varying
+  /// fastest over the tasks; empty = one "isovalue" axis of `tasks` values. Non-empty replaces `tasks`
+  /// by the product (issue 43: A / Shift+A / PageUp in key tests need several axes).
+  std::vector<int> axes;
   /// Recorded as rig parameter "projection" when not "perspective" (frames are stamped all the same).
   std::string projection = "perspective";
 };
 
 /// The manifest of a synthetic database: cameras on a Fibonacci sphere (radius 3, looking at the
-/// origin, labelled with latitude/longitude), a ring navigation graph (left/right = previous/next
-/// camera), tasks on one "isovalue" axis, times 0.1 s apart. Throws Error on non-positive counts.
+/// origin, labelled with latitude/longitude; more shells inside it with `shells`), a ring navigation
+/// graph per shell (left/right = previous/next camera, in/out = the next shell), tasks on one
+/// "isovalue" axis or on `axes`, times 0.1 s apart. Throws Error on non-positive counts.
 Manifest synthetic_manifest(const SyntheticOptions& options);
 
 /// Frame `frame` of stream (camera, task): coloured background, a disc moving with time and camera,

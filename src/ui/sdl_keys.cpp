@@ -43,33 +43,34 @@ std::string plain_name(SDL_Keycode key) {
 
 }  // namespace
 
-std::string key_name(SDL_Keycode key, Uint16 modifiers) {
-  std::string name = plain_name(key);
-  if (name.empty()) return name;
-  if ((modifiers & KMOD_SHIFT) && name.rfind("Shift+", 0) != 0) {
-    const std::string shifted = "Shift+" + name;
-    if (player::action_for_key(shifted)) return shifted;
-    // Shift+'=' is '+' on US layouts.
-    if (name == "=") return "+";
-  }
-  return name;
+const player::KeyBinding* binding_for_event(const SDL_KeyboardEvent& event) {
+  if (event.keysym.mod & KMOD_GUI) return nullptr;
+  const std::string name = plain_name(event.keysym.sym);
+  if (name.empty()) return nullptr;
+  unsigned mods = player::kNoModifier;
+  if (event.keysym.mod & KMOD_SHIFT) mods |= player::kShift;
+  if (event.keysym.mod & KMOD_CTRL) mods |= player::kCtrl;
+  if (event.keysym.mod & KMOD_ALT) mods |= player::kAlt;
+  // '>' and '<' are SDL keys of their own whose name already says Shift ("Shift+Period").
+  const player::KeyChord named = player::parse_chord(name);
+  if (const auto* b = player::binding_for_chord(named.base, mods | named.modifiers)) return b;
+  // Shift+'=' is '+' on US layouts.
+  if (name == "=" && mods == player::kShift) return player::binding_for_key("+");
+  return nullptr;
 }
 
 std::optional<player::Action> action_for_event(const SDL_KeyboardEvent& event) {
-  // Ctrl/Alt/GUI combinations belong to the desktop (e.g. Alt+Tab), not to the player.
-  if (event.keysym.mod & (KMOD_CTRL | KMOD_ALT | KMOD_GUI)) return std::nullopt;
-  const std::string name = key_name(event.keysym.sym, event.keysym.mod);
-  if (name.empty()) return std::nullopt;
-  return player::action_for_key(name);
+  if (const auto* b = binding_for_event(event)) return b->action;
+  return std::nullopt;
 }
 
 std::optional<SDL_Event> key_event_for_name(std::string_view name) {
+  const player::KeyChord chord = player::parse_chord(name);
+  const std::string_view base = chord.base;
   Uint16 mod = KMOD_NONE;
-  std::string_view base = name;
-  if (base.rfind("Shift+", 0) == 0) {
-    mod = KMOD_LSHIFT;
-    base.remove_prefix(6);
-  }
+  if (chord.modifiers & player::kShift) mod |= KMOD_LSHIFT;
+  if (chord.modifiers & player::kCtrl) mod |= KMOD_LCTRL;
+  if (chord.modifiers & player::kAlt) mod |= KMOD_LALT;
   SDL_Keycode key = SDLK_UNKNOWN;
   // Letters and digits first, so "1" is the main-row key rather than the keypad's.
   if (base.size() == 1) {

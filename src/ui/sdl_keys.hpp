@@ -11,12 +11,11 @@
 
 namespace panoptes::ui {
 
-/// Canonical key name of a key press: "Right", "Tab", "A", "1", "Period"; with Shift held, the
-/// "Shift+" form is returned when the key table has it (e.g. "Shift+Tab"), else the plain name.
-/// Empty for keys Panoptes has no name for.
-std::string key_name(SDL_Keycode key, Uint16 modifiers);
-
-/// The action of a key press (via player::action_for_key), or std::nullopt if the key is unbound.
+/// The binding of a key press: the key's plain name and its Shift / Ctrl / Alt state matched by
+/// player::binding_for_chord (the rule every front end uses); nullptr if the key is unbound. GUI
+/// (Windows/Command) combinations belong to the desktop and match nothing.
+const player::KeyBinding* binding_for_event(const SDL_KeyboardEvent& event);
+/// binding_for_event(event)'s action, or std::nullopt if the key is unbound.
 std::optional<player::Action> action_for_event(const SDL_KeyboardEvent& event);
 
 /// A synthetic SDL_KEYDOWN event for a canonical key name (scripts, the window test), so injected

@@ -25,7 +25,10 @@ TEST(SdlKeys, TypedKeysMapThroughThePlayersTable) {
   EXPECT_EQ(press(SDLK_EQUALS, KMOD_LSHIFT), Action::zoom_in);  // '+' on US keyboards
   EXPECT_EQ(press(SDLK_KP_PLUS), Action::zoom_in);
   EXPECT_EQ(press(SDLK_l), Action::toggle_loop);
-  EXPECT_EQ(press(SDLK_l, KMOD_LSHIFT), Action::toggle_loop);
+  EXPECT_EQ(press(SDLK_l, KMOD_LSHIFT), Action::toggle_loop);  // no Shift+L binding: L
+  EXPECT_EQ(press(SDLK_a), Action::next_axis);
+  EXPECT_EQ(press(SDLK_a, KMOD_LSHIFT), Action::previous_axis);  // the table's Shift+A, not A
+  EXPECT_FALSE(press(SDLK_a, KMOD_LCTRL));  // Ctrl+A is not bound: not A either
   EXPECT_EQ(press(SDLK_3), Action::task_3);
   EXPECT_EQ(press(SDLK_PAGEUP), Action::axis_up);
   EXPECT_EQ(press(SDLK_RIGHTBRACKET), Action::speed_up);  // as mpv
@@ -44,6 +47,7 @@ TEST(SdlKeys, EveryKeyOfTheTableCanBeInjected) {
     ASSERT_TRUE(e) << b.key;
     EXPECT_EQ(e->type, SDL_KEYDOWN);
     EXPECT_EQ(action_for_event(e->key), b.action) << b.key;
+    EXPECT_EQ(binding_for_event(e->key), &b) << b.key << ": matched another row of the table";
   }
   EXPECT_FALSE(key_event_for_name("NoSuchKey"));
 }

@@ -221,7 +221,6 @@ class WindowApp {
   void run_due_script_commands();
   void handle_event(const SDL_Event& e);
   void do_action(player::Action action);
-  void explain_refused(player::Action action);
   void zoom_by(double factor);
   void apply_hud_requests(const HudRequests& req);
   HudInfo gather_hud_info(const player::ShownFrame& shown);
@@ -265,6 +264,12 @@ class WindowApp {
   std::optional<player::TraceWriter> trace_;
   int trace_step_ = 0;
   void write_trace(const player::ScriptCommand& c);
+  /// Shows a refused key's text (player::refusal) and keeps it for the script's trace.
+  void refuse(std::string_view why) {
+    last_refusal_ = why;
+    if (!why.empty()) hud_.notify(std::string(why));
+  }
+  std::string last_refusal_;
   std::vector<MeshVertex> mesh_;
   std::vector<SDL_Vertex> sdl_mesh_;
   void face_the_action();
@@ -297,6 +302,7 @@ void WindowApp::run_due_script_commands() {
   if (next_command_ < script_.size() && script_[next_command_].t <= t) engine_.tick();
   while (next_command_ < script_.size() && script_[next_command_].t <= t) {
     const auto& c = script_[next_command_++];
+    last_refusal_.clear();
     if (c.kind == Kind::end) {
       quit_ = true;
       continue;
@@ -323,7 +329,7 @@ void WindowApp::run_due_script_commands() {
 
 void WindowApp::write_trace(const player::ScriptCommand& c) {
   if (!trace_) return;
-  trace_->write({trace_step_++, c.line, player::describe(c), engine_.selection(), controls_.look()});
+  trace_->write(player::trace_step(trace_step_++, c, engine_, controls_, last_refusal_));
 }
 
 void WindowApp::zoom_by(double factor) {
@@ -340,14 +346,14 @@ void WindowApp::zoom_by(double factor) {
 // Turns the 360° view toward the strongest signal of the frame on screen (player/face_action.hpp).
 void WindowApp::face_the_action() {
   if (!equirect_ || !shown_frame_) {
-    hud_.notify("C turns a 360-degree view toward the strongest signal; this database has fixed views");
+    refuse(player::refusal(player::Action::face_action, player::ViewMode::sphere));
     return;
   }
   const auto& cam = engine_.manifest().cameras[std::size_t(engine_.selection().camera)];
   const player::ViewBasis basis = player::camera_basis(cam);
   const auto d = player::strongest_signal_direction(*shown_frame_, basis);
   if (!d) {
-    hud_.notify("nothing stands out in this frame to turn to");
+    refuse(controls_.refusal(player::Action::face_action));
     return;
   }
   look_ = player::look_towards(basis, *d, look_.fov_deg);
@@ -385,11 +391,9 @@ void WindowApp::do_action(player::Action action) {
       }
       return;
     case player::Controls::Result::refused: {
-      const player::Operation op = player::operation(action, controls_.mode());
-      if (op == player::Operation::engine) explain_refused(action);
-      if (player::is_walk(op)) hud_.notify("no camera that way");
-      if (op == player::Operation::none) hud_.notify("this key does nothing inside a lattice or along a path");
-      return;  // a field of view at its limit needs no words
+      // The table's and the database's words (player::refusal), the same the browser shows.
+      refuse(controls_.refusal(action));
+      return;
     }
     case player::Controls::Result::front_end: break;
   }
@@ -407,29 +411,6 @@ void WindowApp::do_action(player::Action action) {
   }
 }
 
-// A key that changes nothing says why, instead of leaving the user to guess.
-void WindowApp::explain_refused(player::Action action) {
-  using player::Action;
-  switch (action) {
-    case Action::shell_in:
-    case Action::shell_out:
-      if (shell_count_ <= 1)
-        hud_.notify("Z / X move between camera shells, and this rig has only one (a rig spec like "
-                    "\"yinyang@2,3\" has two); use + / - or the wheel to magnify");
-      else
-        hud_.notify(action == Action::shell_in ? "no closer shell from this camera" : "no farther shell from this camera");
-      break;
-    case Action::camera_up: hud_.notify("no camera above this one"); break;
-    case Action::camera_down: hud_.notify("no camera below this one"); break;
-    case Action::camera_left:
-    case Action::camera_right: hud_.notify("no camera that way"); break;
-    case Action::axis_up:
-    case Action::axis_down:
-    case Action::next_axis: hud_.notify("this database has no parameter axis to step here"); break;
-    default: break;
-  }
-}
-
 void WindowApp::handle_event(const SDL_Event& e) {
   ImGui_ImplSDL2_ProcessEvent(&e);
   const ImGuiIO& io = ImGui::GetIO();
@@ -441,14 +422,8 @@ void WindowApp::handle_event(const SDL_Event& e) {
       break;
     case SDL_KEYDOWN: {
       if (io.WantTextInput) break;
-      if (auto action = action_for_event(e.key)) {
-        // Holding a key repeats navigation and frame steps, but not toggles.
-        const bool toggle = *action == player::Action::play_pause || *action == player::Action::fullscreen ||
-                            *action == player::Action::record || *action == player::Action::help ||
-                            *action == player::Action::toggle_hud ||
-                            *action == player::Action::screenshot || *action == player::Action::toggle_loop;
-        if (!(e.key.repeat && toggle)) do_action(*action);
-      }
+      // Holding a key repeats navigation and frame steps, but not toggles: the table says which.
+      if (const player::KeyBinding* b = binding_for_event(e.key); b && !(e.key.repeat && !b->repeats())) do_action(b->action);
       break;
     }
     case SDL_MOUSEBUTTONDOWN:

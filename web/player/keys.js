@@ -14,14 +14,13 @@ export function parseKeyTable(json, source = "keys.json") {
     if (!r || typeof r.desktop !== "string" || typeof r.action !== "string" || !Array.isArray(r.keys))
       throw new Error(`${source}: binding ${i} lacks "desktop", "action" or "keys"`);
   if (json.mode !== undefined && !MODES.includes(json.mode)) throw new Error(`${source}: unknown mode "${json.mode}"`);
-  // event.key → bindings; those that name `shift` are tried first (Shift+Tab before Tab).
+  // event.key → bindings, in the table's order.
   const byKey = new Map();
   for (const r of rows)
     for (const k of r.keys) {
       if (!byKey.has(k)) byKey.set(k, []);
       byKey.get(k).push(r);
     }
-  for (const list of byKey.values()) list.sort((a, b) => (b.shift !== undefined) - (a.shift !== undefined));
   return { rows, byKey, mode: json.mode ?? null, actions: json.actions ?? {}, walk: json.walk ?? null, look: json.look ?? null,
            playback: json.playback ?? null, numbering: json.numbering ?? null,
            // Actions that can change nothing in this database (C++ player::usable: no parameter axes, one
@@ -29,11 +28,23 @@ export function parseKeyTable(json, source = "keys.json") {
            unusable: new Set(Array.isArray(json.unusable) ? json.unusable : []) };
 }
 
-/// The binding of a keydown event (event.key among its keys, and its shift state when it names one),
-/// or undefined; events with Ctrl, Alt or Meta match nothing.
+/// The binding of a keydown event, by keys.json's match_rule (player::binding_for_chord): event.key
+/// among its keys, its `shift` (when it names one) equal to event.shiftKey, its `ctrl` and `alt` equal
+/// to event.ctrlKey and event.altKey; failing that, with Shift alone held, the binding that names
+/// shift false (Shift+L acts as L, as on the desktop). Meta matches nothing. Undefined if none.
 export function bindingOf(e, table) {
-  if (!table || e.ctrlKey || e.metaKey || e.altKey) return undefined;
-  return (table.byKey.get(e.key) ?? []).find((r) => r.shift === undefined || r.shift === e.shiftKey);
+  if (!table || e.metaKey) return undefined;
+  const rows = table.byKey.get(e.key) ?? [];
+  const mods = (r) => !!r.ctrl === e.ctrlKey && !!r.alt === e.altKey;
+  return rows.find((r) => mods(r) && (r.shift === undefined || r.shift === e.shiftKey)) ??
+    (e.shiftKey && !e.ctrlKey && !e.altKey ? rows.find((r) => mods(r) && r.shift === false) : undefined);
+}
+
+/// What a refused press of the binding says in the mode (keys.json's `refusal`, player::refusal: the
+/// window shows the same words); "" when a refusal needs none.
+export function refusalOf(table, binding, mode) {
+  const r = binding && binding.refusal;
+  return (r && typeof r === "object" && r[mode]) || "";
 }
 
 /// What an action does in a mode: the table's operation, null for nothing, the action's own name

@@ -7,7 +7,8 @@ import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
 import { installReadoutHover } from "./readout_hover.js";
-import { parseKeyTable, bindingOf, helpRows, operationOf } from "./keys.js";
+import { parseKeyTable, bindingOf, helpRows, operationOf, refusalOf } from "./keys.js";
+import { makeClock, stepTaskOnAxis, engineOps, isFrontEndOperation } from "./engine_ops.js";
 import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf,
          lookTowards, cutoutDirection, neighbourToward, strongestSignalDirection } from "./look.js";
 import { LookView, drawOrientationMarks } from "./look_view.js";
@@ -103,27 +104,8 @@ function stream(camera, task) {
   return s;
 }
 
-// ---- clock: time stays continuous through switches ---------------------------------------------
-function currentFrame(now = performance.now()) {
-  const n = S.db.frames;
-  if (!S.playing) return S.anchorFrame;
-  // As player::Engine: the position runs forward or backward (J) and wraps or stops at either end.
-  let f = S.anchorFrame + S.dir * Math.floor(((now - S.anchorTime) / 1000) * S.fps * S.speed + 1e-9);
-  if (f >= n || f < 0) {
-    if (S.loop) f = ((f % n) + n) % n;
-    else { f = f < 0 ? 0 : n - 1; S.playing = false; S.anchorFrame = f; }
-  }
-  return f;
-}
-function setFrame(f) {
-  S.anchorFrame = Math.max(0, Math.min(S.db.frames - 1, f));
-  S.anchorTime = performance.now();
-}
-function setPlaying(p) {
-  const f = currentFrame();
-  S.playing = p;
-  setFrame(f);
-}
+// ---- clock: time stays continuous through switches (engine_ops.js, as player::Engine's) ----------
+const { currentFrame, setFrame, setPlaying } = makeClock(S);
 
 // ---- navigation ---------------------------------------------------------------------------------
 const COLUMNS = ["left", "right", "up", "down", "in", "out"];
@@ -131,19 +113,6 @@ const trail = new MoveTrail();  // the arrow keys' moves, so the opposite key re
 function graphNeighbour(camera, direction) {
   const g = S.cams && S.cams.neighbours;  // null until the camera table is loaded, or without a graph
   return g && camera >= 0 && camera < S.cams.count ? g[6 * camera + COLUMNS.indexOf(direction)] : -1;
-}
-/// The task at the same positions as `task` on every axis but `axis`, moved by delta there; -1 if none.
-function stepTaskOnAxis(task, axisName, delta) {
-  const pos = (t) => Object.fromEntries(S.db.tasks[t].axes.map((a) => [a.axis, a.index]));
-  const from = pos(task);
-  if (!(axisName in from)) return -1;
-  for (let t = 0; t < S.db.tasks.length; t++) {
-    const p = pos(t);
-    if (p[axisName] !== from[axisName] + delta) continue;
-    if (Object.keys(from).every((k) => k === axisName || p[k] === from[k]) && Object.keys(p).length === Object.keys(from).length)
-      return t;
-  }
-  return -1;
 }
 function neighbourSelections(camera, task) {
   const out = [];
@@ -156,7 +125,7 @@ function neighbourSelections(camera, task) {
   if (T > 1) out.push([camera, (task + 1) % T], [camera, (task + T - 1) % T]);
   for (const axis of S.db.axes)
     for (const d of [1, -1]) {
-      const t = stepTaskOnAxis(task, axis.name, d);
+      const t = stepTaskOnAxis(S.db, task, axis.name, d);
       if (t >= 0) out.push([camera, t]);
     }
   const seen = new Set();
@@ -585,16 +554,13 @@ function zoomAt(factor, px, py) {
   S.shown = null;  // redraw
 }
 // Arrow keys (and Z/X): the opposite of the last move(s) retraces them (MoveTrail in cameras.js).
-const move = (d) => {
-  const to = trail.next(S.camera, d, graphNeighbour(S.camera, d));
-  if (to < 0) notify(d === "in" || d === "out" ? `no ${d === "in" ? "closer" : "farther"} shell from this camera` : "no camera that way");
-  return select(to, S.task, d);
-};
+// A refused move is explained by the key handler (keys.json's refusal), not here.
+const move = (d) => select(trail.next(S.camera, d, graphNeighbour(S.camera, d)), S.task, d);
 /// Walks to the neighbour in the walk's direction relative to the view, keeping the world view
 /// direction (player::walk_keeping_view).
 function walk(w) {
   const to = walkTarget(S.cams, S.camera, S.look, w, S.keys && S.keys.walk ? S.keys.walk.min_cos : undefined);
-  if (to < 0) { notify("no camera that way"); return false; }
+  if (to < 0) return false;
   S.look = lookAfterWalk(S.cams, S.camera, to, S.look);
   S.lookDirty = true;
   trail.clear();
@@ -618,13 +584,11 @@ function stepTowardClick(x, y, w, h, back) {
 }
 let faceCanvas = null;
 /// C: turns the 360° view toward the strongest signal of the frame on screen (the desktop's
-/// face_the_action), read from the decoded frame drawn into a canvas of at most 512 columns.
+/// face_the_action), read from the decoded frame drawn into a canvas of at most 512 columns. False
+/// when refused: the key handler says why (keys.json's refusal for the mode, the window's words).
 function faceTheAction() {
   const vf = S.shownKey && cache.map.get(S.shownKey);
-  if (!S.rig.equirect || !vf || !S.cams) {
-    notify("C turns a 360-degree view toward the strongest signal; this database has fixed views");
-    return;
-  }
+  if (!S.rig.equirect || !vf || !S.cams) return false;
   const fw = vf.displayWidth ?? vf.width, fh = vf.displayHeight ?? vf.height;
   const W = Math.min(512, fw), H = Math.max(2, Math.round((fh * W) / fw));
   faceCanvas = faceCanvas ?? document.createElement("canvas");
@@ -638,22 +602,10 @@ function faceTheAction() {
   for (let i = 0; i < W * H; i++) luma[i] = Math.round(16 + (219 / 255) * (0.299 * px[4 * i] + 0.587 * px[4 * i + 1] + 0.114 * px[4 * i + 2]));
   const cam = basisOfCamera(S.cams, S.camera);
   const d = strongestSignalDirection(luma, W, H, cam);
-  if (!d) { notify("nothing stands out in this frame to turn to"); return; }
+  if (!d) return false;
   setLook(lookTowards(cam, d, S.look.fov));
   notify(`facing the strongest signal: ${lookText(S.look)}`);
-}
-/// Speed factor, as player::Engine::set_speed (×¼..×8), keeping the playhead where it is.
-function setSpeed(v) {
-  const f = currentFrame();
-  S.speed = Math.min(pb("speed_max", 8), Math.max(pb("speed_min", 0.25), v));
-  setFrame(f);
-  notify(`speed x${S.speed.toFixed(2)} (${(S.speed * S.fps).toFixed(1)} frames/s)`);
-}
-/// A stepped frame wraps when looping, else stops at the ends (Engine::step_frame).
-function stepFrame(d) {
-  const n = S.db.frames, f = currentFrame() + d;
-  S.playing = false;
-  setFrame(S.loop ? ((f % n) + n) % n : Math.max(0, Math.min(n - 1, f)));
+  return true;
 }
 let notifyTimer = 0;
 /// A line in the status bar for 3 s (a key that changed nothing says why).
@@ -668,54 +620,21 @@ function download(url, name) {
   a.download = name;
   a.click();
 }
-/// The operations the key table's actions stand for (api/keys.json `actions`: per mode), by name.
 const pb = (k, dflt) => (S.keys && S.keys.playback && S.keys.playback[k]) || dflt;
 const lk = (k, dflt) => (S.keys && S.keys.look && S.keys.look[k]) || dflt;
-const stepAxis = (d) => (S.db.axes[S.axis] ? select(S.camera, stepTaskOnAxis(S.task, S.db.axes[S.axis].name, d), d > 0 ? "axis_up" : "axis_down")
-                                          : notify("this database has no parameter axis to step here"));
+/// The engine's and the dispatch's operations (engine_ops.js); OPS below holds only what a page does
+/// itself. Each returns false when refused.
+const ENGINE = engineOps({ S, clock: { currentFrame, setFrame, setPlaying }, select, move, walk, setLook, notify }).ops;
 const OPS = {
-  play_pause: () => setPlaying(!S.playing),
-  frame_forward: () => stepFrame(1),
-  frame_back: () => stepFrame(-1),
-  first_frame: () => setFrame(0),
-  last_frame: () => setFrame(S.db.frames - 1),
-  toggle_loop: () => { const f = currentFrame(); S.loop = !S.loop; setFrame(f); notify(S.loop ? "loop on" : "loop off"); },
-  faster: () => setSpeed(S.speed * pb("faster_factor", 2)),
-  slower: () => setSpeed(S.speed / pb("faster_factor", 2)),
-  reverse: () => { const f = currentFrame(); S.dir = -S.dir; setFrame(f); },
-  speed_up: () => setSpeed(S.speed * pb("fine_factor", 1.1)),
-  speed_down: () => setSpeed(S.speed / pb("fine_factor", 1.1)),
-  speed_reset: () => setSpeed(1),
-  camera_left: () => move("left"),
-  camera_right: () => move("right"),
-  camera_up: () => move("up"),
-  camera_down: () => move("down"),
-  shell_in: () => move("in"),
-  shell_out: () => move("out"),
-  walk_forward: () => walk("forward"),
-  walk_back: () => walk("back"),
-  walk_left: () => walk("left"),
-  walk_right: () => walk("right"),
-  walk_up: () => walk("up"),
-  walk_down: () => walk("down"),
-  next_task: () => select(S.camera, (S.task + 1) % S.db.tasks.length, "next_task"),
-  previous_task: () => select(S.camera, (S.task + S.db.tasks.length - 1) % S.db.tasks.length, "previous_task"),
-  axis_up: () => stepAxis(1),
-  axis_down: () => stepAxis(-1),
-  next_axis: () => { if (S.db.axes.length) S.axis = (S.axis + 1) % S.db.axes.length; else notify("this database has no parameter axis to step here"); },
   zoom_in: () => zoomAt(1.25, canvas.width / 2, canvas.height / 2),
   zoom_out: () => zoomAt(0.8, canvas.width / 2, canvas.height / 2),
   zoom_reset: () => { S.zoom = 1; S.panX = S.panY = 0; S.shown = null; },
-  fov_narrow: () => setLook({ ...S.look, fov: S.look.fov / lk("key_fov_factor", 1.25) }),
-  fov_widen: () => setLook({ ...S.look, fov: S.look.fov * lk("key_fov_factor", 1.25) }),
-  fov_reset: () => setLook({ ...S.look, fov: lk("fov_deg", 90) }),
   fullscreen: () => (document.fullscreenElement ? document.exitFullscreen() : document.getElementById("stage").requestFullscreen()).catch((e) => notify(`full screen: ${e.message}`)),
   screenshot: () => download((surface === "look" ? lookCanvas : canvas).toDataURL("image/png"), `panoptes-c${S.camera}-t${S.task}-f${currentFrame()}.png`),
-  help: () => document.getElementById("help").classList.toggle("hidden"),
+  help: () => { document.getElementById("help").classList.toggle("hidden"); },
   face_action: () => faceTheAction(),
   toggle_hud: () => { S.hudHidden = !S.hudHidden; for (const id of ["hud", "minimap", "legend"]) document.getElementById(id).classList.toggle("off", S.hudHidden); },
 };
-for (let k = 1; k <= 9; k++) OPS[`task_${k}`] = () => select(S.camera, k - 1, `task_${k}`);
 /// Actions of the desktop that a browser page cannot do (left out of the help).
 const NOT_HERE = new Set(["record", "quit"]);
 const WHY_NOT = { record: "recording is the desktop player's (panoptes play, R); here use S for a screenshot", quit: "close the tab to quit" };
@@ -724,11 +643,17 @@ document.addEventListener("keydown", (e) => {
   const b = bindingOf(e, S.keys);
   if (!b) return;
   e.preventDefault();
+  if (e.repeat && b.repeat === false) return;  // a held toggle acts once (the table's repeat)
   inputEventTime = e.timeStamp;
   const op = operationOf(S.keys, b.action, S.mode);
-  if (op === null) notify(`${b.desktop} does nothing in this database`);
-  else if (OPS[op]) OPS[op](e);
-  else notify(WHY_NOT[op] ?? `${b.desktop}: "${op}" is not available in the web player`);
+  const run = op === null ? null : isFrontEndOperation(b, op) ? OPS[op] : ENGINE[op];
+  S.refusal = "";
+  if (op !== null && !run) notify(WHY_NOT[op] ?? `${b.desktop}: "${op}" is not available in the web player`);
+  else if (!run || run(e) === false) {
+    // Refused: the words of keys.json (player::refusal), the same the window shows.
+    S.refusal = refusalOf(S.keys, b, S.mode);
+    if (S.refusal) notify(S.refusal);
+  }
   inputEventTime = 0;
   drawNowIfReady();
 });

@@ -13,7 +13,9 @@ export function installTestApi(p) {
   const { S, streams, cache, options, drag, canvas, ctx, lookCanvas, currentFrame, setLook, setPlaying, select, graphNeighbour, dirs } = p;
   window.panoptes = {
     state: () => ({ camera: S.camera, task: S.task, frame: S.db ? currentFrame() : 0, frames: S.db ? S.db.frames : 0, playing: S.playing, zoom: S.zoom,
-                    speed: S.speed, fps: S.fps, direction: S.dir, loop: S.loop, look: { ...S.look }, rig: S.rig, surface: p.surface(), hudHidden: S.hudHidden }),
+                    speed: S.speed, fps: S.fps, direction: S.dir, loop: S.loop, look: { ...S.look }, rig: S.rig, surface: p.surface(), hudHidden: S.hudHidden,
+                    // The active parameter axis, the shown camera's shell and what the last key's refusal said (issue 43).
+                    axis: S.db && S.db.axes.length ? S.axis : -1, shell: S.cams && S.cams.shell ? S.cams.shell[S.camera] : 0, refusal: S.refusal ?? "" }),
     /// The key table as loaded (null before or when keys.json failed) and why it failed.
     keys: () => (S.keys ? S.keys.rows : null),
     /// The key table's mode in use: sphere, panorama or lattice.

@@ -8,11 +8,13 @@ set -euo pipefail
 panoptes=$(realpath "$1") node_modules=$(realpath "$2") chromium=$3
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
-pids=()
+. "$here/serve_db.sh"  # serve_db DB LOG [ARGS], serve_db_stop: every server stopped and checked at exit
 cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  local rc=$?
+  serve_db_stop || rc=1
   wait 2>/dev/null || true
   rm -rf "$tmp"
+  exit $rc
 }
 trap cleanup EXIT
 
@@ -20,28 +22,7 @@ trap cleanup EXIT
 rm "$tmp/db/movies/c5/t1.mp4"                                   # missing
 head -c 3000 /dev/urandom > "$tmp/db/movies/c4/t0.mp4"          # corrupt
 
-# start_serve LOG ARGS...: starts `panoptes serve ARGS` in the background (logging to LOG) and sets
-# served_url to the URL it prints once it listens.
-start_serve() {
-  local log=$1
-  shift
-  # The log exists before the server starts: the background job's redirection may run after the first
-  # sed below, which (under set -e) would end the test on a missing file.
-  : > "$log"
-  "$panoptes" serve "$@" > "$log" 2>&1 &
-  pids+=($!)
-  served_url=""
-  for _ in $(seq 100); do
-    served_url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$log")
-    [ -n "$served_url" ] && return 0
-    sleep 0.1
-  done
-  echo "serve $* did not start:"
-  cat "$log"
-  exit 1
-}
-
-start_serve "$tmp/serve.log" "$tmp/db" --port 0 --token t0k3n
+serve_db "$tmp/db" "$tmp/serve.log" --token t0k3n
 url=$served_url
 
 "$panoptes" export-web "$tmp/db" "$tmp/site" >/dev/null
@@ -51,7 +32,7 @@ url=$served_url
 "$panoptes" synth-db "$tmp/live" --cameras 2 --tasks 1 --frames 16 --size 160x120 --gop 1 >/dev/null
 exec 9>"$tmp/live/.panoptes.lock"
 flock -x 9
-start_serve "$tmp/live.log" "$tmp/live" --port 0
+serve_db "$tmp/live" "$tmp/live.log"
 live_url=$served_url
 
 export NODE_PATH=$node_modules

@@ -8,11 +8,13 @@ set -euo pipefail
 panoptes=$(realpath "$1") node_modules=$(realpath "$2") chromium=$3 shots=${4:-}
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
-pids=()
+. "$here/serve_db.sh"  # serve_db DB LOG [ARGS], serve_db_stop: every server stopped and checked at exit
 cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  local rc=$?
+  serve_db_stop || rc=1
   wait 2>/dev/null || true
   rm -rf "$tmp"
+  exit $rc
 }
 trap cleanup EXIT
 
@@ -29,17 +31,7 @@ with open(f"{out}/camera.txt", "w") as c:
 PY
 "$panoptes" render "$tmp/f_0.npy" "$tmp/f_1.npy" --rig "$tmp/camera.txt" --task slice:z:0.5 --size 256x192 \
   --no-outline -q --out "$tmp/db"
-# Started here, not through serve_db.sh's function: called as url=$(serve_db ...) it records the
-# server's pid in a subshell, and the cleanup above never stops it.
-: > "$tmp/serve.log"
-"$panoptes" serve "$tmp/db" --port 0 --quiet > "$tmp/serve.log" 2>&1 &
-pids+=($!)
-url=""
-for _ in $(seq 100); do
-  url=$(sed -n 's/^serving .* at \(http[^ ]*\)$/\1/p' "$tmp/serve.log")
-  [ -n "$url" ] && break
-  sleep 0.1
-done
-[ -n "$url" ] || { echo "serve did not start:"; cat "$tmp/serve.log"; exit 1; }
+serve_db "$tmp/db" "$tmp/serve.log" --quiet
+url=$served_url
 export NODE_PATH=$node_modules
 node "$here/legend_test.mjs" "$url" "$chromium" "$node_modules" "$shots"

@@ -6,20 +6,22 @@ set -euo pipefail
 panoptes=$(realpath "$1") node_modules=$(realpath "$2") chromium=$3 shots=${4:-}
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
-pids=()
+. "$here/serve_db.sh"  # serve_db DB LOG [ARGS], serve_db_stop: every server stopped and checked at exit
 cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  declare -F serve_db_stop >/dev/null && serve_db_stop "$tmp/serve.log" "$tmp/sphere.log"
+  local rc=$?
+  serve_db_stop || rc=1
   wait 2>/dev/null || true
   rm -rf "$tmp"
+  exit $rc
 }
 trap cleanup EXIT
 
 "$panoptes" synth-db "$tmp/db" --lattice 3x3x3 --projection equirectangular --tasks 2 --frames 24 --size 256x128 --gop 4 >/dev/null
 # A sphere rig (perspective, navigation graph) for the same key script through both players.
 "$panoptes" synth-db "$tmp/sphere" --cameras 12 --tasks 3 --frames 8 --size 96x64 --gop 4 >/dev/null
-. "$here/serve_db.sh"  # serve_db DB LOG
-url=$(serve_db "$tmp/db" "$tmp/serve.log")
-sphere_url=$(serve_db "$tmp/sphere" "$tmp/sphere.log")
+serve_db "$tmp/db" "$tmp/serve.log" --quiet
+url=$served_url
+serve_db "$tmp/sphere" "$tmp/sphere.log" --quiet
+sphere_url=$served_url
 export NODE_PATH=$node_modules
 node "$here/look_test.mjs" "$url" "$chromium" "$node_modules" "$panoptes" "$tmp/db" "$shots" "${LOOK_TEST_SWITCHES:-40}" "$sphere_url" "$tmp/sphere"

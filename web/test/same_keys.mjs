@@ -1,5 +1,6 @@
-// One key script through the web player (headless Chromium), printed as one "camera task frame" row per
-// script line, for same_keys.sh to compare with `play --headless`, the window and Python's Player.
+// One key script through the web player (headless Chromium), printed as one "camera task frame axis
+// shell" row per script line (OUT) and the words of each refused key ("-" for none; OUT.refusals), for
+// same_keys.sh to compare with `play --headless`, the window and Python's Player.
 //   node same_keys.mjs CHROMIUM NODE_MODULES SCRIPT URL START_CAMERA OUT [URL START_CAMERA OUT ...]
 // (one browser for every database: its start-up is most of the leg's time).
 // SCRIPT holds `t=... key=NAME` lines (the desktop's key names); each is pressed as the browser's key
@@ -35,7 +36,7 @@ for (let r = 0; r + 2 < runs.length; r += 3) {
     page.on("pageerror", (e) => errors.push(e.message));
     await page.goto(`${url}?play=0&camera=${start}`);
     await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded() && window.panoptes.keys(), { timeout: 20000 });
-    const rows = [];
+    const rows = [], refusals = [];
     for (const name of keys) {
       const { key, shift } = browserKey(name);
       if (shift) await page.keyboard.down("Shift");
@@ -47,11 +48,13 @@ for (let r = 0; r + 2 < runs.length; r += 3) {
         return w && w.camera === s.camera && w.task === s.task && w.frame === s.frame;
       }, { timeout: 10000 }).catch(() => {});
       const s = await page.evaluate(() => ({ state: window.panoptes.state(), shown: window.panoptes.shown() }));
-      rows.push(`${s.shown.camera} ${s.shown.task} ${s.shown.frame}`);
+      rows.push(`${s.shown.camera} ${s.shown.task} ${s.shown.frame} ${s.state.axis} ${s.state.shell}`);
+      refusals.push(s.state.refusal || "-");
       if (s.state.playing) throw new Error(`key ${name} started playback`);
     }
     if (errors.length) throw new Error(`page errors: ${errors.join(" | ")}`);
     fs.writeFileSync(outFile, rows.join("\n") + "\n");
+    fs.writeFileSync(outFile + ".refusals", refusals.join("\n") + "\n");
     await page.close();
   } catch (e) {
     console.log(`same_keys.mjs: ${url}: ${e.message}`);

@@ -40,6 +40,7 @@ class Player:
         return self._p.walk(direction)
 
     mode = property(lambda self: self._p.mode, doc="view mode: sphere, panorama or lattice")
+    active_axis = property(lambda self: self._p.active_axis, doc="the axis PageUp/PageDown step (A, Shift+A turn it); -1 without axes")
     look = property(lambda self: self._p.look, lambda self, v: setattr(self._p, "look", tuple(v)),
                     doc="(yaw, pitch, fov) in degrees inside 360-degree streams")
 
