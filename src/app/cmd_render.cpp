@@ -321,7 +321,12 @@ void run(const Args& args) {
     const double points = double(grid.dims[0]) * grid.dims[1] * grid.dims[2];
     MemoryEstimate e = insitu::estimate_session_memory(cfg, points, insitu::rig_camera_count(cfg, grid), 1,
                                                        omp_get_max_threads());
-    e.add("volumes read", points * 4 * (files.size() > 1 ? 2 : 1));
+    if (!source) e.add("volumes read", points * 4 * (files.size() > 1 ? 2 : 1));
+    if (source) {  // the grid stage, and each source volume read whole (2x: its bytes and its floats)
+      const double source_points = double(source->source.points_per_patch()) * source->source.patches();
+      e.add(insitu::estimate_grid_stage_memory(source_points, points, 1, 1));
+      e.add("source volumes read", source_points * 8 * (files.size() > 1 ? 2 : 1));
+    }
     check_memory(e, available_memory(), 1, "this render", "pass --force");
     cfg.check_memory = false;
   }

@@ -41,9 +41,15 @@ inline std::string read_npy_bytes(const std::string& path) {
   return read_regular_file(path, std::uint64_t(volume_detail::kMaxVolumePoints) * 16 + (1 << 20), "volume file");
 }
 
+// A coordinate array has at most 65535 values (GridDescription's limit): 512 kB of float64 and a
+// header. A larger file (a 3 GB sparse .npy was read whole, issue 44) is refused before it is read.
+inline std::string read_coordinate_bytes(const std::string& path) {
+  return read_regular_file(path, std::uint64_t(65535) * 8 + (1 << 16), "coordinate file (at most 65535 values)");
+}
+
 // A 1-D float32/float64 .npy array of coordinates, in double precision.
 inline std::vector<double> read_coordinates(const std::string& path, const std::string& key) {
-  const std::string data = read_npy_bytes(path);
+  const std::string data = read_coordinate_bytes(path);
   const NpyHeader h = parse_npy_header(data, path);
   if (h.shape.size() != 1)
     throw FileError(path, "grid." + key + ": array of " + std::to_string(h.shape.size()) +

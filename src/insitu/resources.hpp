@@ -15,6 +15,13 @@ namespace panoptes::insitu {
 MemoryEstimate estimate_session_memory(const SessionConfig& config, double block_points, long long cameras,
                                        int ranks, int encode_threads);
 
+/// What one rank's grid stage (grid_adapter.hpp) holds for a source grid of `source_points` points
+/// (every patch) resampled onto a cover of `cover_points`, over `ranks` ranks and `fields` fields: its
+/// resampling plan (14 B per slab point), the resampled fields (4 B per slab point and field), and the
+/// gathered, sent and received source points of one field (the grid stage was outside the estimate:
+/// an 8x200x400 shell peaked at 2.5 GB against an estimate of 348 MB, issue 44).
+MemoryEstimate estimate_grid_stage_memory(double source_points, double cover_points, int ranks, int fields);
+
 /// The number of cameras config.rig gives: computed for built-in rigs, read for file rigs (bounded).
 long long rig_camera_count(const SessionConfig& config, const render::GridGeometry& grid);
 

@@ -246,6 +246,27 @@ void Session::Impl::start_grid_stage(const grid::GridDescription& source, const 
                   std::to_string(cover.dims[2]) + " points along z; expected at most one rank per cell layer (raise the "
                   "resample points)");
     cfg.source_grid = source.summary();
+    // The grid stage and the session it feeds, before either is built (a cover of 1024^3 points ended in
+    // a bare "out of memory"); check_resources() below repeats the session's part for every grid.
+    if (cfg.check_memory) {
+      const double cover_points = double(cover.dims[0]) * cover.dims[1] * cover.dims[2];
+      const double source_points = double(source.points_per_patch()) * source.patches();
+      const int ranks = agreement.size();
+      int fields = 0;
+      {
+        std::vector<std::string> names;
+        for (const TaskConfig& t : cfg.tasks)
+          for (const std::string& f : t.fields)
+            if (std::find(names.begin(), names.end(), f) == names.end()) names.push_back(f);
+        fields = int(names.size());
+      }
+      MemoryEstimate e = estimate_session_memory(cfg, cover_points / ranks * 1.1, rig_camera_count(cfg, cover), ranks,
+                                                 omp_get_max_threads());
+      e.add(estimate_grid_stage_memory(source_points, cover_points, ranks, fields));
+      const std::string refusal = memory_refusal(e, available_memory(), 1, "this in-situ session with its grid stage",
+                                                 "set check_memory = false in [resources]");
+      if (!refusal.empty()) throw Error(refusal);
+    }
   } catch (...) {
     local = std::current_exception();
   }

@@ -10,6 +10,8 @@
 #include "core/error.hpp"
 #include "core/stop_request.hpp"
 #include "core/memory.hpp"
+#include "grid/grid_description.hpp"
+#include "insitu/grid_adapter.hpp"
 #include "insitu/resources.hpp"
 #include "insitu/session.hpp"
 #include "render/synthetic_fields.hpp"
@@ -364,3 +366,32 @@ TEST(InsituSession, ValidGhostLayersAreChecked) {
 }
 
 }  // namespace
+
+// The grid stage is in the memory estimate (issue 44, point 3): an 8x200x400 spherical shell resampled
+// onto its default 400^3 cover needs ~2.5 GB (resampling plan, corner copies, field copies); under a
+// 400 MB limit the session refuses before the grid stage is built, naming it, instead of being admitted.
+TEST(SessionResources, TheGridStageIsInTheMemoryEstimate) {
+  std::vector<double> r(8), theta(200), phi(400);
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] = 0.5 + 0.5 * double(i) / 7;
+  for (std::size_t i = 0; i < theta.size(); ++i) theta[i] = 0.01 + (3.14159265 - 0.02) * double(i) / 199;
+  for (std::size_t i = 0; i < phi.size(); ++i) phi[i] = -3.14159265 + 2 * 3.14159265 * double(i) / 400;
+  const grid::GridDescription shell = grid::GridDescription::spherical(r, theta, phi);
+  insitu::SessionConfig cfg = insitu::parse_session_config_text(
+      "[image]\nwidth = 32\nheight = 32\n[rig]\nspec = \"fibonacci:2\"\n[[task]]\nname = \"v\"\nfield = \"f\"\n", "t");
+  cfg.output_dir = (fs::temp_directory_path() / ("grid_memory_" + std::to_string(::getpid()))).string();
+  const char* old = std::getenv("PANOPTES_MEMORY_LIMIT");
+  const std::string saved = old ? old : "";
+  ::setenv("PANOPTES_MEMORY_LIMIT", "400M", 1);
+  std::string message;
+  try {
+    insitu::Session s(cfg, shell, {insitu::GridBlock::whole(shell)}, insitu::ResampleOptions{});
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  if (old) ::setenv("PANOPTES_MEMORY_LIMIT", saved.c_str(), 1);
+  else ::unsetenv("PANOPTES_MEMORY_LIMIT");
+  EXPECT_NE(message.find("grid stage: resampling plan"), std::string::npos) << message;
+  EXPECT_NE(message.find("with its grid stage"), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(cfg.output_dir)) << "refused after the database was created";
+  fs::remove_all(cfg.output_dir);
+}

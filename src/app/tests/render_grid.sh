@@ -90,4 +90,31 @@ printf '[grid]\nkind = "cubed-sphere"\n' > "$tmp/kind.toml"
 refuse "grid.kind:" "$tmp/kind.toml" "$tmp/shell_0.npy"
 printf '[grid]\nkind = "spherical"\nr = "missing.npy"\ntheta = "theta.npy"\nphi = "phi.npy"\n' > "$tmp/missing.toml"
 refuse "missing.npy" "$tmp/missing.toml" "$tmp/shell_0.npy"
+# Memory (issue 44, point 3): the grid stage and the march's corner copies are in the estimate (an
+# 8x200x400 shell on its default 400^3 cover peaked at 2.5 GB, estimated at 348 MB and admitted under
+# 400 MB); a 1024-point cover is refused by the estimate, not by a bare "out of memory"; a huge
+# coordinate file is refused before it is read.
+/usr/bin/python3 - "$tmp" <<'PY'
+import sys, numpy as np
+d = sys.argv[1]
+np.save(f"{d}/big_r.npy", np.linspace(0.5, 1.0, 8))
+np.save(f"{d}/big_theta.npy", np.linspace(0.01, np.pi - 0.01, 200))
+np.save(f"{d}/big_phi.npy", np.linspace(-np.pi, np.pi, 400, endpoint=False))
+np.save(f"{d}/big_vol.npy", np.zeros((400, 200, 8), np.float32))
+# A coordinate file whose header claims 400 million values, sparse on disk (3.2 GB apparent).
+header = b"\x93NUMPY\x01\x00" + (lambda h: len(h).to_bytes(2, "little") + h)(
+    b"{'descr': '<f8', 'fortran_order': False, 'shape': (400000000,), }".ljust(118) + b"\n")
+with open(f"{d}/sparse_r.npy", "wb") as f:
+    f.write(header)
+    f.truncate(len(header) + 8 * 400000000)
+PY
+printf '[grid]\nkind = "spherical"\nr = "big_r.npy"\ntheta = "big_theta.npy"\nphi = "big_phi.npy"\n' > "$tmp/big.toml"
+PANOPTES_MEMORY_LIMIT=400M refuse "grid stage: resampling plan" "$tmp/big.toml" "$tmp/big_vol.npy"
+PANOPTES_MEMORY_LIMIT=400M refuse "corner copies" "$tmp/big.toml" "$tmp/big_vol.npy"
+printf '[grid]\nkind = "spherical"\nr = "big_r.npy"\ntheta = "big_theta.npy"\nphi = "big_phi.npy"\npoints = 1024\n' > "$tmp/p1024.toml"
+PANOPTES_MEMORY_LIMIT=8G refuse "needs about" "$tmp/p1024.toml" "$tmp/big_vol.npy"
+sed 's/"r.npy"/"sparse_r.npy"/' "$tmp/shell.toml" > "$tmp/sparse.toml"
+start=$(date +%s%N)
+refuse "coordinate file (at most 65535 values)" "$tmp/sparse.toml" "$tmp/shell_0.npy"
+[ $(( ($(date +%s%N) - start) / 1000000 )) -lt 2000 ] || fail "the sparse coordinate file took over 2 s to refuse"
 echo "render_grid.sh: OK"
