@@ -17,7 +17,9 @@
 #include <cstdio>
 #include <ctime>
 #include <mutex>
+#include <map>
 #include <regex>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "store/database.hpp"
@@ -148,6 +150,34 @@ struct Server::Impl {
   int port = 0;
   std::mutex db_mutex;
   std::shared_ptr<const store::Database> db;
+  // database.json as sent, per query, for the database opened now: built once per opened database
+  // (issue 44: every GET re-built the JSON of the whole manifest, 5.8-7.7 s per request at 255 MB). A
+  // running database is reopened at each request (database()), so its JSON is rebuilt then.
+  std::mutex json_mutex;
+  std::shared_ptr<const store::Database> json_db;
+  std::map<std::tuple<bool, std::uint64_t, std::int64_t>, std::shared_ptr<const std::string>> json_cache;
+  static constexpr std::size_t kJsonCacheEntries = 64;  // pages of times and the inline form
+
+  std::shared_ptr<const std::string> cached_database_json(const std::shared_ptr<const store::Database>& d,
+                                                         const DatabaseJsonOptions& o) {
+    const auto key = std::make_tuple(o.inline_cameras, std::uint64_t(o.times_from), std::int64_t(o.frames_backed));
+    {
+      std::lock_guard lock(json_mutex);
+      if (json_db != d) json_cache.clear(), json_db = d;
+      if (const auto it = json_cache.find(key); it != json_cache.end()) return it->second;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    auto text = std::make_shared<const std::string>(database_json(*d, o).dump());
+    log("database.json built (" + std::to_string(text->size()) + " bytes, " +
+        std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0).count()) +
+        " ms); later requests get it from the cache until the manifest changes");
+    std::lock_guard lock(json_mutex);
+    if (json_db == d) {
+      if (json_cache.size() >= kJsonCacheEntries) json_cache.clear();
+      json_cache.emplace(key, text);
+    }
+    return text;
+  }
   FragmentIndexCache indexes;  // per movie, checked against size + mtime per request
   std::atomic<bool> stopping{false};
   int listen_socket = -1;  // seen when httplib creates it, to widen its backlog
@@ -291,7 +321,7 @@ struct Server::Impl {
       }
       const auto d = database(true);
       o.frames_backed = frames_backed(*d);
-      res.set_content(database_json(*d, o).dump(), "application/json");
+      res.set_content(*cached_database_json(d, o), "application/json");
     });
     // The players' key table as data (docs/web.md), with this database's view mode.
     http.Get("/api/keys.json", [this](const httplib::Request&, httplib::Response& res) {

@@ -6,7 +6,9 @@
 #include <atomic>
 #include <fstream>
 #include <sstream>
+#include <mutex>
 #include <thread>
+#include <chrono>
 
 #include <nlohmann/json.hpp>
 
@@ -98,6 +100,49 @@ TEST(Server, ServesDatabaseJsonIndexAndByteRanges) {
   bool logged_range = false;
   for (const auto& line : log) logged_range |= line.find("GET /db/movies/c2/t1.mp4 206 bytes=") != std::string::npos;
   EXPECT_TRUE(logged_range) << "one log line per request, with the range";
+}
+
+// database.json is built once per opened database and query (issue 44, point 4: every request re-built
+// the JSON of the whole manifest, 5.8-7.7 s each at 255 MB); a changed manifest is read again.
+TEST(Server, DatabaseJsonIsBuiltOncePerManifest) {
+  Fixture f;
+  std::vector<std::string> log;
+  std::mutex log_mutex;
+  auto o = options(f);
+  o.log = [&](const std::string& line) {
+    std::lock_guard lock(log_mutex);
+    log.push_back(line);
+  };
+  const auto builds = [&] {
+    std::lock_guard lock(log_mutex);
+    int n = 0;
+    for (const auto& line : log) n += line.find("database.json built") != std::string::npos;
+    return n;
+  };
+  Running r(o);
+  httplib::Client c("127.0.0.1", r.server.port());
+  std::string first;
+  for (int i = 0; i < 3; ++i) {
+    auto res = c.Get("/api/database.json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200);
+    if (i == 0) first = res->body;
+    EXPECT_EQ(res->body, first);
+  }
+  EXPECT_EQ(builds(), 1);
+  ASSERT_EQ(c.Get("/api/database.json?cameras=inline")->status, 200);
+  ASSERT_EQ(c.Get("/api/database.json?cameras=inline")->status, 200);
+  EXPECT_EQ(builds(), 2);  // another query: its own entry
+  // A new manifest (a checkpoint of a running simulation rewrites it): read and built again.
+  const fs::path man = f.db / store::kManifestFileName;
+  nlohmann::json m = nlohmann::json::parse(read_file(man));
+  m["title"] = "renamed " + m.value("title", std::string());
+  std::ofstream(man, std::ios::trunc) << m.dump(1);
+  fs::last_write_time(man, fs::last_write_time(man) + std::chrono::seconds(2));
+  auto res = c.Get("/api/database.json");
+  ASSERT_TRUE(res);
+  EXPECT_NE(res->body.find("renamed "), std::string::npos);
+  EXPECT_EQ(builds(), 3);
 }
 
 TEST(Server, NoPathOutsideTheDatabaseCanBeReached) {
