@@ -444,8 +444,10 @@ fs::path find_player_dir() {
   }
   std::string list;
   for (const auto& t : tried) list += (list.empty() ? "" : ", ") + t.string();
+  // The usual cause: a build of the program alone (before issue 44, scripts/demo built no web player).
   throw Error("the web player's files were not found (looked in " + list +
-              "); set PANOPTES_WEB_DIR to the directory holding index.html");
+              "); build them with `scripts/setup` (or `cmake --build build --target web_player`), or set "
+              "PANOPTES_WEB_DIR to the directory holding index.html");
 }
 
 }  // namespace panoptes::web

@@ -8,6 +8,7 @@ import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
 import { taskLegend, drawLegend, timeText } from "./legend.js";
 import { installReadoutHover } from "./readout_hover.js";
 import { parseKeyTable, bindingOf, helpRows, operationOf, refusalOf } from "./keys.js";
+import { renderHelp } from "./help_overlay.js";
 import { makeClock, stepTaskOnAxis, engineOps, isFrontEndOperation } from "./engine_ops.js";
 import { LOOK_LIMITS, basisOfCamera, clamped, rigOf, latticeNode, walkTarget, lookAfterWalk, viewDirection, lookText, positionOf,
          lookTowards, cutoutDirection, neighbourToward, strongestSignalDirection } from "./look.js";
@@ -721,15 +722,15 @@ const endLook = () => { lookLast = null; };
 lookCanvas.addEventListener("pointerup", endLook);
 lookCanvas.addEventListener("pointercancel", endLook);
 
-/// The help line for the database at hand, from the key table.
+/// The key help for the database at hand, from the key table: a one-line hint under the view and the
+/// table H shows over the page (help_overlay.js).
 function showHelp() {
-  const el = document.getElementById("help");
   if (!S.keys) return;
-
-  const mouse = S.rig.equirect ? "<b>drag</b>: look around · <b>wheel</b>: field of view" +
-    (S.rig.walkable ? " · <b>double-click</b>: step toward that point (Shift: away from it)" : "") : "<b>drag</b>: rotate to the nearest camera · <b>wheel</b>: magnify";
-  const esc = (t) => t.replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" })[c]);
-  el.innerHTML = mouse + " · " + helpRows(S.keys, S.mode, NOT_HERE).map((r) => `<b>${esc(r.keys)}</b>: ${esc(r.text)}`).join(" · ");
+  const mouse = S.rig.equirect
+    ? [["drag", "look around"], ["wheel", "field of view"]].concat(
+        S.rig.walkable ? [["double-click", "step toward that point (Shift: away from it)"]] : [])
+    : [["drag", "rotate to the nearest camera"], ["wheel", "magnify"]];
+  renderHelp(document.getElementById("help"), document.getElementById("hint"), mouse, helpRows(S.keys, S.mode, NOT_HERE));
 }
 
 // ---- start --------------------------------------------------------------------------------------
@@ -747,7 +748,7 @@ async function loadKeys() {
   } catch (e) {
     S.keysError = `the key table ${url} could not be loaded (${e.message}): keys do nothing; the mouse still works. ` +
       "It is written by panoptes serve / export-web of this version.";
-    document.getElementById("help").textContent = S.keysError;
+    document.getElementById("hint").textContent = S.keysError;
     notify(S.keysError);
     clearTimeout(notifyTimer);  // stays
   }

@@ -162,6 +162,38 @@ await check("keys: the opposite arrow retraces the last moves; HUD numbers tasks
   await page.close();
 });
 
+// Issue 44: the key help was one run-on paragraph under the view, cut off at 1280x720 and 1600x1000.
+// H opens a table over the page: every row of the key table inside the window or reachable by scrolling
+// the overlay itself, and H closes it.
+await check("help: H shows every key in an overlay that fits 1280x720 and 1600x1000", async () => {
+  for (const [width, height] of [[1280, 720], [1600, 1000]]) {
+    const { page, errors } = await open(serveUrl + "&play=0");
+    await page.setViewport({ width, height });
+    assert.equal(await page.evaluate(() => document.getElementById("help").classList.contains("hidden")), true, "closed at first");
+    await page.keyboard.press("h");
+    const m = await page.evaluate(() => {
+      const el = document.getElementById("help"), r = el.getBoundingClientRect();
+      const rows = [...el.querySelectorAll(".row")];
+      const last = rows[rows.length - 1].getBoundingClientRect();
+      return { shown: !el.classList.contains("hidden"), left: r.left, top: r.top, right: r.right, bottom: r.bottom,
+               rows: rows.length, scroll: el.scrollHeight, client: el.clientHeight, overflow: getComputedStyle(el).overflowY,
+               lastInside: last.right <= r.right + 1 && (last.bottom <= r.bottom + 1 || el.scrollHeight > el.clientHeight),
+               hint: document.getElementById("hint").textContent };
+    });
+    assert.ok(m.shown, "H opens the help");
+    assert.ok(m.left >= 0 && m.top >= 0 && m.right <= width && m.bottom <= height, `${width}x${height}: the overlay is inside the window (${JSON.stringify(m)})`);
+    assert.ok(m.rows >= 20, `${m.rows} rows`);
+    assert.ok(m.scroll <= m.client || m.overflow === "auto", "rows beyond the window scroll inside the overlay");
+    assert.ok(m.lastInside, "the last row is inside the overlay or reachable by its scroll");
+    assert.match(m.hint, /^H: keys and mouse/);
+    await page.screenshot({ path: `${process.env.SHOT_DIR || "/tmp"}/web-help-${width}x${height}.png` });
+    await page.keyboard.press("h");
+    assert.equal(await page.evaluate(() => document.getElementById("help").classList.contains("hidden")), true, "H closes it");
+    assert.deepEqual(errors, []);
+    await page.close();
+  }
+});
+
 await check("playback: frames advance and switches during playback show the right stamp", async () => {
   const { page } = await open(serveUrl + "&play=1");
   await expectShown(page, 0, 0, null, "start");

@@ -76,7 +76,7 @@ await check("360° lattice: cut-out, help from the key table, short-run rule, fr
     assert.ok(help.includes(row.description.lattice), `help shows "${row.description.lattice}" from the table`);
   }
   assert.ok(!help.includes(keys.find((r) => r.action === "camera_up").description.sphere), "not the sphere wording");
-  assert.match(help, /drag: look around/);
+  assert.match(await page.evaluate(() => document.getElementById("hint").textContent), /drag: look around/);
   assert.ok(!/record/.test(help.toLowerCase().replace(/recording is/, "")), "no desktop-only record key in the web help");
   const hud = await page.evaluate(() => document.getElementById("hud").textContent);
   assert.match(hud, new RegExp(`frame 0 of ${db.frames} `));
