@@ -82,7 +82,7 @@ up_axis = "z_down"     # z is depth: the sky is -z (poles, latitudes, image up a
 every_steps = 12       # 40 snapshots
 
 [video]                # intra-only: the player's fastest random access, ~1 MB per open writer (P-frames keep a
-gop = 1                # 3 MB encoder per writer; their size gain is unmeasured: docs/insitu.md); crf 23: -14 %, 45 dB
+gop = 1                # 3 MB encoder per writer; their size gain is unmeasured: docs/measurements/insitu.md); crf 23: -14 %, 45 dB
 crf = 23
 preset = "superfast"
 playback_fps = 10      # the player shows the 40 snapshots in 4 s (the movies themselves are 30 fps)
@@ -91,7 +91,7 @@ playback_fps = 10      # the player shows the 40 snapshots in 4 s (the movies th
 sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) against 0.5, with the windows below
 percentile = 0.999     # and phi without the surface sheet (2026-11-25): PSNR mean 55-56 dB, min 44.7 (p+s, the view
                        # down onto the surface); 1.5 voxel: min 39.1 dB. (With the sheet and the former windows the
-                       # saturated p rings at the surface gave min 34 dB at 1.0, 26 at 1.5: docs/insitu.md.)
+                       # saturated p rings at the surface gave min 34 dB at 1.0, 26 at 1.5: docs/measurements/insitu.md.)
                        # 0.5 voxel would cost more march for no visible gain.
 adaptive = true        # 3-4 px per voxel: interpolate smooth cells of every 4th pixel's rays; frames within
                        # 65.6 dB (min) of marching every pixel, the thin gaps kept (docs/rendering.md, Round 4)

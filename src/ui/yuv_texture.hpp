@@ -36,7 +36,7 @@ class YuvTexture {
   /// size, redone only after a new upload), or nullptr where the renderer has no render targets.
   /// Meant for drawings that sample the frame many times over, such as the look-around mesh: sampling
   /// one RGBA texture costs the software GL rasteriser far less than three planes plus the YUV→RGB
-  /// conversion for every window pixel (measured in docs/ui.md).
+  /// conversion for every window pixel (measured in docs/measurements/ui.md).
   SDL_Texture* rgba();
   /// Nearest-neighbour sampling (to see individual pixels when zoomed far in) instead of linear.
   void set_pixelated(bool on);
