@@ -111,6 +111,9 @@ void run(const Args& a) {
                   {"gop", m.video.gop}, {"fps", m.video.fps}};
     j["movie_pattern"] = m.movie_pattern;
     j["frame_checks"] = m.frame_checks.recorded() ? nlohmann::json(m.frame_checks.scheme) : nlohmann::json(nullptr);
+    // What a frame read as good proves (issue 44): "all" (scheme 3), "frames" (scheme 2: not the
+    // parameter sets), "none" (written before frame checks: unverified).
+    j["frames_verified"] = m.frame_checks.binds_parameter_sets() ? "all" : m.frame_checks.recorded() ? "frames" : "none";
     j["bytes_on_disk"] = disk;
     if (!a.no_check) {
       nlohmann::json problems = nlohmann::json::array();
@@ -158,9 +161,15 @@ void run(const Args& a) {
     std::printf("video      h264, crf %d, preset %s, gop %d, %g fps\n", m.video.crf, m.video.preset.c_str(),
                 m.video.gop, m.video.fps);
     std::printf("streams    %lld (movies %s)\n", (long long)db.stream_count(), m.movie_pattern.c_str());
-    std::printf("checks     %s\n", m.frame_checks.recorded()
-                                      ? "every frame: checksum, movie identity, index and timestamp (panoptes-frame-2)"
-                                      : "checksums where a movie carries them (written before frame checks were recorded)");
+    std::printf("checks     %s\n", m.frame_checks.binds_parameter_sets()
+                                      ? "every frame: checksum, movie identity, index, timestamp and the stream's parameter "
+                                        "sets (panoptes-frame-3)"
+                                  : m.frame_checks.recorded()
+                                      ? "every frame: checksum, movie identity, index and timestamp (panoptes-frame-2); "
+                                        "the parameter sets (SPS/PPS) are unverified: written before they were bound"
+                                      : "UNVERIFIED frames: checksums only where a movie carries them (written before frame "
+                                        "checks were recorded): damage that decodes, re-ordered fragments and damaged "
+                                        "parameter sets cannot be told from good frames");
     std::printf("on disk    %s", human_bytes(double(disk)).c_str());
     if (!a.no_check && db.stream_count() > 0)
       std::printf(" (movies %s, %s per stream)", human_bytes(double(report.bytes)).c_str(),
@@ -171,7 +180,8 @@ void run(const Args& a) {
     } else {
       std::printf("checked    %lld of %lld movies%s: %s\n", (long long)report.checked, (long long)db.stream_count(),
                   a.decode ? " (every frame decoded)" : "",
-                  report.problems.empty() ? "all readable"
+                  report.problems.empty() ? (m.frame_checks.recorded() ? "all readable"
+                                                                        : "all readable, frames unverified (see checks)")
                                           : (std::to_string(report.problems.size()) + " with problems").c_str());
       const std::size_t shown = std::min(report.problems.size(), std::size_t(std::max(0, a.max_problems)));
       for (std::size_t i = 0; i < shown; ++i)

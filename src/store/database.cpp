@@ -377,7 +377,8 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
     std::optional<video::MovieIdentity> identity;
     if (impl_->manifest.frame_checks.recorded()) identity = movie_identity(impl_->manifest, camera, task);
     auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), im.width, im.height,
-                                                       impl_->manifest.video, identity);
+                                                       impl_->manifest.video, identity,
+                                                       impl_->manifest.frame_checks.binds_parameter_sets());
     if (writer->padded_width() != im.padded_width || writer->padded_height() != im.padded_height) {
       std::lock_guard lock(impl_->mutex);
       impl_->manifest.image.padded_width = writer->padded_width();
@@ -565,7 +566,7 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
     std::optional<video::MovieIdentity> identity;
     if (man.frame_checks.recorded()) identity = movie_identity(man, camera, task);
     auto writer = std::make_unique<video::MovieWriter>(file.release(), path.string(), man.image.width, man.image.height,
-                                                       man.video, identity);
+                                                       man.video, identity, man.frame_checks.binds_parameter_sets());
     writer->copy_frames(*old, frames);
     writer->flush();
     if (::renameat(movie_dir.get(), temp.c_str(), movie_dir.get(), leaf.c_str()) != 0)
@@ -725,6 +726,7 @@ video::FrameChecks Database::frame_checks(int camera, int task) const {
   if (manifest_.frame_checks.recorded()) {
     checks.required = true;
     checks.identity = movie_identity(manifest_, camera, task);
+    checks.parameter_sets = manifest_.frame_checks.binds_parameter_sets();
   }
   return checks;
 }

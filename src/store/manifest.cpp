@@ -157,9 +157,9 @@ void Manifest::validate() const {
   if (!domain.up_axis.empty() && domain.up_axis != "z_up" && domain.up_axis != "z_down")
     fail("domain.up_axis \"" + echo(domain.up_axis) + "\"; expected \"z_up\" or \"z_down\"");
   if (frame_checks.recorded()) {
-    if (frame_checks.scheme != kFrameCheckScheme)
+    if (frame_checks.scheme != kFrameCheckScheme && frame_checks.scheme != kFrameCheckSchemeUnboundHeader)
       fail("frame_checks.scheme \"" + echo(frame_checks.scheme) + "\" is not known to this build (expected \"" +
-           kFrameCheckScheme + "\")");
+           kFrameCheckScheme + "\" or \"" + kFrameCheckSchemeUnboundHeader + "\")");
     const auto& id = frame_checks.database_id;
     if (id.size() != 16 || id.find_first_not_of("0123456789abcdef") != std::string::npos)
       fail("frame_checks.database_id \"" + echo(id) + "\" is not 16 lowercase hex digits");

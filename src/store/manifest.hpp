@@ -179,11 +179,18 @@ struct FrameCheckRecord {
   std::string scheme;
   std::string database_id;  ///< 16 lowercase hex digits, random per database
   bool recorded() const { return !scheme.empty(); }
+  /// Scheme 3: the frames' identity also binds the movie's parameter sets (SPS/PPS).
+  bool binds_parameter_sets() const;
   bool operator==(const FrameCheckRecord&) const = default;
 };
 
-/// The frame check scheme this build writes and reads.
-inline constexpr const char* kFrameCheckScheme = "panoptes-frame-2";
+/// The frame check scheme this build writes: version-2 messages whose identity is bound to the movie's
+/// parameter sets (video::bind_parameter_sets; issue 44: a flipped bit in the avcC's PPS changed every
+/// frame while every frame's own CRC held).
+inline constexpr const char* kFrameCheckScheme = "panoptes-frame-3";
+/// The scheme before it (no parameter-set binding), still read: its frames are checked, its SPS/PPS not.
+inline constexpr const char* kFrameCheckSchemeUnboundHeader = "panoptes-frame-2";
+inline bool FrameCheckRecord::binds_parameter_sets() const { return scheme == kFrameCheckScheme; }
 
 /// Lifecycle of a database. `running` on disk with no live writer is reported as interrupted by
 /// Database::open (see database.hpp).

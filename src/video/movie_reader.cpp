@@ -82,6 +82,7 @@ struct MovieReader::Impl {
   bool checksummed = false;      // the movie's packets carry checksums (packet_checksum.hpp)
   std::vector<std::uint8_t> header;  // the stream's extradata
   FrameChecks checks;            // what the caller demands of every frame
+  MovieIdentity expected_identity{};  // checks.required: what every frame's stamp must say
   std::int64_t pts_step = 0;     // checks.required: the frame duration; frame f must sit at f * pts_step
   std::string bad_reason;        // why the last bad packet was bad, for the damaged frame's message
 
@@ -324,6 +325,9 @@ struct MovieReader::Impl {
       nal_length_size = (par->extradata[4] & 3) + 1;
     if (checks.required) {
       checksummed = true;
+      expected_identity = checks.parameter_sets
+                              ? bind_parameter_sets(checks.identity, parameter_sets_crc(header.data(), int(header.size())))
+                              : checks.identity;
       // Every frame lasts one frame duration (MovieWriter writes constant frame rate from 0).
       pts_step = durations.empty() ? 0 : durations[durations.size() / 2];
     } else if (nal_length_size > 0) {
@@ -350,8 +354,14 @@ struct MovieReader::Impl {
       bad_reason = "it carries no frame checksum although its database records that every frame has one";
     } else if (c.checksum != PacketChecksum::good) {
       bad_reason = "its checksum does not match";
-    } else if (c.stamp.movie != checks.identity) {
-      bad_reason = "it belongs to another movie (foreign or spliced)";
+    } else if (c.stamp.movie != expected_identity) {
+      // Scheme 3 binds the parameter sets into the identity's last 4 bytes: the rest still matching
+      // means the frame is this movie's and the movie's SPS/PPS are not the ones it was encoded with.
+      const bool same_movie = checks.parameter_sets &&
+                              std::equal(c.stamp.movie.begin(), c.stamp.movie.begin() + 12, checks.identity.begin());
+      bad_reason = same_movie ? "the movie's parameter sets (SPS/PPS in its avcC box) are not the ones its frames were "
+                                "encoded with (a damaged stream header changes every picture)"
+                              : "it belongs to another movie (foreign or spliced)";
     } else if (f < 0 || c.stamp.frame != std::uint32_t(f)) {
       bad_reason = "it is frame " + std::to_string(c.stamp.frame) + " of its movie, shown at index " + std::to_string(f) +
                    " (re-ordered or spliced timestamps)";

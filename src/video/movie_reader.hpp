@@ -36,6 +36,10 @@ struct FrameChecks {
   /// frames are otherwise taken as they come.
   bool required = false;
   MovieIdentity identity{};
+  /// Frame-check scheme 3: the frames carry `identity` bound to the CRC of the stream's parameter sets
+  /// (bind_parameter_sets()), computed here from the movie's own avcC. A damaged SPS or PPS (outside
+  /// every frame's CRC, yet it changes every decoded picture: issue 44) then fails every frame.
+  bool parameter_sets = false;
 };
 
 /// An open movie. Not thread-safe: use one reader per thread.

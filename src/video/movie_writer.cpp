@@ -32,6 +32,8 @@ struct MovieWriter::Impl {
   int width = 0, height = 0, padded_width = 0, padded_height = 0;
   VideoSettings settings;
   std::optional<MovieIdentity> identity;  // stamped on every frame when set
+  bool bind = false;                      // fold the parameter sets' CRC into it (bind_parameter_sets)
+  std::optional<MovieIdentity> stamped;   // what frames carry: identity, bound once the header is known
 
   AVFormatContext* fmt = nullptr;
   AVStream* stream = nullptr;
@@ -180,7 +182,11 @@ struct MovieWriter::Impl {
     // With an identity the message also says whose frame this is and where it belongs.
     FrameStamp stamp;
     if (identity) {
-      stamp.movie = *identity;
+      if (!stamped) {
+        const AVCodecParameters* par = stream->codecpar;
+        stamped = bind ? bind_parameter_sets(*identity, parameter_sets_crc(par->extradata, par->extradata_size)) : *identity;
+      }
+      stamp.movie = *stamped;
       stamp.frame = std::uint32_t(pkt->pts != AV_NOPTS_VALUE && pkt->pts >= 0 ? pkt->pts : packets_out);  // encoder clock = frame index
     }
     append_packet_checksum(pkt, identity ? &stamp : nullptr);
@@ -242,10 +248,11 @@ MovieWriter::MovieWriter(const std::string& path, int width, int height, const V
     : MovieWriter(-1, path, width, height, settings) {}
 
 MovieWriter::MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings,
-                         const std::optional<MovieIdentity>& identity)
+                         const std::optional<MovieIdentity>& identity, bool bind_parameter_sets)
     : impl_(std::make_unique<Impl>()) {
   impl_->fd = fd;  // owned from here on, also if a check below throws
   impl_->identity = identity;
+  impl_->bind = bind_parameter_sets;
   settings.validate();
   if (width < 1 || height < 1 || width > 16384 || height > 16384)
     throw Error("movie " + path + ": frame size " + std::to_string(width) + "x" + std::to_string(height) +

@@ -29,9 +29,11 @@ class MovieWriter {
   /// when the constructor throws); `path` only names it in messages. The store opens its movies this
   /// way, relative to the database directory and without following links. With `identity`, every
   /// frame's checksum message also carries it and the frame's index (packet_checksum.hpp, version 2),
-  /// so readers can tell this movie's frames from any other's.
+  /// so readers can tell this movie's frames from any other's. `bind_parameter_sets`: the identity the
+  /// frames carry has the CRC of the stream's SPS/PPS folded in (bind_parameter_sets(), frame-check
+  /// scheme 3), so damage to the avcC's parameter sets shows on every frame.
   MovieWriter(int fd, const std::string& path, int width, int height, const VideoSettings& settings = {},
-              const std::optional<MovieIdentity>& identity = std::nullopt);
+              const std::optional<MovieIdentity>& identity = std::nullopt, bool bind_parameter_sets = false);
   ~MovieWriter();  ///< Closes the movie if still open; never throws.
   MovieWriter(const MovieWriter&) = delete;
   MovieWriter& operator=(const MovieWriter&) = delete;

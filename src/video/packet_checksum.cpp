@@ -69,6 +69,50 @@ bool is_checksum_sei(const std::uint8_t* nal, std::size_t n, std::uint32_t* crc,
 
 }  // namespace
 
+std::uint32_t parameter_sets_crc(const std::uint8_t* h, int n) {
+  if (!h || n <= 0) return 0;
+  std::uint32_t crc = 0;
+  bool any = false;
+  auto add = [&](const std::uint8_t* nal, std::size_t len) {
+    if (len == 0) return;
+    const int type = nal[0] & 0x1f;
+    if (type != 7 && type != 8) return;
+    crc = crc_update(crc, nal, trimmed(nal, len));
+    any = true;
+  };
+  if (h[0] == 1) {  // avcC: version, profile, compat, level, length size, #SPS, (len16, SPS)..., #PPS, (len16, PPS)...
+    if (n < 7) return 0;
+    int pos = 5;
+    for (int list = 0; list < 2; ++list) {
+      if (pos >= n) return 0;
+      const int count = list == 0 ? (h[pos] & 0x1f) : h[pos];
+      ++pos;
+      for (int i = 0; i < count; ++i) {
+        if (pos + 2 > n) return 0;
+        const int len = h[pos] << 8 | h[pos + 1];
+        pos += 2;
+        if (pos + len > n) return 0;
+        add(h + pos, std::size_t(len));
+        pos += len;
+      }
+    }
+    return any ? crc : 0;
+  }
+  int sc = next_start_code(h, n, 0);
+  while (sc < n) {
+    const int next = next_start_code(h, n, sc + 3);
+    if (sc + 3 < n) add(h + sc + 3, std::size_t(next - sc - 3));
+    sc = next;
+  }
+  return any ? crc : 0;
+}
+
+MovieIdentity bind_parameter_sets(const MovieIdentity& identity, std::uint32_t crc) {
+  MovieIdentity bound = identity;
+  for (int i = 0; i < 4; ++i) bound[std::size_t(12 + i)] ^= std::uint8_t(crc >> (24 - 8 * i));
+  return bound;
+}
+
 bool append_packet_checksum(AVPacket* pkt, const FrameStamp* stamp) {
   const std::uint8_t* d = pkt->data;
   const int n = pkt->size;

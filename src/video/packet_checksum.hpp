@@ -27,6 +27,17 @@ struct FrameStamp {
   std::uint32_t frame = 0;  ///< index of the frame in its movie
 };
 
+/// CRC-32 of the stream's parameter sets (H.264 SPS and PPS NAL units, in order, without their framing)
+/// in `header`: an MP4 avcC record or an Annex B global header (the same units give the same value).
+/// 0 when the header holds none or is not parseable.
+std::uint32_t parameter_sets_crc(const std::uint8_t* header, int size);
+
+/// The identity a version-2 message carries for a movie whose parameter sets are bound to its frames
+/// (frame-check scheme 3, issue 44): the caller's identity with the parameter sets' CRC folded into its
+/// last four bytes. A flipped bit in the avcC's SPS or PPS (outside every frame's CRC, yet it changes
+/// every decoded picture) then shows as a mismatch on every frame.
+MovieIdentity bind_parameter_sets(const MovieIdentity& identity, std::uint32_t parameter_sets_crc);
+
 /// Appends the checksum SEI to an Annex B H.264 packet (as libx264 produces them): version 2 with
 /// `stamp` when given, else version 1 (CRC only). Returns false and leaves the packet unchanged if it
 /// is not Annex B or memory runs out.

@@ -65,4 +65,41 @@ assert index(1).get("damaged_frames") == [0, 1, 2, 3], index(1)
 assert index(2).get("damaged_frames") == [0, 1, 2, 3], index(2)
 PY
 kill "$server" 2>/dev/null || true
+
+# Issue 44, point 1: a flipped bit in the avcC's PPS (outside every frame's CRC) changed every frame while
+# all read as ok at 11-13 dB; now every frame is damaged, naming the parameter sets. And a database
+# written before frame checks is said to be unverified, not "all readable".
+"$panoptes" synth-db "$tmp/pps" --cameras 2 --tasks 1 --frames 3 --size 48x32 --gop 1 >/dev/null
+"$py" - "$tmp/pps/movies/c0/t0.mp4" <<'PY'
+import sys
+p = sys.argv[1]; b = bytearray(open(p, 'rb').read())
+i = b.find(b'avcC') + 4; at = i + 5
+n_sps = b[at] & 0x1f; at += 1
+for _ in range(n_sps): at += 2 + int.from_bytes(b[at:at + 2], 'big')
+at += 1  # number of PPS
+pps_len = int.from_bytes(b[at:at + 2], 'big'); at += 2
+b[at + pps_len - 1] ^= 0x02  # the PPS's last byte
+open(p, 'wb').write(b)
+PY
+set +e
+"$panoptes" info "$tmp/pps" --decode --json > "$tmp/pps.json"
+status=$?
+set -e
+[ "$status" = 2 ] || { cat "$tmp/pps.json"; fail "a damaged PPS: info --decode exit status $status, expected 2"; }
+"$py" - "$tmp/pps.json" <<'PY' || { cat "$tmp/pps.json"; exit 1; }
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['frames_verified'] == 'all', j['frames_verified']
+problems = j['check']['problems']
+assert len(problems) == 1 and problems[0]['camera'] == 0 and problems[0]['damaged_frames'] == [0, 1, 2], problems
+assert 'parameter sets' in problems[0]['message'], problems[0]
+PY
+"$py" - "$tmp/pps/panoptes.json" <<'PY'
+import json, sys
+p = sys.argv[1]; j = json.load(open(p)); del j['frame_checks']; open(p, 'w').write(json.dumps(j))
+PY
+rm -f "$tmp/pps/movies/c0/t0.mp4" && cp "$tmp/pps/movies/c1/t0.mp4" "$tmp/pps/movies/c0/t0.mp4"
+"$panoptes" info "$tmp/pps" --decode > "$tmp/old.txt" || { cat "$tmp/old.txt"; fail "an old database"; }
+grep -q "all readable, frames unverified" "$tmp/old.txt" || { cat "$tmp/old.txt"; fail "an old database is not said to be unverified"; }
+grep -q "^checks     UNVERIFIED" "$tmp/old.txt" || { cat "$tmp/old.txt"; fail "the checks line of an old database"; }
 echo "frame_checks: ok"
