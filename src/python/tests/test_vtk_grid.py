@@ -75,7 +75,7 @@ def test_rectilinear_series_renders_as_its_npy(tmp_path):
     args = vtk_grid.write_render_inputs([f for _, _, f in series], tmp_path / "conv")
     assert (tmp_path / "conv" / "grid.toml").read_text().startswith('[grid]\nkind = "rectilinear"')
     for name, c in zip("xyz", coords):
-        assert np.array_equal(np.load(tmp_path / "conv" / f"{name}.npy"), c)
+        assert np.array_equal(np.load(tmp_path / "conv" / "grid" / f"{name}.npy"), c)
     via_vtk = render(args, tmp_path / "vtk_db")
     # The same values and coordinates as .npy written here, without VTK: the same frames.
     direct = tmp_path / "direct"
