@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import vtk_xml_check
+
 KINDS = ("uniform", "rectilinear", "spherical")
 _AXES = {"rectilinear": ("x", "y", "z"), "spherical": ("r", "theta", "phi")}
 
@@ -62,6 +64,7 @@ class Limits:
         return min(4 << 30, phys * 3 // 4)
 
 
+_CHILD = Path(__file__).with_name("_vtk_child.py")  # the script that runs VTK (tests put a crashing one here)
 _VTK_OVERHEAD = 1 << 30  # address space of Python, NumPy and VTK's libraries in the child (measured: ~110 MB)
 
 
@@ -82,8 +85,7 @@ def _run_vtk(path, array, work, limits, need):
     import signal
     import subprocess
     mem = limits.memory()
-    script = Path(__file__).with_name("_vtk_child.py")
-    cmd = [sys.executable, str(script), str(path), array if array is not None else "-", str(work)]
+    cmd = [sys.executable, str(_CHILD), str(path), array if array is not None else "-", str(work)]
     try:
         proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 preexec_fn=_child_limits(mem + _VTK_OVERHEAD, limits.timeout),
@@ -255,7 +257,7 @@ def _structured(path, pts, dims, notes):
 
 def _read_one(path, array, limits, work):
     """One .vti/.vtr/.vts file -> VtkGrid (kind "yang" for a Yin-Yang code's Yang patch, which needs its Yin)."""
-    from . import vtk_xml_check
+
     path = os.fspath(path)
     ext = Path(path).suffix.lower()
     if ext not in (".vti", ".vtr", ".vts"):
@@ -319,7 +321,7 @@ def _yinyang(yin, yang, label):
 
 
 def _read_vtm(path, array, limits, work):
-    from . import vtk_xml_check
+
     blocks = vtk_xml_check.blocks(path)
     if len(blocks) != 2:
         raise ValueError(f"{path}: a multi-block file of {len(blocks)} data sets "
@@ -395,7 +397,7 @@ def _volume_names(stems):
 
 def _inputs(paths):
     """The real paths of every file the inputs read (a .vtm's blocks included), which no output may replace."""
-    from . import vtk_xml_check
+
     seen = set()
     for p in paths:
         seen.add(os.path.realpath(p))
