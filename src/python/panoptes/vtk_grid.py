@@ -1,21 +1,34 @@
-"""VTK XML image, rectilinear and structured grids (.vti, .vtr, .vts) as input of `panoptes render`.
+"""VTK XML image, rectilinear and structured grids (.vti, .vtr, .vts, a Yin-Yang .vtm) as input of `panoptes render`.
 
 The files are read by VTK's own XML readers (the `vtkmodules` package; on Debian 12 it comes with
 python3-paraview, which scripts/setup installs): Panoptes does not link VTK, whose Debian package is the
 whole toolkit, for three readers. What it writes is what `panoptes render` reads: the point-data array
-as .npy volumes (C order (n2, n1, n0), the first axis fastest as in VTK), the coordinates as 1-D .npy
-and a grid TOML for `render --grid` (docs/insitu.md):
+as .npy volumes (C order (n2, n1, n0), the first axis fastest as in VTK; shells (nphi, ntheta, nr)), the
+coordinates as 1-D .npy in DIR/grid/ and a grid TOML for `render --grid` (docs/instrumenting.md):
 
     .vti  ImageData         uniform: no grid TOML, render's --origin and --spacing
     .vtr  RectilinearGrid   rectilinear: x, y, z as given
     .vts  StructuredGrid    explicit points, accepted when they lie on per-axis lines: rectilinear
-                            (x depends on i only, y on j, z on k) or spherical ((r, theta, phi) on
-                            (i, j, k)); any other curvilinear grid is refused with its reason
+                            (x depends on i only, y on j, z on k) or spherical ((r, theta, phi) along
+                            the index axes in any order - r fastest or phi fastest - and either
+                            direction; theta may reach the poles, phi may close the circle with its
+                            seam plane written twice, which is dropped); a Yin-Yang code's Yang patch
+                            (the same lines in Yang's frame (x, y, z) -> (-x, z, y)) pairs with the
+                            Yin file beside it into one Yin-Yang frame; any other curvilinear grid is
+                            refused with its deviation and what would be accepted
+    .vtm  MultiBlock        two .vts blocks, Yin and Yang: one Yin-Yang frame
 
     /usr/bin/python3 -m panoptes.vtk_grid FILE.vtr [FILE2.vtr ...] --out DIR [--array NAME]
-    -> DIR/grid.toml, DIR/<file>.npy; prints the `panoptes render` command that renders them.
+    -> DIR/grid.toml, DIR/grid/*.npy, DIR/<file>.npy; prints the `panoptes render` command.
 
-Several files make a time series: they must share the grid (same kind and coordinates)."""
+Several files make a time series: they must share the grid (same kind and coordinates). Two inputs of one
+name (a/run.vtr b/run.vtr) give numbered volumes (0000_run.npy, 0001_run.npy); no output replaces an input;
+nothing is moved into DIR unless every file converts.
+
+Hostile files: each file's XML header is checked first (vtk_xml_check: nesting, element count, the bytes
+its extent claims against the memory limit and against the file, data block headers), and VTK then runs
+in a child process (_vtk_child.py) under RLIMIT_AS (the memory limit + 1 GB) and a timeout, so that an
+abort, a crash or a hang in VTK is a one-line error here."""
 import argparse
 import os
 import sys
