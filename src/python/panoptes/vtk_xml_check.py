@@ -339,9 +339,10 @@ def _check_block(h, a, src):
                               f"{h.compressor} does not shrink data more than {ratio}:1")
 
 
-def scan(path, max_bytes, copies=1):
+def scan(path, max_bytes, copies=1, per_point=0):
     """Reads path's XML header and checks what it claims (see the module's doc): `copies` times the bytes
-    of its arrays must fit in max_bytes. Returns the Header."""
+    of its arrays, plus `per_point` bytes for each point (the caller's own work), must fit in max_bytes.
+    Returns the Header."""
     path = os.fspath(path)
     ext = Path(path).suffix.lower()
     if ext not in DATASETS:
@@ -358,11 +359,11 @@ def scan(path, max_bytes, copies=1):
             h = _parse(path, mm)
             if h.type == "vtkMultiBlockDataSet":
                 return h
-            _check_sizes(h, mm, max_bytes, copies)
+            _check_sizes(h, mm, max_bytes, copies, per_point)
     return h
 
 
-def _check_sizes(h, mm, max_bytes, copies):
+def _check_sizes(h, mm, max_bytes, copies, per_point):
     path = h.path
     if not h.pieces:
         raise Refused(f"{path}: no <Piece> with an Extent: not a {h.type} VTK reads")
@@ -394,9 +395,10 @@ def _check_sizes(h, mm, max_bytes, copies):
                whole * sum(a.components * TYPES[a.type] for a in h.arrays
                            if a.where in ("PointData", "Points") and a.piece == 0))
     h.need = need
-    if need * copies > max_bytes:
+    if need * copies + whole * per_point > max_bytes:
         raise Refused(f"{path}: claims {dims[0]}x{dims[1]}x{dims[2]} points whose arrays take {_mb(need)}"
                       + (f" (x{copies}: VTK's and the converter's copies)" if copies > 1 else "")
+                      + (f" and their analysis {_mb(whole * per_point)}" if per_point else "")
                       + f"; over the memory limit of {_mb(max_bytes)} (--max-memory MB to allow more)")
     for a in h.arrays:
         if a.format == "appended":
