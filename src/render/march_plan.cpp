@@ -126,6 +126,7 @@ MarchPlan compile_march_plan(std::span<const PreparedField> fields, std::span<co
         r.lut1 = &l1.entry(0);
         r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
         S.march_mask |= bit;
+        S.mip_mask |= bit;
         break;
       }
     }

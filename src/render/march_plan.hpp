@@ -64,8 +64,9 @@ struct MarchPlan {
   std::vector<MarchTask> rt;
   std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
   std::uint64_t march_mask = 0, iso_mask = 0, volume1_mask = 0;
-  // Tasks whose partials join by Blend::max (blend_of()): the march keeps their running maximum
-  // and the pixel loop writes their colour and order key (renderer.cpp).
+  // MIP tasks: the march keeps their running maximum, the pixel loop colours it (renderer.cpp).
+  std::uint64_t mip_mask = 0;
+  // Tasks whose partials join by Blend::max (blend_of()): their depth is the maximum's order key.
   std::uint64_t max_mask = 0;
   // The paper's mix on one corner layout: volume1 tasks trio[0] (slot trio_a) and trio[1] (slot
   // trio_b) and the volume2 task trio[2] reading (trio_a, trio_b); trio_mask = 0 when absent.

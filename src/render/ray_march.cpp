@@ -532,11 +532,11 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   effective += std::uint64_t(ke - ks + 1);
   // During the march acc[i][3] holds the TRANSMITTANCE T = 1 − α: the loop-carried chain per
   // sample is then one multiply, T ← T·(1 − α_s), and colour accumulates as C ← C + T·c_s·α_s.
-  // (partial_image.hpp states the convention.) A max-blend task keeps its running maximum in
+  // (partial_image.hpp states the convention.) A MIP task keeps its running maximum in
   // acc[i][0], from the window's low end (0): cells below it are skipped, so a ray that sees only
   // them still has its maximum 0.
   for (std::uint64_t m = mm; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
-  for (std::uint64_t m = mm & S.max_mask; m; m &= m - 1) acc[std::countr_zero(m)][0] = 0.0f;
+  for (std::uint64_t m = mm & S.mip_mask; m; m &= m - 1) acc[std::countr_zero(m)][0] = 0.0f;
   RayMarch ray(S, O, D, dir, t0, tg1, ke, kg_last, mm, acc, marched);
   if (S.direct && ray.clear_of_exceptions(ks, ke)) {
     // One run over the whole ray: the samples and their order are those of the merged walk, so
@@ -545,11 +545,11 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   } else {
     ray.walk_macro_cells(ks, ke);
   }
-  for (std::uint64_t m = mm & ~S.max_mask; m; m &= m - 1) {
+  for (std::uint64_t m = mm & ~S.mip_mask; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
   }
-  // Max-blend tasks keep a[3] = 1: the ray has samples in this brick (the pixel loop colours them).
+  // MIP tasks keep a[3] = 1: the ray has samples in this brick (the pixel loop colours them).
 }
 
 }  // namespace panoptes::render::march

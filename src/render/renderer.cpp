@@ -244,19 +244,25 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     for (int i = 0; i < K; ++i) {
       PartialImage& o = out[std::size_t(i)];
       float& depth = o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)];
-      if (S.max_mask >> i & 1) {
+      if (S.mip_mask >> i & 1) {
         // A max-blend image's depth is its order key (partial_image.hpp), written only when the
-        // task is marched here: an adaptive pass marching other tasks must not overwrite it.
-        if (!(tasks >> i & 1)) continue;
+        // task is marched here: an adaptive pass marching other tasks must not overwrite it. (The
+        // blend, not the kind, decides what the depth holds: a MIP joined by over would be ordered
+        // by its entry depth, and its bricks' images would not join to the single-brick image.)
+        const bool keyed = S.max_mask >> i & 1;
+        if (!(tasks >> i & 1)) {
+          if (!keyed) depth = r.depth;
+          continue;
+        }
         float* dst = o.rgba_at(x, y);
         if (acc[i][3] > 0) {  // samples in this brick: the colour map at the maximum, opaque
           const MarchTask& rt = S.rt[std::size_t(i)];
           const LutEntry& e = rt.lut1[int(acc[i][0])];
           dst[0] = e.r, dst[1] = e.g, dst[2] = e.b, dst[3] = 1;
-          depth = max_key_depth(acc[i][0]);
+          depth = keyed ? max_key_depth(acc[i][0]) : r.depth;
         } else {
           dst[0] = dst[1] = dst[2] = dst[3] = 0;
-          depth = PartialImage::kNoDepth;
+          depth = keyed ? PartialImage::kNoDepth : r.depth;
         }
         continue;
       }
