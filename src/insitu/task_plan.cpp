@@ -1,5 +1,9 @@
 #include "insitu/task_plan.hpp"
 
+// Sections, in order: the [[task]] table (parse_task_table), sweeps (planned_task_count), the plan
+// (TaskPlan: specs, axes, manifest entries; share_scales; resolve), the --task shorthand
+// (parse_task_shorthand, tasks_from_shorthand), the table printed back (task_table_toml), and each
+// kind's words for help and errors (kind_help, task_shorthand_syntax, task_tables_help).
 #include <toml++/toml.h>
 
 #include <algorithm>

@@ -1,5 +1,10 @@
 #include "render/ray_march.hpp"
 
+// Sections, in order: the samples a brick owns (brick_samples); one ray's march (class RayMarch: the
+// run dispatch run(), the macro-cell walk walk_macro_cells(), the loops run_trio(), run_sweep() and
+// general_block(), where every kind has its case); march_ray(), which sets up and finishes the
+// accumulators (the transmittance convention of partial_image.hpp).
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
