@@ -183,6 +183,36 @@ void BM_Isosurfaces(benchmark::State& state) {
 BENCHMARK(BM_Isosurfaces)->ArgNames({"aa", "inside"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})
     ->Iterations(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// One task of each kind (render::kTaskKinds, in that order: volume, isosurface, slice, mip) on the
+// p field from kMain, one march each: what a kind costs against a volume task (issue 43). The MIP reads
+// the float field through every cell whose values reach above its window's low end, and stops a ray
+// only where it reaches the window's top; the volume stops where it is opaque. Counter cpu_s_frame:
+// process CPU-seconds per frame.
+void BM_TaskKinds(benchmark::State& state) {
+  const auto& sc = scene();
+  const TaskKind kind = kTaskKinds[std::size_t(state.range(0))];
+  TaskSpec t;
+  switch (kind) {
+    case TaskKind::volume: t = p_task(); break;
+    case TaskKind::isosurface: t = TaskSpec::isosurface(0, 0.3f); break;
+    case TaskKind::slice:
+      t = TaskSpec::slice(0, 2, sc.grid.centre()[2], TransferFunction::preset("diverging"), ValueWindow::absolute(-1, 1));
+      break;
+    case TaskKind::mip: t = TaskSpec::mip(0, TransferFunction::preset("hot"), ValueWindow::absolute(0, 1)); break;
+  }
+  state.SetLabel(to_string(kind));
+  const std::vector<TaskSpec> tasks{t};
+  std::vector<PartialImage> out(1);
+  RenderStats total;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) total = add(total, render_brick(kMain, sc.fields, tasks, out, RenderOptions{}));
+  const double cpu = process_cpu_seconds() - cpu0;
+  report(state, total, total.seconds, cpu);
+  state.counters["cpu_s_frame"] = cpu / double(state.iterations());
+}
+BENCHMARK(BM_TaskKinds)->ArgName("kind")->DenseRange(0, int(kTaskKinds.size()) - 1)->Iterations(2)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_PrepareFields(benchmark::State& state) {
   const auto& sc = scene();
   for (auto _ : state) {

@@ -397,7 +397,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                   "lattice:NXxNYxNZ[@MARGIN] (lattice nodes, walk along world axes) or path:FILE (x y z per line)")
       ->capture_default_str();
   sub->add_option("--task", args->tasks,
-                  "Visualization task (repeatable): volume:PRESET[:LO:HI], iso:VALUE, slice:x|y|z:FRACTION[:PRESET[:LO:HI]]; "
+                  "Visualization task (repeatable): " + insitu::task_shorthand_syntax() + "; "
                   "shorthand for the TOML [[task]] tables of `panoptes run` (--print-tasks shows them; several iso: "
                   "form one isovalue sweep). Presets: p-wave, s-wave, diverging, grayscale, hot, rainbow. Without "
                   "LO:HI the window is relative to the --reference (default task: volume:hot)")

@@ -321,7 +321,8 @@ SessionConfig load_session_config(const std::string& path, const std::vector<std
 }
 
 const char* config_keys_help() {
-  return R"(IN-SITU CONFIGURATION (TOML). Unknown keys, wrong types and impossible values are errors.
+  // The [[task]] part comes from the task plan, which holds each kind's keys (one list of kinds).
+  static const std::string text = std::string(R"(IN-SITU CONFIGURATION (TOML). Unknown keys, wrong types and impossible values are errors.
 [output]    dir = "panoptes_out" (database directory); title = "in-situ visualization";
             units = "" (length unit of the grid); time_units = "" (unit of the snapshot times, e.g. "s");
             field_units = {} (unit of each field's values, e.g. { phi_p = "1/s" }: the players' colour legends);
@@ -363,19 +364,8 @@ const char* config_keys_help() {
             available: MemAvailable or the cgroup limit; false = panoptes run --force);
             mpi_timeout = 120 (seconds a rank waits in a Panoptes call for the other ranks before every
             waiting rank reports them missing: no job hangs inside Panoptes)
-[[task]]    one table per task (or sweep); name (unique, required); type = "volume" | "volume2" |
-            "isosurface" | "slice"; field = "name" (volume2: fields = ["a", "b"])
-  volume:     preset = "hot" (p-wave, s-wave, diverging, grayscale, hot, rainbow); extinction_scale = 1;
-              window = [lo, hi] (default [0, 1]) or windows = [[lo, hi], ...] (a sweep: one task per window
-              on axis "<name> window"); relative = true (window in multiples of ref) | false (absolute)
-  volume2:    preset = "p-wave", preset2 = "s-wave", window = [0, 1], window2 = [0, 1], relative = true,
-              extinction_scale = 1 (the paper's p-wave orange + s-wave green in one image)
-  isosurface: isovalue = v or isovalues = [v1, v2, ...] (a sweep on axis "<name> isovalue");
-              relative = false (true: values are fractions of ref); colour = [0.85, 0.85, 0.85]
-  slice:      axis = "z" (x, y, z); position = 0.5 or positions = [...] (fractions of the domain; a sweep
-              on axis "<name> position"); preset = "diverging"; window = [-1, 1]; relative = true
-  Any sweep may set axis_name to name its axis.
-)";
+)") + task_tables_help();
+  return text.c_str();
 }
 
 }  // namespace panoptes::insitu

@@ -248,7 +248,7 @@ void Session::Impl::render_snapshot(int frame) {
         } else if (p.size() == 1) {
           render::finish_image_into(*p[0], cam, grid, out, bg, outline);
         } else {
-          render::composite_into(p, composited[std::size_t(t)]);
+          render::composite_into(specs[std::size_t(t)].kind, p, composited[std::size_t(t)]);  // the kind's blend
           render::finish_image_into(composited[std::size_t(t)], cam, grid, out, bg, outline);
         }
       }

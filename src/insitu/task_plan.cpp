@@ -1,5 +1,9 @@
 #include "insitu/task_plan.hpp"
 
+// Sections, in order: the [[task]] table (parse_task_table), sweeps (planned_task_count), the plan
+// (TaskPlan: specs, axes, manifest entries; share_scales; resolve), the --task shorthand
+// (parse_task_shorthand, tasks_from_shorthand), the table printed back (task_table_toml), and each
+// kind's words for help and errors (kind_help, task_shorthand_syntax, task_tables_help).
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -60,7 +64,7 @@ TaskConfig parse_task_table(const toml_keys::Source& c, const toml::table& t, st
   try {
     tc.kind = volume2 ? render::TaskKind::volume : render::parse_task_kind(type);
   } catch (const Error&) {
-    c.fail(where + "type", "\"" + type + "\"; expected volume, volume2, isosurface or slice");
+    c.fail(where + "type", "\"" + type + "\"; expected " + render::task_kind_words(kVolume2));
   }
   std::set<std::string> allowed{"type", "name", "field", "fields"};
   switch (tc.kind) {
@@ -72,6 +76,7 @@ TaskConfig parse_task_table(const toml_keys::Source& c, const toml::table& t, st
     case render::TaskKind::slice:
       allowed.insert({"preset", "window", "relative", "axis", "position", "positions", "axis_name"});
       break;
+    case render::TaskKind::mip: allowed.insert({"preset", "window", "relative"}); break;
   }
   toml_keys::only_keys(c, t, where.substr(0, where.size() - 1), allowed);
   tc.name = str(c, t, "name", where, "");
@@ -159,6 +164,12 @@ TaskConfig parse_task_table(const toml_keys::Source& c, const toml::table& t, st
         if (!(f >= 0 && f <= 1)) c.fail(where + "positions", "expected fractions of the domain in [0, 1]");
       break;
     }
+    case render::TaskKind::mip:
+      tc.preset = str(c, t, "preset", where, "hot");
+      check_preset("preset", tc.preset);
+      tc.windows = {t.get("window") ? window_at(c, *t.get("window"), where + "window", relative)
+                                    : WindowConfig{tc.preset == "diverging" ? -1.0 : 0.0, 1, relative}};
+      break;
   }
   return tc;
 }
@@ -168,6 +179,7 @@ std::size_t planned_task_count(const TaskConfig& t) {
     case render::TaskKind::volume: return two_fields(t) ? 1 : t.windows.size();
     case render::TaskKind::isosurface: return t.isovalues.size();
     case render::TaskKind::slice: return t.slice_positions.size();
+    case render::TaskKind::mip: return 1;
   }
   return 1;
 }
@@ -202,6 +214,7 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
         axis_suffix = "position";
         axis_values = tc.slice_positions;
         break;
+      case render::TaskKind::mip: break;
     }
     const std::string axis_name = tc.axis.empty() ? tc.name + " " + axis_suffix : tc.axis;
     if (n > 1) axes_.push_back({axis_name, axis_values, ""});
@@ -258,6 +271,15 @@ TaskPlan::TaskPlan(const std::vector<TaskConfig>& configs, const render::GridGeo
                                 {"relative", w.relative}, {"transfer_function", transfer_json(t.spec.tf)}};
           break;
         }
+        case render::TaskKind::mip: {
+          const WindowConfig& w = tc.windows[0];
+          t.spec = render::TaskSpec::mip(f, render::TransferFunction::preset(tc.preset), window_of(w));
+          t.relative = w.relative;
+          t.entry.method = "mip";
+          t.entry.parameters = {{"preset", tc.preset}, {"window", {w.lo, w.hi}}, {"relative", w.relative},
+                                {"transfer_function", transfer_json(t.spec.tf)}};
+          break;
+        }
       }
       t.entry.id = int(tasks_.size());
       for (const PlannedTask& o : tasks_)
@@ -306,7 +328,7 @@ TaskConfig parse_task_shorthand(const std::string& text, const std::string& fiel
     if (e == std::string::npos) break;
     b = e + 1;
   }
-  const std::string usage = "; expected volume:PRESET[:LO:HI], iso:VALUE or slice:x|y|z:FRACTION[:PRESET[:LO:HI]]";
+  const std::string usage = "; expected " + task_shorthand_syntax();
   auto number = [&](const std::string& s) {
     try {
       std::size_t used = 0;
@@ -363,6 +385,12 @@ TaskConfig parse_task_shorthand(const std::string& text, const std::string& fiel
       t.windows = {parts.size() == 6 ? absolute(parts[4], parts[5]) : WindowConfig{-1, 1, true}};
       break;
     }
+    case render::TaskKind::mip:  // the window as a volume's
+      if (parts.size() != 2 && parts.size() != 4) throw Error("--task \"" + text + "\"" + usage);
+      t.preset = preset(parts[1]);
+      t.windows = {parts.size() == 4 ? absolute(parts[2], parts[3])
+                                     : WindowConfig{t.preset == "diverging" ? -1.0 : 0.0, 1.0, true}};
+      break;
   }
   return t;
 }
@@ -464,8 +492,61 @@ std::string task_table_toml(const TaskConfig& t) {
       s += std::string("relative = ") + (t.windows.at(0).relative ? "true" : "false") + "\n";
       s += "window = " + list({t.windows.at(0).lo, t.windows.at(0).hi}) + "\n";
       break;
+    case render::TaskKind::mip:
+      s += "preset = " + q(t.preset) + "\n";
+      s += std::string("relative = ") + (t.windows.at(0).relative ? "true" : "false") + "\n";
+      s += "window = " + list({t.windows.at(0).lo, t.windows.at(0).hi}) + "\n";
+      break;
   }
   return s;
+}
+
+namespace {
+// Each kind's words for users, in one place: its --task shorthand and its [[task]] keys (config help).
+struct KindHelp {
+  const char* shorthand;
+  const char* keys;
+};
+KindHelp kind_help(render::TaskKind k) {
+  switch (k) {
+    case render::TaskKind::volume:
+      return {"volume:PRESET[:LO:HI]",
+              "  volume:     preset = \"hot\" (p-wave, s-wave, diverging, grayscale, hot, rainbow); extinction_scale = 1;\n"
+              "              window = [lo, hi] (default [0, 1]) or windows = [[lo, hi], ...] (a sweep: one task per window\n"
+              "              on axis \"<name> window\"); relative = true (window in multiples of ref) | false (absolute)\n"
+              "  volume2:    preset = \"p-wave\", preset2 = \"s-wave\", window = [0, 1], window2 = [0, 1], relative = true,\n"
+              "              extinction_scale = 1 (the paper's p-wave orange + s-wave green in one image)\n"};
+    case render::TaskKind::isosurface:
+      return {"iso:VALUE",
+              "  isosurface: isovalue = v or isovalues = [v1, v2, ...] (a sweep on axis \"<name> isovalue\");\n"
+              "              relative = false (true: values are fractions of ref); colour = [0.85, 0.85, 0.85]\n"};
+    case render::TaskKind::slice:
+      return {"slice:x|y|z:FRACTION[:PRESET[:LO:HI]]",
+              "  slice:      axis = \"z\" (x, y, z); position = 0.5 or positions = [...] (fractions of the domain; a sweep\n"
+              "              on axis \"<name> position\"); preset = \"diverging\"; window = [-1, 1]; relative = true\n"};
+    case render::TaskKind::mip:
+      return {"mip:PRESET[:LO:HI]",
+              "  mip:        maximum-intensity projection (the colour map at the largest value along each ray, of |v|\n"
+              "              for the absolute-value presets; opaque); preset = \"hot\"; window = [0, 1] ([-1, 1] for\n"
+              "              diverging); relative = true\n"};
+  }
+  return {"", ""};
+}
+}  // namespace
+
+std::string task_shorthand_syntax() {
+  std::string s;
+  for (std::size_t i = 0; i < render::kTaskKinds.size(); ++i)
+    s += std::string(i == 0 ? "" : i + 1 == render::kTaskKinds.size() ? " or " : ", ") +
+         kind_help(render::kTaskKinds[i]).shorthand;
+  return s;
+}
+
+std::string task_tables_help() {
+  std::string s = "[[task]]    one table per task (or sweep); name (unique, required); type = " +
+                  render::task_kind_words(kVolume2) + "; field = \"name\" (volume2: fields = [\"a\", \"b\"])\n";
+  for (render::TaskKind k : render::kTaskKinds) s += kind_help(k).keys;
+  return s + "  Any sweep may set axis_name to name its axis.\n";
 }
 
 }  // namespace panoptes::insitu

@@ -19,7 +19,7 @@ struct Source;
 namespace panoptes::insitu {
 
 /// Reads one [[task]] table (the `index`-th, for messages): `type` is a render::TaskKind word
-/// ("volume", "isosurface", "slice") or "volume2" (a volume of two fields); only the kind's keys are
+/// (render::task_kind_words()) or "volume2" (a volume of two fields); only the kind's keys are
 /// accepted. Throws FileError naming `task[index].KEY` and what was expected.
 TaskConfig parse_task_table(const toml_keys::Source& source, const toml::table& table, std::size_t index);
 
@@ -75,6 +75,7 @@ class TaskPlan {
 ///   iso:VALUE               type = "isosurface", isovalue = VALUE (absolute)
 ///   slice:x|y|z:F[:PRESET[:LO:HI]]  type = "slice", axis, position = F, preset (default "diverging"),
 ///                           relative window [-1, 1], or absolute [LO, HI]
+///   mip:PRESET[:LO:HI]      type = "mip", preset, the window as volume's
 /// Throws panoptes::Error naming `--task`, the text and the expected syntax.
 TaskConfig parse_task_shorthand(const std::string& text, const std::string& field);
 
@@ -85,5 +86,10 @@ std::vector<TaskConfig> tasks_from_shorthand(const std::vector<std::string>& tex
 
 /// The TOML [[task]] table of `task` (what a shorthand means; `panoptes render --print-tasks`).
 std::string task_table_toml(const TaskConfig& task);
+
+/// Every kind's --task shorthand, for help and errors: "volume:PRESET[:LO:HI], iso:VALUE, … or mip:…".
+std::string task_shorthand_syntax();
+/// The [[task]] section of the configuration help (config_keys_help()): every kind's keys.
+std::string task_tables_help();
 
 }  // namespace panoptes::insitu

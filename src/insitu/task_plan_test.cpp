@@ -99,7 +99,8 @@ TEST(TaskPlan, KindsAreRenderTaskKinds) {
     (void)insitu::parse_session_config_text("[schedule]\nevery_steps = 1\n[[task]]\nname = \"c\"\ntype = \"cube\"\nfield = \"a\"\n", "kinds");
     ADD_FAILURE() << "type = \"cube\" accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("task[0].type: \"cube\"; expected volume, volume2, isosurface or slice"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("task[0].type: \"cube\"; expected volume, volume2, isosurface, slice or mip"),
+              std::string::npos)
         << e.what();
   }
   // A configuration built in code with an empty sweep is refused by validate().
@@ -109,3 +110,54 @@ TEST(TaskPlan, KindsAreRenderTaskKinds) {
 }
 
 }  // namespace
+
+// Every kind (render::kTaskKinds) has its keys in the configuration help and a --task shorthand; the
+// user-visible lists are built from that one list, so a new kind appears in all of them or fails here.
+TEST(TaskPlan, EveryKindIsInTheHelpTheShorthandAndTheErrors) {
+  const std::string help = insitu::config_keys_help();
+  const std::string syntax = insitu::task_shorthand_syntax();
+  for (const render::TaskKind k : render::kTaskKinds) {
+    const std::string word = render::to_string(k);
+    EXPECT_NE(help.find("\n  " + word + ":"), std::string::npos) << word << " has no keys in the help";
+    EXPECT_NE(render::task_kind_words().find(word), std::string::npos) << word;
+    const std::string first = k == render::TaskKind::isosurface ? "iso" : word;
+    EXPECT_NE(syntax.find(first + ":"), std::string::npos) << word << " has no shorthand in: " << syntax;
+  }
+  EXPECT_NE(help.find("type = volume, volume2, isosurface, slice or mip"), std::string::npos) << help;
+}
+
+// MIP (issue 43): the TOML table, the shorthand and the printed table mean the same task; the window
+// follows the reference as a volume's; the manifest says "mip" with its colour map.
+TEST(TaskPlan, MipFromTomlAndShorthand) {
+  const insitu::SessionConfig cfg = insitu::parse_session_config_text(
+      "[schedule]\nevery_steps = 1\n"
+      "[[task]]\nname = \"m\"\ntype = \"mip\"\nfield = \"a\"\npreset = \"hot\"\n"
+      "[[task]]\nname = \"mip:diverging:-2:2\"\ntype = \"mip\"\nfield = \"a\"\npreset = \"diverging\"\n"
+      "relative = false\nwindow = [-2, 2]\n",
+      "mip");
+  const std::vector<insitu::TaskConfig> shorthand = insitu::tasks_from_shorthand({"mip:hot", "mip:diverging:-2:2"}, "a");
+  ASSERT_EQ(cfg.tasks.size(), 2u);
+  ASSERT_EQ(shorthand.size(), 2u);
+  const insitu::TaskPlan a(cfg.tasks, kGrid), b(shorthand, kGrid);
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_EQ(a.tasks()[0].spec.kind, render::TaskKind::mip);
+  EXPECT_EQ(a.tasks()[0].entry.method, "mip");
+  EXPECT_TRUE(a.tasks()[0].relative);
+  EXPECT_FALSE(a.tasks()[1].relative);
+  EXPECT_EQ(a.tasks()[1].entry, b.tasks()[1].entry);
+  EXPECT_EQ(a.tasks()[0].entry.parameters, b.tasks()[0].entry.parameters);
+  // Printed back, the tables parse to the same plan.
+  std::string toml = "[schedule]\nevery_steps = 1\n";
+  for (const auto& t : shorthand) toml += insitu::task_table_toml(t) + "\n";
+  const insitu::TaskPlan c(insitu::parse_session_config_text(toml, "printed").tasks, kGrid);
+  for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(c.tasks()[i].entry, b.tasks()[i].entry) << i;
+  std::vector<render::TaskSpec> specs;
+  a.resolve({3.0}, specs);
+  EXPECT_EQ(specs[0].reference, 3.0);
+  EXPECT_EQ(specs[1].window.hi, 2.0);
+  // Keys of other kinds are refused.
+  EXPECT_THROW(insitu::parse_session_config_text(
+                   "[schedule]\nevery_steps = 1\n[[task]]\nname = \"m\"\ntype = \"mip\"\nfield = \"a\"\nisovalue = 1\n", "mip"),
+               Error);
+  EXPECT_THROW(insitu::tasks_from_shorthand({"mip:hot:1"}, "a"), Error);
+}

@@ -141,9 +141,11 @@ std::vector<std::array<float, 3>> drawn_colours(const store::TaskEntry& task, co
   // A slice is a surface: the renderer writes its colour map's colour at the slice's opacity (1, opaque,
   // unless recorded otherwise) over the black background, whatever the map's extinction says. Drawing it
   // as a volume's thin layer made the diverging map's zero (light grey on the plane) black in the legend.
-  const bool slice = task.method == "slice";
+  // A maximum-intensity projection (method "mip") is opaque too: the colour map at the ray's
+  // maximum, alpha 1, wherever the ray crosses the domain.
+  const bool slice = task.method == "slice" || task.method == "mip";
   if (!slice && !tf.contains("extinction")) return out;
-  const double opacity = slice ? slice_opacity(p) : 0;
+  const double opacity = task.method == "slice" ? slice_opacity(p) : slice ? 1.0 : 0.0;
   for (int i = 0; i < samples; ++i) {
     const double u = double(i) / (samples - 1);
     std::array<double, 3> rgb{};

@@ -45,7 +45,8 @@ struct LegendBar {
 /// The colours the transfer function `tf_key` of `task` ("transfer_function" or "transfer_function2" of
 /// its manifest parameters) puts on screen at `samples` (>= 2) evenly spaced window positions, both ends
 /// included: a slice's colour map as the slice renderer writes it (opaque: render/march_plan.cpp's
-/// slice_opacity, recorded as "slice_opacity" when not 1, over black), a volume's as a
+/// slice_opacity, recorded as "slice_opacity" when not 1, over black), a MIP's ("mip") opaque as well
+/// (the colour map at each ray's maximum), a volume's as a
 /// kLegendDepthVoxels-thick layer over black. Empty when the manifest does not record them.
 std::vector<std::array<float, 3>> drawn_colours(const store::TaskEntry& task, const char* tf_key, int samples);
 

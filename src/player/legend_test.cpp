@@ -168,3 +168,26 @@ TEST(Legend, ASlicesColoursAreItsColourMapAsTheSliceIsDrawn) {
   m.tasks[0].parameters["slice_opacity"] = 0.5;
   EXPECT_NEAR(task_legend(m, 0, 0)[0].colours[0][2], 0.375f, 1e-6);
 }
+
+// Issue 43: a maximum-intensity projection is opaque like a slice (the renderer writes the colour
+// map's colour at each ray's maximum with alpha 1), so its legend is the colour map over its window.
+TEST(Legend, AMipsColoursAreItsColourMapOpaque) {
+  store::Manifest m;
+  m.fields = {{"p", "1/s", {4.0}, ""}};
+  const nlohmann::json hot = {{"colour", {{0, 0.0, 0.0, 0.0}, {0.5, 1.0, 0.4, 0.0}, {1, 1.0, 1.0, 1.0}}},
+                              {"extinction", {{0, 0.0}, {1, 0.2}}},
+                              {"absolute_value", true}};
+  store::TaskEntry mip;
+  mip.id = 0, mip.name = "mip", mip.method = "mip", mip.fields = {"p"};
+  mip.parameters = {{"preset", "hot"}, {"window", {0.0, 0.5}}, {"relative", true}, {"transfer_function", hot}};
+  m.tasks = {mip};
+  const auto b = task_legend(m, 0, 0);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_DOUBLE_EQ(b[0].hi, 2.0);  // 0.5 x the reference 4
+  EXPECT_EQ(b[0].label, "|p|");
+  ASSERT_EQ(b[0].colours.size(), std::size_t(kLegendSamples));
+  EXPECT_NEAR(b[0].colours.back()[2], 1.0f, 1e-6) << "the map's top, unattenuated (a volume's layer would be dim)";
+  const int mid = (kLegendSamples - 1) / 2;  // u = 15/31: 30/31 of the way to the map's middle point
+  EXPECT_NEAR(b[0].colours[std::size_t(mid)][0], 30.0f / 31, 1e-5);
+  EXPECT_NEAR(b[0].colours[std::size_t(mid)][1], 0.4f * 30 / 31, 1e-5);
+}

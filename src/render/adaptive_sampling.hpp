@@ -109,11 +109,16 @@ class AdaptiveTile {
   /// `column_stride` (0: the stride) spaces the coarse lattice's columns differently from its rows
   /// (equirectangular frames widen them toward the poles, equirect_sampling.hpp); cells are split at
   /// their midpoints on both axes as square ones are.
+  /// `keyed`: images whose depth is a Blend::max order key (partial_image.hpp), not the entry depth:
+  /// `march` writes it only for the tasks it marches, and an interpolated pixel takes its cell's
+  /// smallest corner key (the largest maximum near it), so the bricks' join still compares maxima.
   template <class March, class Locate>
   void run(const PixelRect& tile, std::span<PartialImage> out, March&& march, Locate&& locate,
-           std::uint64_t follow = 0, const Silhouette* silhouette = nullptr, int column_stride = 0) {
+           std::uint64_t follow = 0, const Silhouette* silhouette = nullptr, int column_stride = 0,
+           std::uint64_t keyed = 0) {
     if (out.size() > 64) throw std::invalid_argument("AdaptiveTile: more than 64 images in one march");
     tile_ = tile;
+    keyed_ = keyed;
     follow_ = follow;
     silhouette_ = silhouette;
     out_ = out;
@@ -170,6 +175,18 @@ class AdaptiveTile {
     std::uint64_t r = 0;
     for (std::uint64_t m = mask; m; m &= m - 1) {
       const PartialImage& o = out_[std::size_t(std::countr_zero(m))];
+      if (keyed_ & m & -m) {
+        // A max-blend image whose corners disagree on having samples in the brick: between them
+        // the brick's part of the ray ends, and an interpolated translucent pixel would win the
+        // bricks' join whole (a max keeps one partial), letting the background through.
+        const bool sampled = depth(o, x0, y0) != PartialImage::kNoDepth;
+        if ((depth(o, x1, y0) != PartialImage::kNoDepth) != sampled ||
+            (depth(o, x0, y1) != PartialImage::kNoDepth) != sampled ||
+            (depth(o, x1, y1) != PartialImage::kNoDepth) != sampled) {
+          r |= m & -m;
+          continue;
+        }
+      }
       const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *d = o.rgba_at(x1, y1);
       // Plain comparisons, not std::fmin/fmax (libm calls here, NaN-aware): the march writes finite
       // colours (LUT entries times opacities), and the range of finite values is the same.
@@ -255,15 +272,23 @@ class AdaptiveTile {
             q[0] = q[1] = q[2] = q[3] = 0.0f;
           }
         }
-        for (PartialImage& o : out_)  // the same exact depth for every image
-          o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)] = d;
+        for (std::size_t i = 0; i < out_.size(); ++i) {  // the same exact depth for every image but keyed ones
+          PartialImage& o = out_[i];
+          float& dst = o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)];
+          if (!(keyed_ >> i & 1)) {
+            dst = d;
+          } else if (pending >> i & 1) {
+            dst = !hit ? PartialImage::kNoDepth
+                       : std::min(std::min(depth(o, x0, y0), depth(o, x1, y0)), std::min(depth(o, x0, y1), depth(o, x1, y1)));
+          }
+        }
       }
     }
   }
 
   int stride_;
   float tolerance_;
-  std::uint64_t follow_ = 0;
+  std::uint64_t follow_ = 0, keyed_ = 0;
   PixelRect tile_;
   std::span<PartialImage> out_;
   const Silhouette* silhouette_ = nullptr;

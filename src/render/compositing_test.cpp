@@ -28,16 +28,32 @@ struct Scene {
     p = wave_field(grid, pf);
     s = wave_field(grid, sf);
     views = {FieldView::whole(grid, p.data()), FieldView::whole(grid, s.data())};
-    tasks = {
-        TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
-        TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
-                          TransferFunction::preset("s-wave"), ValueWindow::relative_to(0, 1.0), 1.0, 0.9),
-        TaskSpec::volume(0, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1)),
-        TaskSpec::isosurface(0, 0.4f, {1, 0.6f, 0.2f}),
-        TaskSpec::isosurface(1, -0.2f, {0.3f, 0.9f, 0.4f}),
-        TaskSpec::slice(0, 2, 1.3, TransferFunction::preset("diverging"), ValueWindow::absolute(-1, 1)),
-        TaskSpec::slice(1, 0, -3.7, TransferFunction::preset("rainbow"), ValueWindow::absolute(-1, 1)),
-    };
+    // Every kind's examples, in the order of kTaskKinds: a kind added to the enum is tested by every
+    // test below that loops over `tasks` the day it is added (and fails here until it has examples).
+    for (const TaskKind k : kTaskKinds) {
+      const std::vector<TaskSpec> ex = examples(k);
+      if (ex.empty()) ADD_FAILURE() << "no compositing example for task kind " << to_string(k);
+      tasks.insert(tasks.end(), ex.begin(), ex.end());
+    }
+  }
+  // Two or three tasks of each kind on the two fields (indices 0-6 are used by name below).
+  static std::vector<TaskSpec> examples(TaskKind k) {
+    switch (k) {
+      case TaskKind::volume:
+        return {TaskSpec::volume(0, TransferFunction::preset("p-wave", 2), ValueWindow::absolute(0, 1)),
+                TaskSpec::volume2(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1), 1,
+                                  TransferFunction::preset("s-wave"), ValueWindow::relative_to(0, 1.0), 1.0, 0.9),
+                TaskSpec::volume(0, TransferFunction::preset("diverging", 3), ValueWindow::absolute(-1, 1))};
+      case TaskKind::isosurface:
+        return {TaskSpec::isosurface(0, 0.4f, {1, 0.6f, 0.2f}), TaskSpec::isosurface(1, -0.2f, {0.3f, 0.9f, 0.4f})};
+      case TaskKind::slice:
+        return {TaskSpec::slice(0, 2, 1.3, TransferFunction::preset("diverging"), ValueWindow::absolute(-1, 1)),
+                TaskSpec::slice(1, 0, -3.7, TransferFunction::preset("rainbow"), ValueWindow::absolute(-1, 1))};
+      case TaskKind::mip:  // |p| on an absolute-value map; signed s on a diverging one
+        return {TaskSpec::mip(0, TransferFunction::preset("hot"), ValueWindow::absolute(0.1, 0.9)),
+                TaskSpec::mip(1, TransferFunction::preset("diverging"), ValueWindow::absolute(-1, 1))};
+    }
+    return {};
   }
   std::vector<Brick> slabs(int axis, int n) const {
     std::vector<Brick> b;
@@ -445,7 +461,9 @@ TEST(Compositing, CamerasInsideTheDomainMatchTheSingleBrickImage) {
                                                           << " bricks, task " << t;
           }
         }
-        // The bricks' partial depths are the full march's (the eye-in-brick shortcut included).
+        // The bricks' partial depths are the full march's (the eye-in-brick shortcut included). A
+        // max-blend image's depth is its maximum's key, which adaptive sampling interpolates as it
+        // does the colour: only the entry depths of over-blend images are exact.
         for (const Brick& b : sc.slabs(axis, n)) {
           std::vector<PreparedField> fields;
           for (const FieldView& f : sc.views) fields.emplace_back(f.subview(b));
@@ -453,7 +471,8 @@ TEST(Compositing, CamerasInsideTheDomainMatchTheSingleBrickImage) {
           render_brick(cam, fields, sc.tasks, a);
           render_brick(cam, fields, sc.tasks, d, full);
           for (std::size_t t = 0; t < sc.tasks.size(); ++t)
-            ASSERT_TRUE(a[t].depth == d[t].depth) << "camera " << ci << ", axis " << axis << ", " << n << " bricks, task " << t;
+            if (blend_of(sc.tasks[t].kind) == Blend::over)
+              ASSERT_TRUE(a[t].depth == d[t].depth) << "camera " << ci << ", axis " << axis << ", " << n << " bricks, task " << t;
         }
       }
   }

@@ -113,6 +113,25 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (sa != sb) th = ta + (tb - ta) * (sa / (sa - sb));
     return th;
   };
+  // Whether the sliver an EXIT (a grazing crossing whose parabola turns back behind it) closes was
+  // entered: beyond its predicted entry, 2·reach behind the crossing (and a quarter of the reach more
+  // for the fit's error), the ray must have been on the side it now leaves to, not on sp's (sp lies
+  // inside the sliver). Where two sheets meet the fit claims an entry that never was (a valley open
+  // towards the camera): such a crossing is the ray's hit, not an exit that shows what lies behind
+  // (issue 41's cracks seen from inside). The field is read only where every brick owning sample k
+  // can read it: at most 2 voxels below sample k and less than 1 above on each axis (the ghost layers
+  // of render::required_points), so every decomposition decides alike; farther entries are trusted
+  // (telling those apart needs the ray's crossings in the bricks in front).
+  const auto sliver_entered = [&](std::int64_t k, double th, double reach, float sp) {
+    const double entry = th + 2 * reach - (0.25 * std::abs(reach) + 0.05 * dt);
+    const double tk = t0 + double(k) * dt;
+    for (int a = 0; a < 3; ++a) {
+      const double d = (entry - tk) * D[a];
+      if (!(d >= -2.0 && d < 1.0)) return true;
+    }
+    const double se = interp_clamped(f, O[0] + entry * D[0], O[1] + entry * D[1], O[2] + entry * D[2]) - iso;
+    return (se < 0) != (sp < 0);
+  };
   for (; cand; cand &= cand - 1) {
     const int j = std::countr_zero(cand) + 1;
     const float sp = s(j - 1), sc = s(j);
@@ -195,7 +214,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
           const double reach = -s1 / s2;  // world units from the hit to the vertex
           if (std::abs(reach) <= max_reach * dt) {
             const double cover = 0.5 + s1 * s1 / (2 * std::abs(s2)) / gn / (th * pitch);
-            if (cover < 1) alpha = reach > 0 ? cover : 0.0;
+            if (cover < 1) alpha = reach > 0 ? cover : sliver_entered(k, th, reach, sp) ? 0.0 : 1.0;
           }
         }
       }

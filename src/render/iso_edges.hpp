@@ -25,7 +25,9 @@ double pixel_pitch(const camera::Camera& cam);
 ///   sets the depth s'²/(2|s''|)/|∇f| (the field's own curvature across the surface bends the
 ///   parabola too: issue 41). Coverage c = 0.5 + depth / footprint (box filter); the entry (vertex
 ///   ahead) gets α = c, the exit (vertex behind) adds nothing, so both together cover c; a crossing
-///   with c ≥ 1 is opaque (the old hit).
+///   with c ≥ 1 is opaque (the old hit). An exit whose predicted entry lies within the ghost layers
+///   of its sample (2 voxels below, 1 above) must have the ray on the other side beyond it, else it
+///   is no exit but a hit (two sheets meeting: issue 43).
 /// - a local minimum of |s| at sample k (no sign change): the field at the parabola's vertex, one
 ///   extra sample, tells a sliver pierced between two samples (a hit, found by regula falsi towards
 ///   the vertex: the saw teeth of grazing views came from missing those) from a near miss, which

@@ -116,7 +116,21 @@ MarchPlan compile_march_plan(std::span<const PreparedField> fields, std::span<co
         S.slices.push_back(int(i));
         break;
       }
+      case TaskKind::mip: {
+        // The colour map's LUT gives the window's coordinate of a value (lo, scale, |v|) and, at the
+        // maximum's bin, the colour; its opacity is not used.
+        r.kind = march_kind(t);
+        r.s1 = slot(t.field);
+        r.slots = 1u << r.s1;
+        const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
+        r.lut1 = &l1.entry(0);
+        r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
+        S.march_mask |= bit;
+        S.mip_mask |= bit;
+        break;
+      }
     }
+    if (blend_of(t.kind) == Blend::max) S.max_mask |= bit;
   }
   if (S.acc.size() > 8) throw Error("render: tasks of one call read " + std::to_string(S.acc.size()) + " fields; at most 8");
   for (std::size_t s = 0; s < S.acc.size(); ++s) {
@@ -182,6 +196,12 @@ MarchPlan compile_march_plan(std::span<const PreparedField> fields, std::span<co
       const MacroCells& c1 = *S.cells[std::size_t(r.s1)];
       if (r.kind == MarchKind::iso) {
         if (c1.min(m) <= r.iso && r.iso <= c1.max(m)) bits |= bit;
+      } else if (r.kind == MarchKind::mip) {
+        // A cell all of whose values lie at or below the window's low end can only give the
+        // coordinate 0, where every ray's maximum starts: skipping it changes no maximum. (The
+        // samples interpolate the float field, within the cell's range.)
+        const float hi = r.abs1 ? std::max(std::fabs(c1.min(m)), std::fabs(c1.max(m))) : c1.max(m);
+        if (!((hi - r.lo1) * r.sc1 <= 0)) bits |= bit;
       } else {
         // Quantized values may stray half a step outside the cell's float range.
         const float e1 = S.acc[std::size_t(r.s1)].qscale;

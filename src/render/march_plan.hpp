@@ -15,7 +15,7 @@ namespace panoptes::render::march {
 
 // How the march treats a task: TaskKind, with a volume task split by its number of fields (the
 // kernels differ). march_kind() is the one place that maps one to the other.
-enum class MarchKind : std::uint8_t { volume1, volume2, iso, slice };
+enum class MarchKind : std::uint8_t { volume1, volume2, iso, slice, mip };
 
 /// The march kind of a task (TaskKind::volume with field2 >= 0 is volume2).
 inline MarchKind march_kind(const TaskSpec& t) {
@@ -23,6 +23,7 @@ inline MarchKind march_kind(const TaskSpec& t) {
     case TaskKind::volume: return t.field2 >= 0 ? MarchKind::volume2 : MarchKind::volume1;
     case TaskKind::isosurface: return MarchKind::iso;
     case TaskKind::slice: return MarchKind::slice;
+    case TaskKind::mip: return MarchKind::mip;
   }
   return MarchKind::volume1;
 }
@@ -63,6 +64,10 @@ struct MarchPlan {
   std::vector<MarchTask> rt;
   std::vector<std::uint64_t> active;  // per macro-cell: tasks with something visible in it
   std::uint64_t march_mask = 0, iso_mask = 0, volume1_mask = 0;
+  // MIP tasks: the march keeps their running maximum, the pixel loop colours it (renderer.cpp).
+  std::uint64_t mip_mask = 0;
+  // Tasks whose partials join by Blend::max (blend_of()): their depth is the maximum's order key.
+  std::uint64_t max_mask = 0;
   // The paper's mix on one corner layout: volume1 tasks trio[0] (slot trio_a) and trio[1] (slot
   // trio_b) and the volume2 task trio[2] reading (trio_a, trio_b); trio_mask = 0 when absent.
   std::uint64_t trio_mask = 0;

@@ -58,9 +58,10 @@ void union_target(std::span<const PartialImage* const> parts, PartialImage& out)
 }
 }  // namespace
 
-void composite_into(std::span<const PartialImage* const> parts, PartialImage& out) {
+void composite_into(Blend blend, std::span<const PartialImage* const> parts, PartialImage& out) {
   union_target(parts, out);
   const int n = int(parts.size());
+  const bool over_all = blend == Blend::over;
 #pragma omp parallel
   {
     // One sort buffer per thread (parts are few: one per rank with a brick).
@@ -73,9 +74,15 @@ void composite_into(std::span<const PartialImage* const> parts, PartialImage& ou
           const float d = parts[i]->depth_at(x, y);
           if (d != PartialImage::kNoDepth) order[std::size_t(m++)] = {d, i};
         }
+        // Ties keep the lower index first (pairs compare their index too): the same pixel for any
+        // order of arrival, which a max blend's equal maxima of different colours would otherwise not be.
         std::sort(order.begin(), order.begin() + m);
         float* acc = out.rgba_at(x, y);
-        for (int r = 0; r < m; ++r) over(acc, parts[order[std::size_t(r)].second]->rgba_at(x, y));
+        if (over_all) {
+          for (int r = 0; r < m; ++r) over(acc, parts[order[std::size_t(r)].second]->rgba_at(x, y));
+        } else if (m) {  // max: the partial holding the largest maximum decides alone
+          std::copy_n(parts[order[0].second]->rgba_at(x, y), 4, acc);
+        }
         out.depth[std::size_t(y - out.rect.y0) * out.rect.width() + (x - out.rect.x0)] =
             m ? order[0].first : PartialImage::kNoDepth;
       }
@@ -83,13 +90,18 @@ void composite_into(std::span<const PartialImage* const> parts, PartialImage& ou
   }
 }
 
-PartialImage composite(std::span<const PartialImage* const> parts) {
+void composite_into(TaskKind kind, std::span<const PartialImage* const> parts, PartialImage& out) {
+  composite_into(blend_of(kind), parts, out);
+}
+
+PartialImage composite(TaskKind kind, std::span<const PartialImage* const> parts) {
   PartialImage out;
-  composite_into(parts, out);
+  composite_into(kind, parts, out);
   return out;
 }
 
-PartialImage composite_ordered(std::span<const PartialImage* const> parts) {
+PartialImage composite_ordered(TaskKind kind, std::span<const PartialImage* const> parts) {
+  if (blend_of(kind) != Blend::over) return composite(kind, parts);  // a maximum has no order
   PartialImage out;
   union_target(parts, out);
 #pragma omp parallel for schedule(static)

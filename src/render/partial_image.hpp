@@ -10,6 +10,7 @@
 #include "camera/orientation.hpp"
 #include "core/image.hpp"
 #include "render/field_view.hpp"
+#include "render/task_spec.hpp"
 #include "render/transfer_function.hpp"
 
 namespace panoptes::render {
@@ -28,7 +29,15 @@ struct PixelRect {
 /// of `rect` (the brick's screen footprint; pixels outside it are transparent), and per pixel the
 /// depth — the ray parameter (world distance from the camera) where the ray ENTERS the brick, +∞
 /// when it misses. Bricks are convex and disjoint, so sorting a pixel's partials by this depth is
-/// their exact front-to-back order.
+/// their exact front-to-back order. For a kind whose blend is Blend::max the depth is instead the
+/// order key max_key_depth() of the ray's maximum in the brick (+∞: no sample), so that in both
+/// blends the partial with the smaller depth comes first.
+///
+/// Alpha convention: `rgba[3]` is the OPACITY α, and colour is premultiplied by it. The march's
+/// accumulators (ray_march.cpp, compositing_kernels.hpp) hold the TRANSMITTANCE T = 1 − α in lane 3
+/// instead while a ray is marched (the loop-carried chain is then one multiply per sample:
+/// C ← C + T·α_s·c_s, T ← T·(1 − α_s)); march_ray() turns T back into α before a pixel is written.
+/// A new kind's kernel that composites along the ray follows the same convention.
 struct PartialImage {
   static constexpr float kNoDepth = std::numeric_limits<float>::infinity();
   int width = 0, height = 0;  ///< full image size
@@ -63,14 +72,22 @@ inline void over(float* acc, const float* back) {
   acc[3] += w * back[3];
 }
 
-/// Merges partial images of disjoint bricks of the same (camera, task) into one, ordering them per
-/// pixel by depth (exact for any brick decomposition). The result covers the union of the rects;
-/// its depth is the nearest. Throws panoptes::Error if the image sizes differ.
-PartialImage composite(std::span<const PartialImage* const> parts);
+/// The depth a Blend::max partial stores for its maximum `key` (≥ 0, the window coordinate the
+/// colour map is read at): −key, so the largest maximum sorts first, and +∞ (no sample) last.
+inline float max_key_depth(float key) { return -key; }
+
+/// Merges partial images of disjoint bricks of the same (camera, task) into one as the task's kind
+/// blends (blend_of()): over, ordering them per pixel by depth, or max, keeping per pixel the partial
+/// with the smallest depth (largest maximum) — exact for any brick decomposition. The result covers
+/// the union of the rects; its depth is the smallest. Throws panoptes::Error if the image sizes differ.
+PartialImage composite(TaskKind kind, std::span<const PartialImage* const> parts);
 /// composite() into `out`, reusing its buffers (no allocation once warm: the in-situ session's path).
-void composite_into(std::span<const PartialImage* const> parts, PartialImage& out);
-/// Merges partial images already in front-to-back order (e.g. from visibility_order()).
-PartialImage composite_ordered(std::span<const PartialImage* const> front_to_back);
+void composite_into(TaskKind kind, std::span<const PartialImage* const> parts, PartialImage& out);
+/// The same by blend (what composite_into(kind, …) dispatches to).
+void composite_into(Blend blend, std::span<const PartialImage* const> parts, PartialImage& out);
+/// Merges partial images already in front-to-back order (e.g. from visibility_order()); a max
+/// blend does not depend on their order.
+PartialImage composite_ordered(TaskKind kind, std::span<const PartialImage* const> front_to_back);
 
 /// A front-to-back order of bricks for a camera: indices into `bricks` sorted by the sum over axes
 /// of the world distance from the camera to the brick's extent along that axis (0 when the camera

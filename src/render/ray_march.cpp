@@ -1,5 +1,10 @@
 #include "render/ray_march.hpp"
 
+// Sections, in order: the samples a brick owns (brick_samples); one ray's march (class RayMarch: the
+// run dispatch run(), the macro-cell walk walk_macro_cells(), the loops run_trio(), run_sweep() and
+// general_block(), where every kind has its case); march_ray(), which sets up and finishes the
+// accumulators (the transmittance convention of partial_image.hpp).
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -329,7 +334,8 @@ class RayMarch {
     std::uint32_t vmask = 0, smask = 0;
     for (std::uint64_t m = lm; m; m &= m - 1) {
       const MarchTask& T = S.rt[std::size_t(std::countr_zero(m))];
-      (T.kind == MarchKind::iso ? smask : vmask) |= T.slots;
+      // Isosurfaces and maxima read the float field (vb), volumes their classification values (vq).
+      (T.kind == MarchKind::iso || T.kind == MarchKind::mip ? smask : vmask) |= T.slots;
     }
     // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_mates, found at
     // setup; a joint copy's partner first: their records share a cache line and one prefetch).
@@ -472,6 +478,19 @@ class RayMarch {
           }
           break;
         }
+        case MarchKind::mip: {
+          // The running maximum of the window's coordinate (lut_bin()'s u before truncation) in
+          // a[0]; lane 3 only flags that the ray has samples here (march_ray()). NaN never wins.
+          const float* v = vb[T.s1] + 1;
+          float m = a[0];
+          for (int l = 0; l < n; ++l) {
+            const float u = ((T.abs1 ? std::fabs(v[l]) : v[l]) - T.lo1) * T.sc1;
+            m = u > m ? u : m;
+          }
+          a[0] = m < T.last1 ? m : T.last1;
+          if (a[0] >= T.last1) stop = n - 1;  // the window's top: nothing further can change the pixel
+          break;
+        }
         case MarchKind::slice:
           break;
       }
@@ -518,7 +537,11 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   effective += std::uint64_t(ke - ks + 1);
   // During the march acc[i][3] holds the TRANSMITTANCE T = 1 − α: the loop-carried chain per
   // sample is then one multiply, T ← T·(1 − α_s), and colour accumulates as C ← C + T·c_s·α_s.
+  // (partial_image.hpp states the convention.) A MIP task keeps its running maximum in
+  // acc[i][0], from the window's low end (0): cells below it are skipped, so a ray that sees only
+  // them still has its maximum 0.
   for (std::uint64_t m = mm; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
+  for (std::uint64_t m = mm & S.mip_mask; m; m &= m - 1) acc[std::countr_zero(m)][0] = 0.0f;
   RayMarch ray(S, O, D, dir, t0, tg1, ke, kg_last, mm, acc, marched);
   if (S.direct && ray.clear_of_exceptions(ks, ke)) {
     // One run over the whole ray: the samples and their order are those of the merged walk, so
@@ -527,10 +550,11 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   } else {
     ray.walk_macro_cells(ks, ke);
   }
-  for (std::uint64_t m = mm; m; m &= m - 1) {
+  for (std::uint64_t m = mm & ~S.mip_mask; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
   }
+  // MIP tasks keep a[3] = 1: the ray has samples in this brick (the pixel loop colours them).
 }
 
 }  // namespace panoptes::render::march

@@ -13,7 +13,8 @@ namespace panoptes::render::march {
 /// Marches the ray O + t·D (index space; `dir` its world direction, for isosurface shading) from t0
 /// (where it enters the domain, or 0 inside) for the march tasks of `plan` in the bit mask `tasks`.
 /// [tb0, tb1] is its stretch inside the brick, tg1 where it leaves the domain. Fills acc[i]
-/// (premultiplied RGBA) of each such task and adds the effective and marched sample counts.
+/// (premultiplied RGBA; a MIP task: its maximum in [0], [3] = 1 when the ray has samples in the
+/// brick) of each such task and adds the effective and marched sample counts.
 void march_ray(const MarchPlan& plan, const double O[3], const double D[3], const Vec3& dir, double t0, double tg1,
                double tb0, double tb1, std::uint64_t tasks, float (*acc)[4], std::uint64_t& effective,
                std::uint64_t& marched);

@@ -28,7 +28,7 @@ inline std::vector<Image> render_bricked(const camera::Camera& cam, const std::v
       for (int b : order) ps.push_back(&parts[std::size_t(b)][t]);
     else
       for (auto& p : parts) ps.push_back(&p[t]);
-    const PartialImage c = ordered ? composite_ordered(ps) : composite(ps);
+    const PartialImage c = ordered ? composite_ordered(tasks[t].kind, ps) : composite(tasks[t].kind, ps);
     images.push_back(finish_image(c, cam, whole[0].grid, {0.1f, 0.1f, 0.15f}, outline));
   }
   return images;

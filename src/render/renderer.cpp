@@ -141,8 +141,10 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     throw Error("render: adaptive tolerance " + std::to_string(opt.adaptive_tolerance) + "; expected >= 0");
   std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0, n_interpolated = 0;
   const std::uint64_t all_tasks = K == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << K) - 1;
-  // Adaptive sampling: isosurfaces and slices are refined wherever any task is (their edges are thin).
-  std::uint64_t edge_tasks = 0;
+  // Adaptive sampling: isosurfaces and slices are refined wherever any task is (their edges are thin),
+  // and so are maxima: where the ray's maximum moves from one feature to another the image has a
+  // crease, at other pixels in each brick than in the whole.
+  std::uint64_t edge_tasks = S.max_mask;
   for (int i = 0; i < K; ++i)
     if (S.rt[std::size_t(i)].kind == MarchKind::iso || S.rt[std::size_t(i)].kind == MarchKind::slice)
       edge_tasks |= std::uint64_t(1) << i;
@@ -241,11 +243,34 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
     for (int i = 0; i < K; ++i) {
       PartialImage& o = out[std::size_t(i)];
+      float& depth = o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)];
+      if (S.mip_mask >> i & 1) {
+        // A max-blend image's depth is its order key (partial_image.hpp), written only when the
+        // task is marched here: an adaptive pass marching other tasks must not overwrite it. (The
+        // blend, not the kind, decides what the depth holds: a MIP joined by over would be ordered
+        // by its entry depth, and its bricks' images would not join to the single-brick image.)
+        const bool keyed = S.max_mask >> i & 1;
+        if (!(tasks >> i & 1)) {
+          if (!keyed) depth = r.depth;
+          continue;
+        }
+        float* dst = o.rgba_at(x, y);
+        if (acc[i][3] > 0) {  // samples in this brick: the colour map at the maximum, opaque
+          const MarchTask& rt = S.rt[std::size_t(i)];
+          const LutEntry& e = rt.lut1[int(acc[i][0])];
+          dst[0] = e.r, dst[1] = e.g, dst[2] = e.b, dst[3] = 1;
+          depth = keyed ? max_key_depth(acc[i][0]) : r.depth;
+        } else {
+          dst[0] = dst[1] = dst[2] = dst[3] = 0;
+          depth = keyed ? PartialImage::kNoDepth : r.depth;
+        }
+        continue;
+      }
       if (tasks >> i & 1) {
         float* dst = o.rgba_at(x, y);
         dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
       }
-      o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = r.depth;
+      depth = r.depth;
     }
   };
 
@@ -296,7 +321,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       const std::uint64_t before = refiner.interpolated();
       const int columns = sphere ? equirect_column_stride(stride, H, ty0, ty1, kEquirectTileWidth / 2) : 0;
       refiner.run(PixelRect{tx0, ty0, tx1, ty1}, out, march, depth_of, edge_tasks, silhouette.empty() ? nullptr : &silhouette,
-                  columns);
+                  columns, S.max_mask);
       n_interpolated += refiner.interpolated() - before;
     }
   }

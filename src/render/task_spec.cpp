@@ -1,6 +1,7 @@
 #include "render/task_spec.hpp"
 
 #include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 
@@ -48,19 +49,54 @@ TaskSpec TaskSpec::slice(int field, int axis, double position, TransferFunction 
   return t;
 }
 
+TaskSpec TaskSpec::mip(int field, TransferFunction colour_map, ValueWindow window, double reference) {
+  TaskSpec t;
+  t.kind = TaskKind::mip;
+  t.field = field;
+  t.tf = std::move(colour_map);
+  t.window = window;
+  t.reference = reference;
+  return t;
+}
+
+Blend blend_of(TaskKind kind) {
+  switch (kind) {
+    case TaskKind::volume:
+    case TaskKind::isosurface:
+    case TaskKind::slice: return Blend::over;
+    // A maximum does not depend on the order of the samples: any brick may hold it, and the one
+    // that does decides the pixel alone (over in depth order would let the front brick's win).
+    case TaskKind::mip: return Blend::max;
+  }
+  return Blend::over;
+}
+
 const char* to_string(TaskKind kind) {
   switch (kind) {
     case TaskKind::volume: return "volume";
     case TaskKind::isosurface: return "isosurface";
     case TaskKind::slice: return "slice";
+    case TaskKind::mip: return "mip";
   }
   return "?";
 }
 
+std::string task_kind_words(std::string_view after_volume) {
+  std::vector<std::string> words;
+  for (TaskKind k : kTaskKinds) {
+    words.emplace_back(to_string(k));
+    if (k == TaskKind::volume && !after_volume.empty()) words.emplace_back(after_volume);
+  }
+  std::string s;
+  for (std::size_t i = 0; i < words.size(); ++i)
+    s += (i == 0 ? "" : i + 1 == words.size() ? " or " : ", ") + words[i];
+  return s;
+}
+
 TaskKind parse_task_kind(std::string_view text) {
-  for (TaskKind k : {TaskKind::volume, TaskKind::isosurface, TaskKind::slice})
+  for (TaskKind k : kTaskKinds)
     if (text == to_string(k)) return k;
-  throw Error("render: task kind \"" + std::string(text) + "\"; expected volume, isosurface or slice");
+  throw Error("render: task kind \"" + std::string(text) + "\"; expected " + task_kind_words());
 }
 
 }  // namespace panoptes::render

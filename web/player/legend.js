@@ -1,7 +1,7 @@
 // Colour legends (issue 34): each bar of the current task — its transfer function's colours and its
 // window in physical values and units at the shown frame — as the desktop HUD draws them. The colours
 // are the desktop's own (src/player/legend.cpp, drawn_colours): database.json publishes them per task
-// as `drawn_colours` (a slice's opaque colour map, a volume's thin layer over black), so the two front
+// as `drawn_colours` (a slice's or a MIP's opaque colour map, a volume's thin layer over black), so the two front
 // ends cannot drift apart (issue 41: this file used to recompute them, every task as a volume).
 
 const drawnColours = (task, tfKey) => (task.drawn_colours && task.drawn_colours[tfKey]) || [];

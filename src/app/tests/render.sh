@@ -120,6 +120,13 @@ grep -q "unsupported volume format" "$tmp/err.txt" || fail "unclear error for .t
 if "$panoptes" render "$tmp/sphere.vtk" --task volume:nope --out "$tmp/e5" 2> "$tmp/err.txt"; then fail "accepted a bad preset"; fi
 grep -q "p-wave" "$tmp/err.txt" || fail "bad preset error does not list presets: $(cat "$tmp/err.txt")"
 if "$panoptes" render "$tmp/sphere.vtk" --task slice:w:0.5 --out "$tmp/e6" 2> "$tmp/err.txt"; then fail "accepted axis w"; fi
+# Issue 43: every kind is a --task word; the help and the usage error list them from one list.
+"$panoptes" render "$tmp/sphere.vtk" --rig fibonacci:2 --task mip:hot --size 32x24 -q --out "$tmp/mip" > /dev/null
+grep -q '"method": *"mip"' "$tmp/mip/panoptes.json" || fail "no mip task in the manifest"
+"$panoptes" render --help > "$tmp/help.txt"  # to a file: grep -q in a pipe would cut it off (pipefail)
+grep -q "mip:PRESET\[:LO:HI\]" "$tmp/help.txt" || fail "render --help does not list mip"
+if "$panoptes" render "$tmp/sphere.vtk" --task cube:1 --out "$tmp/e11" 2> "$tmp/err.txt"; then fail "accepted kind cube"; fi
+grep -q "or mip:PRESET" "$tmp/err.txt" || fail "the kind error does not list mip: $(cat "$tmp/err.txt")"
 if "$panoptes" render "$tmp/missing.npy" --out "$tmp/e7" 2> "$tmp/err.txt"; then fail "accepted a missing file"; fi
 grep -q "missing.npy" "$tmp/err.txt" || fail "missing-file error does not name the file"
 # Issue 15: memory and open files are checked before the database exists; a device is not a volume.
