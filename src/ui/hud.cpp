@@ -127,6 +127,10 @@ HudRequests Hud::draw(const HudInfo& info, float vw, float vh) {
       const auto& task = m.tasks[std::size_t(sel.task)];
       ImGui::Text("%s   frame %d of %d   %s x%.2g%s%s", player::time_text(m, info.sim_time).c_str(), sel.frame, info.frame_count,
                   info.playing ? "playing" : "paused", info.speed, info.direction < 0 ? " reverse" : "", info.loop ? "" : " once");
+      // A database written before frame checks cannot prove its frames (issue 44): say so, in amber,
+      // instead of letting a frame that decodes pass for a verified one.
+      if (!m.frame_checks.recorded())
+        ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "frames unverified (written before frame checks)");
       const std::string shell = info.shell_count > 1 ? "   shell " + std::to_string(cam.labels.shell) : "";
       if (!info.position_label.empty())
         ImGui::Text("camera %d   %s%s", sel.camera, info.position_label.c_str(), shell.c_str());

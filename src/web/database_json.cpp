@@ -18,6 +18,10 @@ nlohmann::json database_json(const store::Database& db, const DatabaseJsonOption
   json j;
   j["title"] = m.title;
   j["status"] = std::string(store::to_string(db.status()));
+  // What a frame read as good proves (issue 44): "all", "frames" (parameter sets unverified), "none"
+  // (written before frame checks: the players say its frames are unverified).
+  const auto& fc = db.manifest().frame_checks;
+  j["frames_verified"] = fc.binds_parameter_sets() ? "all" : fc.recorded() ? "frames" : "none";
   std::int64_t frames = db.frame_count();
   if (options.frames_backed >= 0 && options.frames_backed < frames) {
     j["frames_claimed"] = frames;

@@ -505,6 +505,7 @@ function updateHud(frame) {
   }
   const text =
     `${timeText(db, db.times[frame] ?? frame)}  frame ${frame} of ${db.frames}  ${S.playing ? "playing" : "paused"} x${speed}${S.dir < 0 ? " reverse" : ""}${S.loop ? "" : " once"}\n` +
+    (db.frames_verified === "none" ? "frames unverified (written before frame checks)\n" : "") +
     where + "\n" +
     (S.rig.equirect ? (S.rig.walkable ? "" : "360 view  ") + lookText(S.look) + "\n" : "") +
     `task ${S.task + 1} of ${db.tasks.length}: "${task.name}" ${axes}  ${active}\n` +
