@@ -23,6 +23,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel_for.hpp"
 #include "store/atomic_file.hpp"
 #include "store/bounded_json.hpp"
 #include "store/camera_table.hpp"
@@ -62,33 +63,6 @@ bool inside(const fs::path& root, const fs::path& path) {
   for (; r != root.end(); ++r, ++p)
     if (p == path.end() || *r != *p) return false;
   return p != path.end();
-}
-
-// Runs body(i) for i in [0, n) on `threads` threads (the caller is one of them); rethrows the first
-// exception after every thread stopped.
-template <class Body>
-void parallel_for(std::int64_t n, int threads, Body body) {
-  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = int(std::min<std::int64_t>(threads, std::max<std::int64_t>(n, 1)));
-  std::atomic<std::int64_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (std::int64_t i; (i = next.fetch_add(1)) < n;) {
-      try {
-        body(i);
-      } catch (...) {
-        std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = n;  // stop handing out work
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
 }
 
 // 64 random bits as 16 lowercase hex digits: the database's identity in every frame it writes.
