@@ -24,6 +24,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/parallel_for.hpp"
+#include "core/utc_time.hpp"
 #include "store/atomic_file.hpp"
 #include "store/bounded_json.hpp"
 #include "store/camera_table.hpp"
@@ -42,16 +43,6 @@ namespace {
 std::string host_name() {
   char buf[256] = {};
   if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
-  return buf;
-}
-
-// Current UTC time as ISO 8601, e.g. "2026-11-21T22:40:00Z".
-std::string utc_now_iso8601() {
-  char buf[32];
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
 
