@@ -1,3 +1,15 @@
+// Importing a Cinema database: plan_import (the table -> a manifest and image files), import_cinema.
+// Sections (each marked "// --- name ---" below):
+//   helpers     columns, numbers, sky angles, the sidecar Panoptes' own export writes
+//   planner     ImportPlanner: what plan_import's steps share
+//   frames      the distinct times
+//   convention  the producer's phi/theta convention
+//   cameras     cameras by id column or by distinct angles
+//   tasks       tasks from the group-by columns
+//   manifest    the manifest's header, axes and task entries, or the sidecar's
+//   images      every view's image, once, all of one size
+//   geometry    camera positions, the navigation graph, the rig
+//   import      plan_import runs the steps; import_cinema encodes the images
 #include "cinema/import.hpp"
 
 #include <algorithm>
@@ -23,6 +35,7 @@
 namespace panoptes::cinema {
 namespace fs = std::filesystem;
 
+// --- helpers ---
 namespace {
 
 std::string lower(std::string s) {
@@ -81,6 +94,7 @@ Sidecar read_sidecar(const CinemaTable& t) {
   return s;
 }
 
+// --- planner ---
 // The steps of plan_import, in the order it takes them; each reads what the ones before it found.
 struct ImportPlanner {
   struct Cam {
@@ -119,6 +133,7 @@ struct ImportPlanner {
   void place_cameras();
 };
 
+// --- frames ---
 void ImportPlanner::read_frames() {
   // ---- frames: the distinct times, ascending --------------------------------------------------
   std::vector<double> row_time(rows, 0.0);
@@ -132,6 +147,7 @@ void ImportPlanner::read_frames() {
     row_frame[r] = int(std::lower_bound(times.begin(), times.end(), row_time[r]) - times.begin());
 }
 
+// --- convention ---
 void ImportPlanner::detect_convention() {
   // ---- the phi/theta convention ---------------------------------------------------------------------
   angles.assign(rows, {0.0, 0.0});
@@ -162,6 +178,7 @@ void ImportPlanner::detect_convention() {
   }
 }
 
+// --- cameras ---
 void ImportPlanner::find_cameras() {
   // ---- cameras: by the camera column, else by distinct (phi, theta[, shell]) ---------------------
   row_camera.resize(rows);
@@ -221,6 +238,7 @@ void ImportPlanner::find_cameras() {
   }
 }
 
+// --- tasks ---
 void ImportPlanner::group_tasks() {
   // ---- tasks: distinct combinations of the group-by columns ----------------------------------------
   auto is_camera_col = [&](int c) { return c == c_time || c == c_phi || c == c_theta || c == c_camera || c == c_shell; };
@@ -270,6 +288,7 @@ void ImportPlanner::group_tasks() {
   }
 }
 
+// --- manifest ---
 void ImportPlanner::start_manifest() {
   plan.spec = t.spec;
   m.title = o.title.empty() ? "Cinema database " + fs::absolute(cdb).lexically_normal().filename().string() : o.title;
@@ -380,6 +399,7 @@ void ImportPlanner::adopt_sidecar_tasks() {
   }
 }
 
+// --- images ---
 void ImportPlanner::find_images() {
   // ---- every (camera, task, frame) exactly once; memory linear in the rows -------------------------
   const std::size_t nc = cams.size(), nt = task_keys.size(), nf = times.size();
@@ -436,6 +456,7 @@ void ImportPlanner::find_images() {
   m.image.height = height;
 }
 
+// --- geometry ---
 void ImportPlanner::place_cameras() {
   const std::size_t nc = cams.size();
   // ---- camera geometry -----------------------------------------------------------------------------
@@ -509,6 +530,7 @@ void ImportPlanner::place_cameras() {
 
 }  // namespace
 
+// --- import ---
 ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   ImportPlanner s(cdb, o);
   s.read_frames();

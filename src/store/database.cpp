@@ -1,3 +1,12 @@
+// The movie database on disk: DatabaseWriter (create, append, checkpoint, finalize, resume) and
+// Database (open, read, validate).
+// Sections (each marked "// --- name ---" below):
+//   helpers     host name, locks, paths inside the root, the database id, frame checks on disk,
+//               removing an overwritten database
+//   writer      DatabaseWriter::Impl and create, append, close, times, notes, checkpoints, finalize
+//   resume      DatabaseWriter::resume: continuing a database after a restart
+//   reader      writer liveness, Database::open, streams resolved inside the directory, frame checks
+//   validation  movie identities and validate_streams
 #include "store/database.hpp"
 
 #include <fcntl.h>
@@ -38,6 +47,7 @@ namespace panoptes::store {
 
 namespace fs = std::filesystem;
 
+// --- helpers ---
 namespace {
 
 std::string host_name() {
@@ -92,7 +102,7 @@ void remove_old_database_files(int dir_fd, const fs::path& dir, std::string* old
 
 }  // namespace
 
-// ---- writer ----------------------------------------------------------------------------------
+// --- writer ---
 
 struct DatabaseWriter::Impl {
   struct Stream {
@@ -425,7 +435,7 @@ void DatabaseWriter::finalize(int frames_written) {
 const Manifest& DatabaseWriter::manifest() const { return impl_->manifest; }
 const fs::path& DatabaseWriter::dir() const { return impl_->dir; }
 
-// ---- resume (continuing a database after a restart) --------------------------------------------
+// --- resume ---
 
 DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, const WriterOptions& options, int frames) {
   std::error_code ec;
@@ -557,7 +567,7 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
   return DatabaseWriter(std::move(impl));
 }
 
-// ---- reader ----------------------------------------------------------------------------------
+// --- reader ---
 
 bool writer_is_alive(const fs::path& dir) {
   // No link, FIFO or device is opened (a FIFO planted at the lock would block a plain open forever).
@@ -700,6 +710,7 @@ std::vector<int> Database::damaged_frames(int camera, int task) const {
   return bad;
 }
 
+// --- validation ---
 video::MovieIdentity movie_identity(const Manifest& manifest, int camera, int task) {
   video::MovieIdentity id{};
   const std::string& hex = manifest.frame_checks.database_id;

@@ -1,3 +1,14 @@
+// run_window: the SDL2 + Dear ImGui front end over player::Engine.
+// Sections (each marked "// --- name ---" below):
+//   clocks        wall time; time tags for file names
+//   window state  WindowApp and what it keeps between frames
+//   script        scripted commands and their trace
+//   actions       zoom, facing the action, a step toward a click, the key dispatch
+//   events        SDL events: keys, wheel, drags, clicks, resizes
+//   hud           the value readout, HUD requests and statistics, what the HUD shows
+//   outputs       file names, recording (recorder.hpp), screenshots
+//   frame loop    WindowApp::run: events, upload, draw, record, the session's summary
+//   entry         run_window: checks before any window opens, the window's size
 #include "ui/window_app.hpp"
 
 #include <SDL.h>
@@ -38,6 +49,7 @@
 #include "ui/yuv_texture.hpp"
 
 namespace panoptes::ui {
+// --- clocks ---
 namespace {
 
 double wall_seconds() {
@@ -55,6 +67,7 @@ std::string time_tag() {
   return buf;
 }
 
+// --- window state ---
 class WindowApp {
  public:
   WindowApp(player::Engine& engine, SdlWindow& window, const WindowOptions& options,
@@ -159,6 +172,7 @@ class WindowApp {
   std::vector<double> upload_ms_, draw_ms_;
 };
 
+// --- script ---
 void WindowApp::run_due_script_commands() {
   using Kind = player::ScriptCommand::Kind;
   const double t = now();
@@ -196,6 +210,7 @@ void WindowApp::write_trace(const player::ScriptCommand& c) {
   trace_->write(player::trace_step(trace_step_++, c, engine_, controls_, last_refusal_));
 }
 
+// --- actions ---
 void WindowApp::zoom_by(double factor) {
   int mx = 0, my = 0;
   const Uint32 focus = SDL_GetWindowFlags(window_.window()) & SDL_WINDOW_MOUSE_FOCUS;
@@ -275,6 +290,7 @@ void WindowApp::do_action(player::Action action) {
   }
 }
 
+// --- events ---
 void WindowApp::handle_event(const SDL_Event& e) {
   ImGui_ImplSDL2_ProcessEvent(&e);
   const ImGuiIO& io = ImGui::GetIO();
@@ -342,6 +358,7 @@ void WindowApp::handle_event(const SDL_Event& e) {
   }
 }
 
+// --- hud ---
 // The value under the cursor when the shown task is a slice (player/value_readout.hpp): read from the
 // decoded pixel and the frame's recorded scale, shown beside the pointer. Perspective frames only: in a
 // 360° cut-out the window pixel is a resampled mix of frame pixels.
@@ -458,6 +475,7 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   return h;
 }
 
+// --- outputs ---
 std::filesystem::path WindowApp::output_path(const std::string& stem, const char* ext) const {
   std::error_code ec;
   std::filesystem::create_directories(options_.output_dir, ec);
@@ -500,6 +518,7 @@ void WindowApp::save_screenshot(const Image& picture) {
   }
 }
 
+// --- frame loop ---
 WindowResult WindowApp::run() {
   WindowResult result;
   const double frame_period = 1.0 / engine_.fps();
@@ -689,6 +708,7 @@ WindowResult WindowApp::run() {
 
 }  // namespace
 
+// --- entry ---
 WindowResult run_window(const std::filesystem::path& db, const WindowOptions& options) {
   // The database and script are checked before any window opens, so their errors need no display.
   std::vector<player::ScriptCommand> script;
