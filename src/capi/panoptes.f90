@@ -1,3 +1,16 @@
+! module panoptes: the C API for Fortran.
+! Sections (each marked "! --- name ---" below):
+!   names          public names, return codes, the session handle
+!   c bindings     the C API's functions as bind(c) interfaces
+!   generics       one name per routine over real(4)/real(8) and integer(4)/integer(8)
+!   errors         the last message, which ranks print, check
+!   session        panoptes_open
+!   grids          uniform, rectilinear, spherical, Yin-Yang; patch, resample
+!   decomposition  this rank's block and its halo
+!   fields         arrays bound in place, their strides measured
+!   steps          process, due, snapshot
+!   close          panoptes_close
+!
 ! Fortran interface to the Panoptes C API (include/panoptes.h) through iso_c_binding. Standard Fortran
 ! 2008 only (no compiler-specific descriptor layout): this source is installed as
 ! share/panoptes/fortran/panoptes.f90, so any compiler (gfortran, Intel, NVHPC, Cray, Fujitsu...) can
@@ -28,6 +41,7 @@
 ! then accepts only a variable (a whole array, a section or a pointer), never an expression or a
 ! vector-subscripted section, which it would pass as a temporary that is freed when the call returns.
 ! Give the array the TARGET (or POINTER) attribute and keep it allocated while it is bound.
+! --- names ---
 module panoptes
   use, intrinsic :: iso_c_binding
   use, intrinsic :: iso_fortran_env, only: int32, int64, real32, real64
@@ -52,6 +66,7 @@ module panoptes
     type(c_ptr) :: handle = c_null_ptr
   end type
 
+  ! --- c bindings ---
   interface
     integer(c_int) function c_create(config, is_file, comm, out) bind(c, name='panoptes_create')
       import :: c_int, c_char, c_ptr
@@ -153,6 +168,7 @@ module panoptes
     end function
   end interface
 
+  ! --- generics ---
   !> The global grid: origin and spacing real(4) or real(8).
   interface panoptes_grid
     module procedure grid_r4, grid_r8
@@ -196,6 +212,7 @@ module panoptes
 
 contains
 
+  ! --- errors ---
   !> The message of the last error ('' if none).
   function panoptes_error_message() result(msg)
     character(len=:), allocatable :: msg
@@ -230,6 +247,7 @@ contains
     end if
   end subroutine
 
+  ! --- session ---
   !> Creates a session from a TOML file; comm is an MPI communicator (or PANOPTES_COMM_WORLD).
   subroutine panoptes_open(s, config_file, comm, ierr)
     type(panoptes_t), intent(out) :: s
@@ -239,6 +257,7 @@ contains
     call check(c_create(trim(config_file)//c_null_char, 1_c_int, int(comm, c_int), s%handle), ierr)
   end subroutine
 
+  ! --- grids ---
   subroutine grid_r4(s, dims, origin, spacing, ierr)
     type(panoptes_t), intent(in) :: s
     integer, intent(in) :: dims(3)
@@ -332,6 +351,7 @@ contains
     call check(c_set_resample(s%handle, int(longest_axis_points, c_int), v), ierr)
   end subroutine
 
+  ! --- decomposition ---
   !> This rank's owned points (0-based offset, extent) and the ghost layers its arrays STORE below / above.
   subroutine panoptes_block(s, offset, extent, ghost_lo, ghost_hi, ierr)
     type(panoptes_t), intent(in) :: s
@@ -356,6 +376,7 @@ contains
     call check(c_set_halo(s%handle, int(valid_lo, c_int), int(valid_hi, c_int), edges), ierr)
   end subroutine
 
+  ! --- fields ---
   ! Elements between two addresses (the array's own strides, whatever the compiler's descriptor).
   integer(c_long_long) function distance(p, q, bytes)
     type(c_ptr), intent(in) :: p, q
@@ -437,6 +458,7 @@ contains
     call field_r8(s, name, a, ierr, order)
   end subroutine
 
+  ! --- steps ---
   subroutine do_step(s, step, time, taken, ierr)
     type(panoptes_t), intent(in) :: s
     integer(c_long_long), intent(in) :: step
@@ -535,6 +557,7 @@ contains
     call check(c_snapshot(s%handle, real(time, c_double)), ierr)
   end subroutine
 
+  ! --- close ---
   !> Finalizes (database complete) and frees the session.
   subroutine panoptes_close(s, ierr)
     type(panoptes_t), intent(inout) :: s

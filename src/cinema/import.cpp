@@ -1,3 +1,15 @@
+// Importing a Cinema database: plan_import (the table -> a manifest and image files), import_cinema.
+// Sections (each marked "// --- name ---" below):
+//   helpers     columns, numbers, sky angles, the sidecar Panoptes' own export writes
+//   planner     ImportPlanner: what plan_import's steps share
+//   frames      the distinct times
+//   convention  the producer's phi/theta convention
+//   cameras     cameras by id column or by distinct angles
+//   tasks       tasks from the group-by columns
+//   manifest    the manifest's header, axes and task entries, or the sidecar's
+//   images      every view's image, once, all of one size
+//   geometry    camera positions, the navigation graph, the rig
+//   import      plan_import runs the steps; import_cinema encodes the images
 #include "cinema/import.hpp"
 
 #include <algorithm>
@@ -23,6 +35,7 @@
 namespace panoptes::cinema {
 namespace fs = std::filesystem;
 
+// --- helpers ---
 namespace {
 
 std::string lower(std::string s) {
@@ -81,29 +94,63 @@ Sidecar read_sidecar(const CinemaTable& t) {
   return s;
 }
 
-}  // namespace
-
-ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
-  const CinemaTable t = read_cinema_database(cdb);
+// --- planner ---
+// The steps of plan_import, in the order it takes them; each reads what the ones before it found.
+struct ImportPlanner {
+  struct Cam {
+    double phi = 0, theta = 0;
+    std::size_t first_row = 0;
+  };
+  ImportPlanner(const fs::path& cdb, const ImportOptions& o) : cdb(cdb), o(o), t(read_cinema_database(cdb)) {}
+  const fs::path& cdb;
+  const ImportOptions& o;
+  const CinemaTable t;
   const Sidecar side = read_sidecar(t);
   const std::size_t rows = t.files.size();
   const int c_time = find_column(t, "time"), c_phi = find_column(t, "phi"), c_theta = find_column(t, "theta"),
             c_camera = find_column(t, "camera"), c_shell = side.present ? find_column(t, "shell") : -1;
-  auto is_camera_col = [&](int c) { return c == c_time || c == c_phi || c == c_theta || c == c_camera || c == c_shell; };
+  std::vector<double> times;            // frames: the distinct times, ascending
+  std::vector<int> row_frame;           // per row
+  std::vector<std::pair<double, double>> angles;  // per row: phi, theta
+  CameraModel model;                    // the producer's convention (no sidecar)
+  std::vector<Cam> cams;
+  std::vector<int> row_camera;          // per row
+  std::vector<int> group;               // the columns that tell tasks apart
+  std::vector<bool> numeric;            // per group column
+  std::vector<std::vector<std::string>> task_keys;
+  std::vector<int> row_task;            // per row
+  ImportPlan plan;
+  store::Manifest& m = plan.manifest;
 
+  void read_frames();
+  void detect_convention();
+  void find_cameras();
+  void group_tasks();
+  void start_manifest();
+  void name_tasks();
+  void adopt_sidecar_tasks();
+  void find_images();
+  void place_cameras();
+};
+
+// --- frames ---
+void ImportPlanner::read_frames() {
   // ---- frames: the distinct times, ascending --------------------------------------------------
   std::vector<double> row_time(rows, 0.0);
   if (c_time >= 0)
     for (std::size_t r = 0; r < rows; ++r) row_time[r] = number_at(t, r, c_time, "time");
-  std::vector<double> times(row_time);
+  times = row_time;
   std::sort(times.begin(), times.end());
   times.erase(std::unique(times.begin(), times.end()), times.end());
-  std::vector<int> row_frame(rows);
+  row_frame.resize(rows);
   for (std::size_t r = 0; r < rows; ++r)
     row_frame[r] = int(std::lower_bound(times.begin(), times.end(), row_time[r]) - times.begin());
+}
 
+// --- convention ---
+void ImportPlanner::detect_convention() {
   // ---- the phi/theta convention ---------------------------------------------------------------------
-  std::vector<std::pair<double, double>> angles(rows, {0.0, 0.0});
+  angles.assign(rows, {0.0, 0.0});
   std::vector<double> thetas;
   for (std::size_t r = 0; r < rows; ++r) {
     angles[r].first = c_phi >= 0 ? number_at(t, r, c_phi, "phi") : 0.0;
@@ -112,7 +159,6 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   }
   std::sort(thetas.begin(), thetas.end());
   thetas.erase(std::unique(thetas.begin(), thetas.end()), thetas.end());
-  CameraModel model;
   if (!side.present) {
     ProducerEvidence ev;
     ev.spec = t.spec;
@@ -130,14 +176,12 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
       throw FileError(t.source, e.what());
     }
   }
+}
 
+// --- cameras ---
+void ImportPlanner::find_cameras() {
   // ---- cameras: by the camera column, else by distinct (phi, theta[, shell]) ---------------------
-  struct Cam {
-    double phi = 0, theta = 0;
-    std::size_t first_row = 0;
-  };
-  std::vector<Cam> cams;
-  std::vector<int> row_camera(rows);
+  row_camera.resize(rows);
   if (side.present) {
     const int n = side.m.camera_count();
     // The export prints each label as format_value: match on that text.
@@ -192,9 +236,12 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     }
     for (std::size_t r = 0; r < rows; ++r) row_camera[r] = by_angles[{-angles[r].second, angles[r].first}];
   }
+}
 
+// --- tasks ---
+void ImportPlanner::group_tasks() {
   // ---- tasks: distinct combinations of the group-by columns ----------------------------------------
-  std::vector<int> group;
+  auto is_camera_col = [&](int c) { return c == c_time || c == c_phi || c == c_theta || c == c_camera || c == c_shell; };
   if (o.group_by.empty()) {
     for (std::size_t c = 0; c < t.columns.size(); ++c)
       if (!is_camera_col(int(c))) group.push_back(int(c));
@@ -212,7 +259,7 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
       group.push_back(c);
     }
   }
-  std::vector<bool> numeric(group.size(), true);
+  numeric.assign(group.size(), true);
   for (std::size_t g = 0; g < group.size(); ++g) {
     bool any = false;
     for (std::size_t r = 0; r < rows && numeric[g]; ++r) {
@@ -225,8 +272,7 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     numeric[g] = numeric[g] && any;
   }
   std::map<std::vector<std::string>, int> task_of;
-  std::vector<std::vector<std::string>> task_keys;
-  std::vector<int> row_task(rows);
+  row_task.resize(rows);
   for (std::size_t r = 0; r < rows; ++r) {
     std::vector<std::string> key;
     key.reserve(group.size());
@@ -240,10 +286,11 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     if (inserted) task_keys.push_back(it->first);
     row_task[r] = it->second;
   }
+}
 
-  ImportPlan plan;
+// --- manifest ---
+void ImportPlanner::start_manifest() {
   plan.spec = t.spec;
-  store::Manifest& m = plan.manifest;
   m.title = o.title.empty() ? "Cinema database " + fs::absolute(cdb).lexically_normal().filename().string() : o.title;
   if (m.title == "Cinema database ") m.title = "Cinema database";
   m.provenance.program = "panoptes import-cinema";
@@ -253,7 +300,9 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
   m.provenance.extra["cinema_source"] = fs::absolute(cdb).lexically_normal().string();
   m.times = times;
   m.video = o.video;
+}
 
+void ImportPlanner::name_tasks() {
   // Axes: every numeric group column, its distinct values ascending.
   std::vector<int> axis_of_group(group.size(), -1);
   for (std::size_t g = 0; g < group.size(); ++g) {
@@ -304,6 +353,9 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     }
     m.tasks.push_back(std::move(e));
   }
+}
+
+void ImportPlanner::adopt_sidecar_tasks() {
   if (side.present) {
     // The export's task column holds the task id, or its axis columns the task's axis values; a
     // table whose tasks are exactly the sidecar's keeps the sidecar's names, methods and parameters.
@@ -345,7 +397,10 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
     m.axes = side.m.axes;
     task_keys.assign(m.tasks.size(), {});
   }
+}
 
+// --- images ---
+void ImportPlanner::find_images() {
   // ---- every (camera, task, frame) exactly once; memory linear in the rows -------------------------
   const std::size_t nc = cams.size(), nt = task_keys.size(), nf = times.size();
   std::unordered_map<std::uint64_t, std::int64_t> row_of;
@@ -399,7 +454,11 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
       }
   m.image.width = width;
   m.image.height = height;
+}
 
+// --- geometry ---
+void ImportPlanner::place_cameras() {
+  const std::size_t nc = cams.size();
   // ---- camera geometry -----------------------------------------------------------------------------
   plan.rotated.assign(nc, false);
   if (side.present) {
@@ -467,9 +526,25 @@ ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
       m.rig.parameters["note"] = "the database records no scene: cameras frame a unit box at the origin as the producer frames its scene";
     plan.producer = model.producer + " (" + model.evidence + ")";
   }
-  m.provenance.extra["cinema_producer"] = plan.producer;
-  m.validate();
-  return plan;
+}
+
+}  // namespace
+
+// --- import ---
+ImportPlan plan_import(const fs::path& cdb, const ImportOptions& o) {
+  ImportPlanner s(cdb, o);
+  s.read_frames();
+  s.detect_convention();
+  s.find_cameras();
+  s.group_tasks();
+  s.start_manifest();
+  s.name_tasks();
+  s.adopt_sidecar_tasks();
+  s.find_images();
+  s.place_cameras();
+  s.m.provenance.extra["cinema_producer"] = s.plan.producer;
+  s.m.validate();
+  return std::move(s.plan);
 }
 
 ImportReport import_cinema(const fs::path& cdb, const fs::path& out, const ImportOptions& o,

@@ -1,3 +1,12 @@
+// The movie database on disk: DatabaseWriter (create, append, checkpoint, finalize, resume) and
+// Database (open, read, validate).
+// Sections (each marked "// --- name ---" below):
+//   helpers     host name, locks, paths inside the root, the database id, frame checks on disk,
+//               removing an overwritten database
+//   writer      DatabaseWriter::Impl and create, append, close, times, notes, checkpoints, finalize
+//   resume      DatabaseWriter::resume: continuing a database after a restart
+//   reader      writer liveness, Database::open, streams resolved inside the directory, frame checks
+//   validation  movie identities and validate_streams
 #include "store/database.hpp"
 
 #include <fcntl.h>
@@ -23,6 +32,8 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel_for.hpp"
+#include "core/utc_time.hpp"
 #include "store/atomic_file.hpp"
 #include "store/bounded_json.hpp"
 #include "store/camera_table.hpp"
@@ -36,21 +47,12 @@ namespace panoptes::store {
 
 namespace fs = std::filesystem;
 
+// --- helpers ---
 namespace {
 
 std::string host_name() {
   char buf[256] = {};
   if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
-  return buf;
-}
-
-// Current UTC time as ISO 8601, e.g. "2026-11-21T22:40:00Z".
-std::string utc_now_iso8601() {
-  char buf[32];
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
 
@@ -62,33 +64,6 @@ bool inside(const fs::path& root, const fs::path& path) {
   for (; r != root.end(); ++r, ++p)
     if (p == path.end() || *r != *p) return false;
   return p != path.end();
-}
-
-// Runs body(i) for i in [0, n) on `threads` threads (the caller is one of them); rethrows the first
-// exception after every thread stopped.
-template <class Body>
-void parallel_for(std::int64_t n, int threads, Body body) {
-  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = int(std::min<std::int64_t>(threads, std::max<std::int64_t>(n, 1)));
-  std::atomic<std::int64_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (std::int64_t i; (i = next.fetch_add(1)) < n;) {
-      try {
-        body(i);
-      } catch (...) {
-        std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = n;  // stop handing out work
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
 }
 
 // 64 random bits as 16 lowercase hex digits: the database's identity in every frame it writes.
@@ -127,7 +102,7 @@ void remove_old_database_files(int dir_fd, const fs::path& dir, std::string* old
 
 }  // namespace
 
-// ---- writer ----------------------------------------------------------------------------------
+// --- writer ---
 
 struct DatabaseWriter::Impl {
   struct Stream {
@@ -461,7 +436,7 @@ void DatabaseWriter::finalize(int frames_written) {
 const Manifest& DatabaseWriter::manifest() const { return impl_->manifest; }
 const fs::path& DatabaseWriter::dir() const { return impl_->dir; }
 
-// ---- resume (continuing a database after a restart) --------------------------------------------
+// --- resume ---
 
 DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, const WriterOptions& options, int frames) {
   std::error_code ec;
@@ -593,7 +568,7 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
   return DatabaseWriter(std::move(impl));
 }
 
-// ---- reader ----------------------------------------------------------------------------------
+// --- reader ---
 
 bool writer_is_alive(const fs::path& dir) {
   // No link, FIFO or device is opened (a FIFO planted at the lock would block a plain open forever).
@@ -737,6 +712,7 @@ std::vector<int> Database::damaged_frames(int camera, int task) const {
   return bad;
 }
 
+// --- validation ---
 video::MovieIdentity movie_identity(const Manifest& manifest, int camera, int task) {
   video::MovieIdentity id{};
   const std::string& hex = manifest.frame_checks.database_id;

@@ -16,6 +16,7 @@
 #include "core/stop_request.hpp"
 #include "core/version.hpp"
 #include "core/frame_stamp.hpp"
+#include "core/parallel_for.hpp"
 #include "store/database.hpp"
 
 namespace panoptes::store {
@@ -191,48 +192,30 @@ void write_synthetic_database(const std::filesystem::path& dir, const SyntheticO
   w.overwrite_option = o.overwrite_option;
   DatabaseWriter writer = DatabaseWriter::create(dir, m, w);
   const std::int64_t total = m.stream_count();
-  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = int(std::min<std::int64_t>(threads, total));
-  std::atomic<std::int64_t> next{0}, done{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
+  std::atomic<std::int64_t> done{0};
   // Stream after stream per thread: each movie is written whole and closed, so at most `threads`
-  // encoders are alive at once whatever the number of streams.
-  auto work = [&] {
+  // encoders are alive at once whatever the number of streams. A stop request (SIGINT/SIGTERM)
+  // abandons the remaining streams (see core/stop_request.hpp).
+  auto work = [&](std::int64_t s) {
+    if (stop_requested()) return;
     Image img(o.width, o.height, 4);
-    for (std::int64_t s; (s = next.fetch_add(1)) < total;) {
-      if (stop_requested()) {  // SIGINT/SIGTERM: abandon the remaining streams (see core/stop_request.hpp)
-        next = total;
-        break;
-      }
-      const int tasks = int(m.tasks.size());
-      const int camera = int(s / tasks), task = int(s % tasks);
-      try {
-        for (int f = 0; f < o.frames; ++f) {
-          draw_synthetic_frame(img, camera, task, f);
-          writer.append(camera, task, img);
-        }
-        writer.close_stream(camera, task);
-      } catch (...) {
-        std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = total;
-      }
-      ++done;
+    const int tasks = int(m.tasks.size());
+    const int camera = int(s / tasks), task = int(s % tasks);
+    for (int f = 0; f < o.frames; ++f) {
+      draw_synthetic_frame(img, camera, task, f);
+      writer.append(camera, task, img);
     }
+    writer.close_stream(camera, task);
+    ++done;
   };
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) pool.emplace_back(work);
-  if (progress) {
-    while (done.load() < total) {
+  std::function<bool()> report;
+  if (progress)
+    report = [&] {
+      if (done.load() >= total || stop_requested()) return false;
       progress(done.load(), total);
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      std::lock_guard lock(error_mutex);
-      if (error || stop_requested()) break;
-    }
-  }
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);  // the writer's destructor marks the database interrupted
+      return true;
+    };
+  parallel_for(total, o.threads, work, report);  // rethrows; the writer's destructor marks the database interrupted
   if (const int sig = stop_requested())
     throw Interrupted(sig, dir.string() + ": stopped by " + signal_name(sig) + " after " + std::to_string(done.load()) +
                                " of " + std::to_string(total) + " streams; the database is marked interrupted");

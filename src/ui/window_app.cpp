@@ -1,3 +1,14 @@
+// run_window: the SDL2 + Dear ImGui front end over player::Engine.
+// Sections (each marked "// --- name ---" below):
+//   clocks        wall time; time tags for file names
+//   window state  WindowApp and what it keeps between frames
+//   script        scripted commands and their trace
+//   actions       zoom, facing the action, a step toward a click, the key dispatch
+//   events        SDL events: keys, wheel, drags, clicks, resizes
+//   hud           the value readout, HUD requests and statistics, what the HUD shows
+//   outputs       file names, recording (recorder.hpp), screenshots
+//   frame loop    WindowApp::run: events, upload, draw, record, the session's summary
+//   entry         run_window: checks before any window opens, the window's size
 #include "ui/window_app.hpp"
 
 #include <SDL.h>
@@ -6,10 +17,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <condition_variable>
-#include <deque>
-#include <mutex>
-#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -35,13 +42,14 @@
 #include "ui/hud.hpp"
 #include "ui/hud_text.hpp"
 #include "ui/input_latency.hpp"
+#include "ui/recorder.hpp"
 #include "ui/sdl_keys.hpp"
 #include "ui/sdl_window.hpp"
 #include "ui/view_transform.hpp"
 #include "ui/yuv_texture.hpp"
-#include "video/movie_writer.hpp"
 
 namespace panoptes::ui {
+// --- clocks ---
 namespace {
 
 double wall_seconds() {
@@ -59,138 +67,7 @@ std::string time_tag() {
   return buf;
 }
 
-/// Recording "what is shown": the window's picture (without the HUD) sampled at the database's frame
-/// rate into an MP4 of the window's size at the start of the recording. The movie lasts as long as
-/// the recording did: movie frame i stands for the moment start + i / fps, and when the display draws
-/// fewer pictures per second than that (a slow machine, a large window) each picture is repeated over
-/// the frame periods it was shown for, and the last one until the recording stops. Encoding runs on
-/// its own thread so the display keeps its frame rate; the display thread only reads the pixels back.
-class Recorder {
- public:
-  ~Recorder() {
-    try {
-      stop();
-    } catch (...) {
-    }
-  }
-  bool active() const { return writer_ != nullptr; }
-  const std::string& path() const { return path_; }
-
-  void start(const std::filesystem::path& path, int width, int height, double fps, double now) {
-    video::VideoSettings settings;
-    settings.fps = fps;
-    settings.crf = 20;
-    settings.gop = std::max(1, int(std::lround(fps)));
-    writer_ = std::make_unique<video::MovieWriter>(path.string(), width, height, settings);
-    path_ = path.string();
-    width_ = width;
-    height_ = height;
-    period_ = 1.0 / fps;
-    start_ = now;
-    queued_ = 0;
-    stopping_ = false;
-    error_.clear();
-    encoder_ = std::thread([this] { encode_loop(); });
-  }
-  /// True if a frame is due at `now` (the caller then reads the pixels and calls add()).
-  bool due(double now) const { return writer_ && slots_until(now) > queued_; }
-  bool size_matches(int width, int height) const { return width == width_ && height == height_; }
-  /// Queues a picture for encoding, as every movie frame due by `now` not yet queued. Blocks only
-  /// while kMaxQueued pictures wait (a display much faster than the encoder then slows to the
-  /// encoder's pace rather than dropping recorded frames). Throws panoptes::Error if the encoder
-  /// thread failed (e.g. disk full).
-  void add(Image picture, double now) {
-    const std::int64_t repeat = std::max<std::int64_t>(1, slots_until(now) - queued_);
-    push({std::move(picture), repeat});
-  }
-  /// Holds the last picture until `now` (when given: the moment the user stopped), encodes what is
-  /// queued, closes the movie; returns the number of frames written. Throws panoptes::Error /
-  /// FileError if encoding or closing failed.
-  int stop(double now = -1) {
-    if (!writer_) return 0;
-    // Frames whose moment lies before `now`: ceil((now - start) / period), less a hair of rounding.
-    const std::int64_t held = now >= start_ ? std::int64_t(std::ceil((now - start_) / period_ - 1e-6)) - queued_ : 0;
-    {
-      std::lock_guard lock(mutex_);
-      if (held > 0 && queued_ > 0 && error_.empty()) {
-        queue_.push_back({Image(), held});  // an empty picture repeats the previous one
-        queued_ += held;
-      }
-      stopping_ = true;
-    }
-    work_.notify_one();
-    encoder_.join();
-    auto w = std::move(writer_);
-    const int n = w->frames_written();
-    std::string err;
-    {
-      std::lock_guard lock(mutex_);
-      err = error_;
-      queue_.clear();
-    }
-    if (!err.empty()) throw Error(err);
-    w->close();
-    return n;
-  }
-
- private:
-  static constexpr std::size_t kMaxQueued = 4;
-  struct Queued {
-    Image picture;  // empty: the previous picture again
-    std::int64_t repeat = 1;
-  };
-
-  // Movie frames whose moment start + i * period is at or before `now` (with a hair of tolerance, so
-  // a virtual clock ticking exactly once per period gives exactly one frame per tick).
-  std::int64_t slots_until(double now) const { return std::int64_t(std::floor((now - start_) / period_ + 1e-6)) + 1; }
-
-  void push(Queued q) {
-    std::unique_lock lock(mutex_);
-    space_.wait(lock, [&] { return queue_.size() < kMaxQueued || !error_.empty(); });
-    if (!error_.empty()) throw Error(error_);
-    queued_ += q.repeat;
-    queue_.push_back(std::move(q));
-    work_.notify_one();
-  }
-
-  void encode_loop() {
-    Image last;
-    for (;;) {
-      Queued q;
-      {
-        std::unique_lock lock(mutex_);
-        work_.wait(lock, [&] { return !queue_.empty() || stopping_; });
-        if (queue_.empty()) return;  // stopping and drained
-        q = std::move(queue_.front());
-        queue_.pop_front();
-      }
-      space_.notify_one();
-      try {
-        if (q.picture.width > 0) last = std::move(q.picture);
-        for (std::int64_t i = 0; i < q.repeat && last.width > 0; ++i) writer_->append(last);
-      } catch (const std::exception& ex) {
-        std::lock_guard lock(mutex_);
-        error_ = std::string("recording ") + path_ + ": " + ex.what();
-        queue_.clear();
-        space_.notify_all();
-        return;
-      }
-    }
-  }
-
-  std::unique_ptr<video::MovieWriter> writer_;
-  std::string path_;
-  int width_ = 0, height_ = 0;
-  double period_ = 1.0 / 30, start_ = 0;
-  std::int64_t queued_ = 0;  // movie frames queued so far (display thread only)
-  std::thread encoder_;
-  std::mutex mutex_;
-  std::condition_variable work_, space_;
-  std::deque<Queued> queue_;
-  bool stopping_ = false;
-  std::string error_;
-};
-
+// --- window state ---
 class WindowApp {
  public:
   WindowApp(player::Engine& engine, SdlWindow& window, const WindowOptions& options,
@@ -295,6 +172,7 @@ class WindowApp {
   std::vector<double> upload_ms_, draw_ms_;
 };
 
+// --- script ---
 void WindowApp::run_due_script_commands() {
   using Kind = player::ScriptCommand::Kind;
   const double t = now();
@@ -332,6 +210,7 @@ void WindowApp::write_trace(const player::ScriptCommand& c) {
   trace_->write(player::trace_step(trace_step_++, c, engine_, controls_, last_refusal_));
 }
 
+// --- actions ---
 void WindowApp::zoom_by(double factor) {
   int mx = 0, my = 0;
   const Uint32 focus = SDL_GetWindowFlags(window_.window()) & SDL_WINDOW_MOUSE_FOCUS;
@@ -411,6 +290,7 @@ void WindowApp::do_action(player::Action action) {
   }
 }
 
+// --- events ---
 void WindowApp::handle_event(const SDL_Event& e) {
   ImGui_ImplSDL2_ProcessEvent(&e);
   const ImGuiIO& io = ImGui::GetIO();
@@ -478,6 +358,7 @@ void WindowApp::handle_event(const SDL_Event& e) {
   }
 }
 
+// --- hud ---
 // The value under the cursor when the shown task is a slice (player/value_readout.hpp): read from the
 // decoded pixel and the frame's recorded scale, shown beside the pointer. Perspective frames only: in a
 // 360° cut-out the window pixel is a resampled mix of frame pixels.
@@ -594,6 +475,7 @@ HudInfo WindowApp::gather_hud_info(const player::ShownFrame& shown) {
   return h;
 }
 
+// --- outputs ---
 std::filesystem::path WindowApp::output_path(const std::string& stem, const char* ext) const {
   std::error_code ec;
   std::filesystem::create_directories(options_.output_dir, ec);
@@ -636,6 +518,7 @@ void WindowApp::save_screenshot(const Image& picture) {
   }
 }
 
+// --- frame loop ---
 WindowResult WindowApp::run() {
   WindowResult result;
   const double frame_period = 1.0 / engine_.fps();
@@ -825,6 +708,7 @@ WindowResult WindowApp::run() {
 
 }  // namespace
 
+// --- entry ---
 WindowResult run_window(const std::filesystem::path& db, const WindowOptions& options) {
   // The database and script are checked before any window opens, so their errors need no display.
   std::vector<player::ScriptCommand> script;

@@ -1,3 +1,12 @@
+// MovieReader: exact random access into an H.264 fragmented MP4 through a packet index.
+// Sections (each marked "// --- name ---" below):
+//   limits       packet records; what a movie may make FFmpeg allocate
+//   state        MovieReader::Impl: the packet index, the decoder's position, damage since the last seek
+//   file access  the readable prefix of the file and FFmpeg's I/O callbacks
+//   index        build_index: one demux at open, packets in decode order, frames by pts
+//   decoding     packet checks, send, seek, decode one frame, export YUV
+//   public API   open, crop, sizes, keyframes, frame checks, raw packets, read
+//   rgba         frames as RGBA images
 #include "video/movie_reader.hpp"
 
 extern "C" {
@@ -24,6 +33,7 @@ extern "C" {
 
 namespace panoptes::video {
 
+// --- limits ---
 namespace {
 
 struct PacketInfo {
@@ -46,6 +56,7 @@ constexpr int kMaxMovieStreams = 16;
 
 }  // namespace
 
+// --- state ---
 struct MovieReader::Impl {
   std::string path;
   int fd = -1;
@@ -101,6 +112,7 @@ struct MovieReader::Impl {
     return int(it - frame_pts.begin());
   }
 
+  // --- file access ---
   // Bytes of the file the demuxer may see. For an MP4 this is the file up to its last complete
   // top-level box, plus a trailing mdat that was cut short (its complete samples are usable); a
   // fragment header (moof) cut short would make FFmpeg refuse the whole file, so it is hidden.
@@ -159,6 +171,7 @@ struct MovieReader::Impl {
     return m->view_pos;
   }
 
+  // --- index ---
   void build_index() {
     // O_NONBLOCK: a FIFO in place of a movie must not block the open (it is refused just below).
     fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
@@ -340,6 +353,7 @@ struct MovieReader::Impl {
     }
   }
 
+  // --- decoding ---
   // True if packet k's bytes pass the checks; else sets bad_reason.
   bool packet_ok(int k, const std::uint8_t* data) {
     const PacketInfo& pi = packets[std::size_t(k)];
@@ -513,6 +527,7 @@ struct MovieReader::Impl {
   }
 };
 
+// --- public API ---
 MovieReader::MovieReader(const std::string& path, const FrameChecks& checks) : impl_(std::make_unique<Impl>()) {
   quiet_ffmpeg_logs();
   impl_->path = path;
@@ -620,6 +635,7 @@ void MovieReader::read(int index, YuvFrame& out) {
   impl_->export_yuv(out);
 }
 
+// --- rgba ---
 Image MovieReader::read_rgba(int index) {
   read(index, impl_->scratch);
   return to_rgba(impl_->scratch);

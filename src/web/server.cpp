@@ -22,6 +22,7 @@
 #include <tuple>
 
 #include "core/error.hpp"
+#include "core/utc_time.hpp"
 #include "store/database.hpp"
 #include "web/bounded_http_server.hpp"
 #include "web/connection_threads.hpp"
@@ -46,15 +47,6 @@ std::string content_type(const fs::path& p) {
   if (ext == ".png") return "image/png";
   if (ext == ".svg") return "image/svg+xml";
   return "application/octet-stream";
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 /// Compares without an early exit, so the time taken does not tell how much of a guess was right.
@@ -203,7 +195,7 @@ struct Server::Impl {
   /// line is made; this catches a line break from anywhere else (an error message quoting a file).
   void log(const std::string& line) const {
     if (!options.log) return;
-    std::string out = utc_now() + " ";
+    std::string out = utc_now_iso8601() + " ";
     for (const char c : line) {
       if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
         out += escape_for_log(std::string_view(&c, 1));

@@ -2,6 +2,19 @@
 // over `panoptes serve` or a static export. Decoding: WebCodecs + mp4box.js (movies.js). Prefetch:
 // the current stream and every neighbour are kept decoded a few frames past the playhead, in step
 // with playback (pump() below), so a switch finds its frame decoded.
+// Sections (each marked "// --- name ---" below):
+//   state       imports, the page's elements, the player's state S, streams
+//   clock       time stays continuous through switches (engine_ops.js, as player::Engine's)
+//   navigation  graph neighbours and select()
+//   prefetch    the pump that keeps every reachable stream decoded ahead
+//   drawing     placeholders, the flat or 360° picture, the frame loop
+//   hud         the heads-up text and legend
+//   readout     the value under the cursor of a slice task (readout_hover.js, issue 41)
+//   minimap     sphere_map.js around the data, lattice_map.js inside it; a click picks a camera
+//   input       keys (keys.json: the engine's operations and the page's OPS), wheel, drag, help
+//   start       the key table, the mode, the mini-map, main()
+
+// --- state ---
 import { FrameCache, Stream, traffic, mark } from "./movies.js";
 import { DragRotation, cameraDirections, nearestCamera } from "./drag.js";
 import { camerasFromJson, parseCameraTable, MoveTrail } from "./cameras.js";
@@ -105,10 +118,10 @@ function stream(camera, task) {
   return s;
 }
 
-// ---- clock: time stays continuous through switches (engine_ops.js, as player::Engine's) ----------
+// --- clock ---
 const { currentFrame, setFrame, setPlaying } = makeClock(S);
 
-// ---- navigation ---------------------------------------------------------------------------------
+// --- navigation ---
 const COLUMNS = ["left", "right", "up", "down", "in", "out"];
 const trail = new MoveTrail();  // the arrow keys' moves, so the opposite key retraces them
 function graphNeighbour(camera, direction) {
@@ -175,7 +188,7 @@ function select(camera, task, command) {
   return true;
 }
 
-// ---- prefetch: a pump, not a queue ------------------------------------------------------------
+// --- prefetch ---
 // Every display frame (and at once after a key) the pump looks at the streams a switch can reach:
 // the current one first, then every neighbour. A stream whose decoded frames do not reach `ahead`
 // frames past the playhead gets its next batch started — unless it already has one in flight (its
@@ -310,7 +323,7 @@ function pump() {
     }
 }
 
-// ---- drawing ------------------------------------------------------------------------------------
+// --- drawing ---
 function drawPlaceholder(camera, task, status, message) {
   showSurface("flat");
   const w = canvas.width, h = canvas.height;
@@ -481,6 +494,7 @@ function render(now) {
   updateHud(frame);
 }
 
+// --- hud ---
 function updateHud(frame) {
   const db = S.db, c = S.camera, task = db.tasks[S.task];
   const last = S.switches.findLast((w) => w.ms !== null);
@@ -520,10 +534,10 @@ function updateHud(frame) {
 }
 let lastHud = "", lastLegend = "";
 
-// ---- the value under the cursor of a slice task: readout_hover.js (issue 41) ----
+// --- readout ---
 const { readoutAt, updateReadout } = installReadoutHover({ S, canvas, cache, isLookView: () => lookView });
 
-// ---- mini-map: sphere_map.js around the data, lattice_map.js inside it; a click picks a camera ----
+// --- minimap ---
 function drawMinimap() {
   if (!S.cams) return;
   const nb = COLUMNS.map((d) => graphNeighbour(S.camera, d));
@@ -545,7 +559,7 @@ minimap.addEventListener("click", (e) => {
   if (c >= 0 && c !== S.camera) { trail.clear(); select(c, S.task, "minimap"); }
 });
 
-// ---- keys, wheel, drag --------------------------------------------------------------------------
+// --- input ---
 function zoomAt(factor, px, py) {
   const z = Math.max(1, Math.min(16, S.zoom * factor));
   const f = z / S.zoom;
@@ -734,7 +748,7 @@ function showHelp() {
   renderHelp(document.getElementById("help"), document.getElementById("hint"), mouse, helpRows(S.keys, S.mode, NOT_HERE));
 }
 
-// ---- start --------------------------------------------------------------------------------------
+// --- start ---
 /// Loads keys.json (beside index.html). Without it the keys do nothing and the page says why — the
 /// player keeps no second copy of the table.
 async function loadKeys() {
