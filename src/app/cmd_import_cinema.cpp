@@ -14,7 +14,7 @@
 namespace cmd_import_cinema {  // named, not anonymous: the unity build joins the command units
 
 struct Args {
-  std::string in, out, group_by, title, angles, azimuth_zero;
+  std::string in, out, group_by, title, angles, azimuth_zero, image_column;
   int crf = -1, threads = 0;
   bool overwrite = false;
 };
@@ -28,8 +28,10 @@ void run(const Args& a) {
   o.title = a.title;
   o.angles = a.angles;
   o.azimuth_zero = a.azimuth_zero;
+  o.image_column = a.image_column;
   o.command_line = "panoptes import-cinema " + a.in + " " + a.out + (a.group_by.empty() ? "" : " --group-by " + a.group_by) +
-                   (a.angles.empty() ? "" : " --angles " + a.angles) + (a.azimuth_zero.empty() ? "" : " --azimuth-zero " + a.azimuth_zero);
+                   (a.angles.empty() ? "" : " --angles " + a.angles) + (a.azimuth_zero.empty() ? "" : " --azimuth-zero " + a.azimuth_zero) +
+                   (a.image_column.empty() ? "" : " --image-column " + a.image_column);
   o.overwrite = a.overwrite;
   o.overwrite_option = "--overwrite";
   o.threads = a.threads;
@@ -45,6 +47,7 @@ void run(const Args& a) {
   std::printf("wrote %s from Cinema Spec %s: %d cameras x %d tasks = %d movies, %d frames each, in %.2f s\n",
               a.out.c_str(), r.spec.c_str(), r.cameras, r.tasks, r.cameras * r.tasks, r.frames, s);
   std::printf("cameras: %s\n", r.producer.c_str());
+  for (const auto& w : r.warnings) std::fprintf(stderr, "panoptes: warning: %s\n", w.c_str());
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {
@@ -64,14 +67,17 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
                   "camera, phi, theta and FILE)");
   sub->add_option("--title", args->title, "Title of the database");
   sub->add_option("--angles", args->angles,
-                  "How phi/theta were made, when the producer is not recognised: paraview (5.11 image extractor, "
-                  "Phi-Theta), cinema-python, ascent (theta polar from +z) or elevation (theta -90..90 above the x-y "
+                  "How phi/theta were made, when the producer is not recognised or its evidence disagrees: paraview (5.11 image extractor, "
+                  "Phi-Theta), cinema-python, ascent (theta polar from +z 0..180, or a latitude -90..90 as older Ascent wrote) or elevation (theta -90..90 above the x-y "
                   "plane, phi about +z)")
       ->check(CLI::IsMember({"paraview", "cinema-python", "ascent", "elevation"}));
   sub->add_option("--azimuth-zero", args->azimuth_zero,
                   "With --angles elevation: where phi = 0 lies, +x (phi counter-clockwise seen from +z, default) or -x "
                   "(clockwise)")
       ->check(CLI::IsMember({"+x", "-x"}));
+  sub->add_option("--image-column", args->image_column,
+                  "data.csv column holding each row's image (default FILE, or ParaView's FILE_<ext>; when rows hold "
+                  "two images, e.g. FILE and FILE2, the first is imported and the others named in a warning)");
   sub->add_option("--crf", args->crf, "x264 quality 0..51 (default: the video default, 20)");
   sub->add_option("--threads", args->threads, "Streams encoded in parallel (0 = all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in OUT");

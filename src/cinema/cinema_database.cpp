@@ -38,8 +38,6 @@ std::string value_text(const nlohmann::json& v, const std::string& source, const
   throw FileError(source, "values of " + shown(name) + ": " + shown(v.dump()) + "; expected numbers or strings");
 }
 
-bool is_file_column(const std::string& name) { return name == "FILE" || (name.size() > 5 && name.rfind("FILE_", 0) == 0); }
-
 // Entries (files, links, directories) under dir, counted up to `enough`: a Spec A product larger than
 // this cannot have an image per combination, so it is refused before it is expanded.
 std::int64_t count_entries(const fs::path& dir, std::int64_t enough) {
@@ -53,18 +51,62 @@ std::int64_t count_entries(const fs::path& dir, std::int64_t enough) {
 
 }  // namespace
 
-void parse_spec_d(std::string_view text, CinemaTable& t) {
+bool is_file_column(const std::string& name) {
+  if (name.rfind("FILE", 0) != 0) return false;
+  if (name.size() == 4) return true;
+  if (name.size() > 5 && name[4] == '_') return true;
+  return std::all_of(name.begin() + 4, name.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+void parse_spec_d(std::string_view text, CinemaTable& t, const std::string& image_column) {
   CsvTable csv = parse_csv(text, t.source);
   std::vector<int> image_cols;
   for (std::size_t c = 0; c < csv.header.size(); ++c) {
     check_field(csv.header[c], t.source, "column name");
     if (is_file_column(csv.header[c])) image_cols.push_back(int(c));
   }
+  std::vector<bool> skip(csv.header.size(), false);  // image columns: not parameters
+  for (int c : image_cols) skip[std::size_t(c)] = true;
+  if (!image_column.empty()) {
+    const auto it = std::find(csv.header.begin(), csv.header.end(), image_column);
+    if (it == csv.header.end())
+      throw FileError(t.source, "--image-column \"" + shown(image_column) + "\" is not a column of the table");
+    const int chosen = int(it - csv.header.begin());
+    std::string others;
+    for (int c : image_cols)
+      if (c != chosen) others += (others.empty() ? "" : ", ") + csv.header[std::size_t(c)];
+    if (!others.empty())
+      t.warnings.push_back(t.source + ": images from column " + image_column + " (--image-column); column" +
+                           (others.find(',') != std::string::npos ? "s " : " ") + others + " left out");
+    skip[std::size_t(chosen)] = true;
+    image_cols = {chosen};
+  }
   if (image_cols.empty())
-    throw FileError(t.source, "no FILE column (Cinema Spec D names each row's image in FILE; ParaView in FILE_png, FILE_jpg)");
+    throw FileError(t.source, "no FILE column (Cinema Spec D names each row's image in FILE; ParaView in FILE_png, FILE_jpg); "
+                              "name the image column with --image-column");
+  // ParaView writes one FILE_<ext> column per image format, one of them non-empty per row. A row with
+  // two images (FILE and FILE2) holds two pictures of one view: the first image column is imported.
+  if (image_cols.size() > 1) {
+    std::size_t first_double = csv.rows.size();
+    for (std::size_t r = 0; r < csv.rows.size() && first_double == csv.rows.size(); ++r) {
+      int filled = 0;
+      for (int c : image_cols) filled += !csv.rows[r][std::size_t(c)].empty();
+      if (filled > 1) first_double = r;
+    }
+    if (first_double < csv.rows.size()) {
+      std::string others;
+      for (std::size_t i = 1; i < image_cols.size(); ++i) others += (i > 1 ? ", " : "") + csv.header[std::size_t(image_cols[i])];
+      t.warnings.push_back(t.source + " line " + std::to_string(csv.lines[first_double]) + ": rows have " +
+                           std::to_string(image_cols.size()) + " images (columns " + csv.header[std::size_t(image_cols[0])] +
+                           ", " + others + "); imported " + csv.header[std::size_t(image_cols[0])] +
+                           ", left out " + others + " (--image-column " + csv.header[std::size_t(image_cols[1])] +
+                           " imports that one instead)");
+      image_cols.resize(1);
+    }
+  }
   t.file_column = csv.header[std::size_t(image_cols[0])];
   for (std::size_t c = 0; c < csv.header.size(); ++c)
-    if (!is_file_column(csv.header[c])) t.columns.push_back(csv.header[c]);
+    if (!skip[c]) t.columns.push_back(csv.header[c]);
   if (std::int64_t(csv.rows.size()) > kMaxImages)
     throw FileError(t.source, std::to_string(csv.rows.size()) + " rows, more than the limit of " + std::to_string(kMaxImages) + " images");
   t.values.reserve(csv.rows.size());
@@ -84,7 +126,7 @@ void parse_spec_d(std::string_view text, CinemaTable& t) {
     std::vector<std::string> row;
     row.reserve(t.columns.size());
     for (std::size_t c = 0; c < in.size(); ++c) {
-      if (is_file_column(csv.header[c])) continue;
+      if (skip[c]) continue;
       check_field(in[c], line, "value of column " + shown(csv.header[c]));
       row.push_back(std::move(in[c]));
     }
@@ -159,7 +201,7 @@ void parse_spec_a(std::string_view text, CinemaTable& t, std::int64_t max_rows) 
   }
 }
 
-CinemaTable read_cinema_database(const fs::path& dir) {
+CinemaTable read_cinema_database(const fs::path& dir, const std::string& image_column) {
   const store::FileHandle dfd = store::open_directory(dir);
   CinemaTable t;
   t.dir = dir;
@@ -174,7 +216,7 @@ CinemaTable read_cinema_database(const fs::path& dir) {
   if (has_csv) {
     t.spec = "D";
     t.source = (dir / "data.csv").string();
-    parse_spec_d(store::read_regular_file(dfd.get(), "data.csv", kMaxTableBytes, "Cinema table", dir), t);
+    parse_spec_d(store::read_regular_file(dfd.get(), "data.csv", kMaxTableBytes, "Cinema table", dir), t, image_column);
     if (has_info) {  // Ascent writes both; its info.json tells the producer
       CinemaTable a;
       a.source = (dir / "info.json").string();
@@ -187,6 +229,8 @@ CinemaTable read_cinema_database(const fs::path& dir) {
     return t;
   }
   if (has_info) {
+    if (!image_column.empty())
+      throw FileError((dir / "info.json").string(), "--image-column applies to a data.csv table (Spec D); Spec A names its images by name_pattern");
     t.spec = "A";
     t.source = (dir / "info.json").string();
     const std::string text = store::read_regular_file(dfd.get(), "info.json", kMaxInfoBytes, "Cinema info.json", dir);

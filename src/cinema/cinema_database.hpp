@@ -43,17 +43,28 @@ struct CinemaTable {
   std::optional<nlohmann::json> info;      ///< info.json when the database has one (Spec A or beside data.csv)
   bool has_info_js = false;                ///< info.js exists (Ascent copies its viewer's data there)
   std::optional<nlohmann::json> panoptes;  ///< panoptes-cinema.json: written by Panoptes' export
+  /// What was read differently from the file's face value, one line each naming the file, the column
+  /// and the option that changes it (e.g. a second image column left out); the import reports them.
+  std::vector<std::string> warnings;
 };
+
+/// An image column's name: FILE, FILE_<ext> (ParaView 5.11: one per image format, one non-empty per
+/// row) or FILE<digits> (a second image per row, e.g. FILE2).
+bool is_file_column(const std::string& name);
 
 /// Reads IN.cdb: data.csv if present (Spec D), else info.json (Spec A). Throws FileError naming the
 /// file when neither exists, either is not a regular file (link, FIFO, device) or too large, or
 /// either is malformed (see parse_csv; Spec A: not JSON, no name_pattern, a {placeholder} without a
 /// parameter, a parameter without values, more combinations than the database has files).
-CinemaTable read_cinema_database(const std::filesystem::path& dir);
+/// `image_column` (--image-column): the column that holds each row's image (empty = FILE, or the one
+/// non-empty FILE_<ext> of each row; when a row has two images, the first image column, with a warning
+/// naming the others).
+CinemaTable read_cinema_database(const std::filesystem::path& dir, const std::string& image_column = {});
 
-/// Parses data.csv text (Spec D) into `t` (columns, values, files, where, file_column). Throws
-/// FileError naming `t.source`. Exposed for the fuzz target.
-void parse_spec_d(std::string_view text, CinemaTable& t);
+/// Parses data.csv text (Spec D) into `t` (columns, values, files, where, file_column, warnings);
+/// `image_column` as read_cinema_database's. Throws FileError naming `t.source` (an --image-column that
+/// is not a column of the table). Exposed for the fuzz target.
+void parse_spec_d(std::string_view text, CinemaTable& t, const std::string& image_column = {});
 
 /// Parses info.json text (Spec A) into `t`: t.info, columns and every combination of the parameter
 /// values as rows, refusing more than `max_rows` combinations. Throws FileError naming `t.source`.

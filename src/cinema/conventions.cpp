@@ -121,9 +121,11 @@ ProducerCamera producer_camera(const CameraModel& m, double phi_deg, double thet
       break;
     }
     case Angles::ascent: {
-      // RotateZ(phi) * RotateX(theta) applied to (0, 0, 1) and to (0, 1, 0).
-      dir = {std::sin(t) * std::sin(p), -std::sin(t) * std::cos(p), std::cos(t)};
-      up = {-std::cos(t) * std::sin(p), std::cos(t) * std::cos(p), std::sin(t)};
+      // RotateZ(phi) * RotateX(theta) applied to (0, 0, 1) and to (0, 1, 0); an older Ascent's
+      // latitude-style theta is first turned into the polar angle.
+      const double a = m.latitude_theta ? (90 - theta_deg) * kDeg : t;
+      dir = {std::sin(a) * std::sin(p), -std::sin(a) * std::cos(p), std::cos(a)};
+      up = {-std::cos(a) * std::sin(p), std::cos(a) * std::cos(p), std::sin(a)};
       break;
     }
     case Angles::elevation: {
@@ -163,19 +165,35 @@ CameraModel detect_producer(const ProducerEvidence& e, const std::string& angles
   if (!azimuth_zero.empty() && azimuth_zero != "+x" && azimuth_zero != "-x")
     throw Error("--azimuth-zero \"" + azimuth_zero + "\"; expected +x or -x");
 
+  // Every piece of evidence names a convention; they must agree.
+  struct Clue {
+    Angles angles;
+    std::string text;
+  };
+  std::vector<Clue> clues;
+  if (e.file_column.size() > 5 && e.file_column.rfind("FILE_", 0) == 0)
+    clues.push_back({Angles::paraview, "data.csv names its image column " + e.file_column +
+                                           (has_producer_column ? " and has a producer column" : "") + " (ParaView image extractor)"});
+  if (phi_theta_model) clues.push_back({Angles::cinema_python, "info.json metadata.camera_model is \"phi-theta\" (cinema_python)"});
+  if (has_arguments && (e.has_info_js || (version == "1.1" && pattern.rfind("{time}/{phi}_{theta}_", 0) == 0)))
+    clues.push_back({Angles::ascent, e.has_info_js
+                                         ? "info.json keeps its parameters under \"arguments\" and info.js (Ascent's viewer data) is present"
+                                         : "info.json version 1.1 with \"arguments\" and name_pattern " + pattern + " (Ascent)"});
   if (!angles.empty()) {
     m.angles = parse_angles(angles);
     m.evidence = "--angles " + angles;
-  } else if (e.file_column.size() > 5 && e.file_column.rfind("FILE_", 0) == 0) {
-    m.angles = Angles::paraview;
-    m.evidence = "data.csv names its image column " + e.file_column + (has_producer_column ? " and has a producer column" : "");
-  } else if (phi_theta_model) {
-    m.angles = Angles::cinema_python;
-    m.evidence = "info.json metadata.camera_model is \"phi-theta\" (cinema_python)";
-  } else if (has_arguments && (e.has_info_js || (version == "1.1" && pattern.rfind("{time}/{phi}_{theta}_", 0) == 0))) {
-    m.angles = Angles::ascent;
-    m.evidence = e.has_info_js ? "info.json keeps its parameters under \"arguments\" and info.js (Ascent's viewer data) is present"
-                               : "info.json version 1.1 with \"arguments\" and name_pattern " + pattern + " (Ascent)";
+  } else if (!clues.empty()) {
+    for (const Clue& c : clues)
+      if (c.angles != clues[0].angles)
+        throw Error("the evidence disagrees on how phi/theta were made: " + clues[0].text + ", but " + c.text +
+                    "; say which with --angles " + to_string(clues[0].angles) + "|" + to_string(c.angles));
+    if (e.layout && *e.layout != clues[0].angles)
+      throw Error("the evidence disagrees on how phi/theta were made: " + clues[0].text + ", but the " + e.layout_text +
+                  " as " + (*e.layout == Angles::paraview ? "ParaView's image extractor" : *e.layout == Angles::ascent ? "Ascent" : "cinema_python") +
+                  " names them; say which with --angles " + to_string(clues[0].angles) + "|" + to_string(*e.layout));
+    m.angles = clues[0].angles;
+    for (const Clue& c : clues) m.evidence += (m.evidence.empty() ? "" : "; ") + c.text;
+    if (e.layout) m.evidence += "; " + e.layout_text;
   } else if (e.thetas.empty()) {
     m.angles = Angles::elevation;  // no theta: one camera ring or one camera, nothing to confuse
     m.evidence = "no theta column";
@@ -183,6 +201,7 @@ CameraModel detect_producer(const ProducerEvidence& e, const std::string& angles
     std::string seen = "spec " + e.spec + ", image column " + e.file_column;
     if (e.info) seen += has_arguments ? ", info.json with \"arguments\"" : ", info.json with \"parameter_list\"";
     if (!version.empty()) seen += ", version " + version;
+    if (e.layout) seen += ", " + e.layout_text;
     throw Error("cannot tell which producer's phi/theta convention this Cinema database uses (" + seen +
                 "): ParaView extracts, cinema_python, Ascent and others build different cameras from the same angles" + kAsk);
   }
@@ -214,8 +233,20 @@ CameraModel detect_producer(const ProducerEvidence& e, const std::string& angles
       m.fov_y_deg = 60;
       m.distance = 2.5 * kUnitSphere;
       m.pole = {0, 0, 1};
+      // Ascent writes theta as a polar angle from +z (0..180); older releases wrote a latitude
+      // (-90..90). A negative theta tells them apart; a range that fits neither is refused.
+      if (!e.thetas.empty() && e.thetas.front() < -1e-9) {
+        if (e.thetas.front() < -90 - 1e-9 || e.thetas.back() > 90 + 1e-9)
+          throw Error("theta runs " + format_float(e.thetas.front()) + ".." + format_float(e.thetas.back()) +
+                      ", neither a polar angle in 0..180 (Ascent) nor a latitude in -90..90 (older Ascent)" + kAsk);
+        m.latitude_theta = true;
+        m.producer += " (theta as a latitude, -90..90)";
+        m.notes.push_back("theta runs " + format_float(e.thetas.front()) + ".." + format_float(e.thetas.back()) +
+                          ": read as a latitude as older Ascent wrote it (polar angle = 90 - theta; --angles elevation "
+                          "reads it as an elevation about +z instead)");
+      }
       for (double t : e.thetas)
-        if (t < -1e-9 || t > 180 + 1e-9)
+        if (!m.latitude_theta && (t < -1e-9 || t > 180 + 1e-9))
           throw Error("theta " + format_float(t) + " is not a polar angle in 0..180 as Ascent writes it" + kAsk);
       break;
     case Angles::elevation:

@@ -48,6 +48,9 @@ struct CameraModel {
   Vec3 pole{0, 0, 1};              ///< the producer's "up" axis (unit, a world axis)
   double fov_y_deg = 30;           ///< vertical view angle
   bool recorded = false;           ///< center, distance, pole and fov come from recorded camera metadata
+  /// ascent only: theta is a latitude in -90..90 (older Ascent), the polar angle is 90 - theta.
+  bool latitude_theta = false;
+  std::vector<std::string> notes;  ///< what the user should be told (e.g. latitude-style theta)
 };
 
 /// One image's camera as the producer built it, and how Panoptes stores it.
@@ -72,12 +75,19 @@ struct ProducerEvidence {
   bool has_info_js = false;
   std::vector<double> thetas;             ///< the distinct theta values (empty: no theta column)
   int time_count = 1;                     ///< distinct times (to check per-time recorded cameras)
+  /// How the image files are named, when every row's path carries its phi and theta as one producer
+  /// names them (import.cpp, file_layout): ParaView's extractor "...p=PHIt=THETA.png", cinema_python's
+  /// ".../PHI/THETA[/...].png", Ascent's "TIME/PHI_THETA_NAME.png". Corroborates or contradicts the
+  /// other evidence; alone it does not decide (a generic layout a user may have chosen).
+  std::optional<Angles> layout;
+  std::string layout_text;                ///< e.g. "files named image/{phi}/{theta}.png (image/30/45.png)"
 };
 
 /// The camera model of a database: `angles` (the --angles option, empty = detect) and `azimuth_zero`
-/// ("+x", "-x" or empty) decide if given; else the producer is recognised from `e`. Throws Error,
-/// naming what was seen and the options to pass, when the convention is unknown, when theta values do
-/// not fit the convention, or when recorded camera metadata is malformed.
+/// ("+x", "-x" or empty) decide if given; else the producer is recognised from all of `e` (image
+/// column name, info.json, info.js, file layout). Throws Error, naming what was seen and the options
+/// to pass, when the convention is unknown, when two pieces of evidence name different producers, when
+/// theta values do not fit the convention, or when recorded camera metadata is malformed.
 CameraModel detect_producer(const ProducerEvidence& e, const std::string& angles, const std::string& azimuth_zero);
 
 }  // namespace panoptes::cinema

@@ -70,6 +70,57 @@ void sky_angles(const Vec3& d, const Vec3& pole, double& lat, double& lon) {
   if (std::abs(lat) > 90 - 1e-9) lon = 0;
 }
 
+// How the image files carry phi and theta, when every row's path does so as one producer names them
+// (ProducerEvidence::layout). A path element equals a value when it reads as the same number.
+bool same_number(const std::string& text, double v) {
+  double x;
+  return parse_number(text, x) && std::abs(x - v) <= 1e-6 * std::max(1.0, std::abs(v));
+}
+
+bool paraview_name(const fs::path& file, double phi, double theta) {  // "...p=PHIt=THETA.png"
+  const std::string stem = file.stem().string();
+  const auto p = stem.rfind("p="), q = stem.rfind("t=");
+  return p != std::string::npos && q != std::string::npos && q > p &&
+         same_number(stem.substr(p + 2, q - p - 2), phi) && same_number(stem.substr(q + 2), theta);
+}
+
+bool ascent_name(const fs::path& file, double phi, double theta) {  // "PHI_THETA_NAME.png"
+  const std::string stem = file.stem().string();
+  const auto a = stem.find('_'), b = a == std::string::npos ? a : stem.find('_', a + 1);
+  return b != std::string::npos && same_number(stem.substr(0, a), phi) && same_number(stem.substr(a + 1, b - a - 1), theta);
+}
+
+bool cinema_python_path(const fs::path& file, double phi, double theta) {  // ".../PHI/THETA[/...].png"
+  std::vector<std::string> parts;
+  for (const auto& e : file) parts.push_back(e.string());
+  if (parts.empty()) return false;
+  parts.back() = file.stem().string();
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i)
+    if (same_number(parts[i], phi) && same_number(parts[i + 1], theta)) return true;
+  return false;
+}
+
+void file_layout(const CinemaTable& t, const std::vector<std::pair<double, double>>& angles, ProducerEvidence& ev) {
+  struct Layout {
+    Angles angles;
+    bool (*match)(const fs::path&, double, double);
+    const char* text;
+  };
+  const Layout layouts[] = {{Angles::paraview, paraview_name, "files named ...p={phi}t={theta}.png"},
+                            {Angles::ascent, ascent_name, "files named {phi}_{theta}_NAME.png"},
+                            {Angles::cinema_python, cinema_python_path, "files laid out .../{phi}/{theta}.png"}};
+  if (t.files.empty()) return;
+  for (const Layout& l : layouts) {
+    bool all = true;
+    for (std::size_t r = 0; r < t.files.size() && all; ++r) all = l.match(fs::path(t.files[r]), angles[r].first, angles[r].second);
+    if (all) {
+      ev.layout = l.angles;
+      ev.layout_text = std::string(l.text) + " (" + t.files[0] + ")";
+      return;
+    }
+  }
+}
+
 // The cameras, tasks and graph Panoptes' own export wrote beside data.csv; rows are matched to them
 // by the camera column or by phi/theta/shell, and by the task column or the axis columns.
 struct Sidecar {
@@ -94,6 +145,45 @@ Sidecar read_sidecar(const CinemaTable& t) {
   return s;
 }
 
+// The table, without rows whose FILE is not an image (cinema_python's and ParaView's .npz depth or
+// value layers, .vti, ...): those are skipped with a warning; a table of no image at all is refused.
+bool is_image_name(const std::string& file) {
+  const std::string ext = lower(fs::path(file).extension().string());
+  return ext.empty() || ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
+CinemaTable read_table(const fs::path& cdb, const ImportOptions& o) {
+  CinemaTable t = read_cinema_database(cdb, o.image_column);
+  std::size_t kept = 0;
+  std::string example;  // the first row skipped
+  std::map<std::string, int> skipped_ext;
+  for (std::size_t r = 0; r < t.files.size(); ++r) {
+    if (!is_image_name(t.files[r])) {
+      if (example.empty()) example = t.where[r] + ": " + t.files[r];
+      ++skipped_ext[lower(fs::path(t.files[r]).extension().string())];
+      continue;
+    }
+    if (kept != r) {
+      t.values[kept] = std::move(t.values[r]);
+      t.files[kept] = std::move(t.files[r]);
+      t.where[kept] = std::move(t.where[r]);
+    }
+    ++kept;
+  }
+  if (skipped_ext.empty()) return t;
+  std::string exts;
+  for (const auto& [ext, n] : skipped_ext) exts += (exts.empty() ? "" : ", ") + std::to_string(n) + " " + ext;
+  if (kept == 0)
+    throw FileError(t.source, "no row names a PNG or JPEG image (" + exts + "; e.g. " + example +
+                                  "); Panoptes imports images" + (t.spec == "D" ? " (--image-column names the column that holds them)" : ""));
+  t.warnings.push_back(t.source + ": skipped " + std::to_string(t.files.size() - kept) + " rows whose " + t.file_column +
+                       " is not an image (" + exts + "; e.g. " + example + "); " + std::to_string(kept) + " image rows imported");
+  t.values.resize(kept);
+  t.files.resize(kept);
+  t.where.resize(kept);
+  return t;
+}
+
 // --- planner ---
 // The steps of plan_import, in the order it takes them; each reads what the ones before it found.
 struct ImportPlanner {
@@ -101,14 +191,18 @@ struct ImportPlanner {
     double phi = 0, theta = 0;
     std::size_t first_row = 0;
   };
-  ImportPlanner(const fs::path& cdb, const ImportOptions& o) : cdb(cdb), o(o), t(read_cinema_database(cdb)) {}
+  ImportPlanner(const fs::path& cdb, const ImportOptions& o) : cdb(cdb), o(o), t(read_table(cdb, o)) { plan.warnings = t.warnings; }
   const fs::path& cdb;
   const ImportOptions& o;
   const CinemaTable t;
   const Sidecar side = read_sidecar(t);
   const std::size_t rows = t.files.size();
-  const int c_time = find_column(t, "time"), c_phi = find_column(t, "phi"), c_theta = find_column(t, "theta"),
+  // The frames: "time", or "timestep" as some producers name it.
+  const int c_time = find_column(t, "time") >= 0 ? find_column(t, "time") : find_column(t, "timestep");
+  const int c_phi = find_column(t, "phi"), c_theta = find_column(t, "theta"),
             c_camera = find_column(t, "camera"), c_shell = side.present ? find_column(t, "shell") : -1;
+  // ParaView's camera mode Static: no phi, theta or camera column; one camera as the producer left it.
+  const bool static_camera = !side.present && c_phi < 0 && c_theta < 0 && c_camera < 0;
   std::vector<double> times;            // frames: the distinct times, ascending
   std::vector<int> row_frame;           // per row
   std::vector<std::pair<double, double>> angles;  // per row: phi, theta
@@ -126,11 +220,15 @@ struct ImportPlanner {
   void detect_convention();
   void find_cameras();
   void group_tasks();
+  void make_tasks();
+  bool views_distinct(bool complete) const;
+  void drop_measures();
   void start_manifest();
   void name_tasks();
   void adopt_sidecar_tasks();
   void find_images();
   void place_cameras();
+  void place_static_camera();
 };
 
 // --- frames ---
@@ -168,8 +266,10 @@ void ImportPlanner::detect_convention() {
     ev.has_info_js = t.has_info_js;
     ev.thetas = thetas;
     ev.time_count = int(times.size());
+    if (c_phi >= 0 && c_theta >= 0) file_layout(t, angles, ev);
     try {
       model = detect_producer(ev, o.angles, o.azimuth_zero);
+      for (const std::string& n : model.notes) plan.warnings.push_back(t.source + ": " + n);
     } catch (const FileError&) {
       throw;
     } catch (const Error& e) {
@@ -271,8 +371,14 @@ void ImportPlanner::group_tasks() {
     }
     numeric[g] = numeric[g] && any;
   }
+  make_tasks();
+  if (o.group_by.empty() && !side.present && !views_distinct(true)) drop_measures();
+}
+
+void ImportPlanner::make_tasks() {
   std::map<std::vector<std::string>, int> task_of;
-  row_task.resize(rows);
+  task_keys.clear();
+  row_task.assign(rows, 0);
   for (std::size_t r = 0; r < rows; ++r) {
     std::vector<std::string> key;
     key.reserve(group.size());
@@ -286,6 +392,64 @@ void ImportPlanner::group_tasks() {
     if (inserted) task_keys.push_back(it->first);
     row_task[r] = it->second;
   }
+}
+
+// Every row a distinct (camera, task, frame); `complete` also asks for every combination.
+bool ImportPlanner::views_distinct(bool complete) const {
+  std::unordered_map<std::uint64_t, char> seen;
+  seen.reserve(rows);
+  const std::uint64_t nt = task_keys.size(), nf = times.size();
+  for (std::size_t r = 0; r < rows; ++r)
+    if (!seen.emplace((std::uint64_t(row_camera[r]) * nt + std::uint64_t(row_task[r])) * nf + std::uint64_t(row_frame[r]), 0).second)
+      return false;
+  return !complete || double(cams.size()) * double(nt) * double(nf) == double(rows);
+}
+
+// Numeric columns that vary between images without indexing them (a per-image measure: an area, a
+// maximum, a time step number beside the time) make every image its own task, so no task has every
+// camera. Such a column is one the images are told apart without: dropped greedily, the most varied
+// first, while the views stay distinct; kept out of the tasks when that completes the table, with a
+// warning naming them and --group-by. Otherwise the table is left as it was (and refused below).
+void ImportPlanner::drop_measures() {
+  constexpr std::size_t kMaxCandidates = 64;  // each try is linear in the table
+  std::vector<std::pair<std::size_t, std::size_t>> candidates;  // (distinct values, group index)
+  for (std::size_t g = 0; g < group.size(); ++g) {
+    if (!numeric[g]) continue;
+    std::set<std::string> distinct;
+    for (std::size_t r = 0; r < rows; ++r) distinct.insert(t.values[r][std::size_t(group[g])]);
+    if (distinct.size() > 1) candidates.push_back({distinct.size(), g});
+  }
+  if (candidates.empty() || candidates.size() > kMaxCandidates) return;
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+  const std::vector<int> all_group = group;
+  const std::vector<bool> all_numeric = numeric;
+  std::vector<bool> dropped(group.size(), false);
+  auto apply = [&] {
+    group.clear();
+    numeric.clear();
+    for (std::size_t g = 0; g < all_group.size(); ++g)
+      if (!dropped[g]) group.push_back(all_group[g]), numeric.push_back(all_numeric[g]);
+    make_tasks();
+  };
+  for (const auto& [n, g] : candidates) {
+    dropped[g] = true;
+    apply();
+    if (!views_distinct(false)) dropped[g] = false;
+  }
+  apply();
+  std::string names;
+  for (std::size_t g = 0; g < all_group.size(); ++g)
+    if (dropped[g]) names += (names.empty() ? "" : ", ") + t.columns[std::size_t(all_group[g])];
+  if (names.empty() || !views_distinct(true)) {  // not measures: the table is incomplete as it is
+    std::fill(dropped.begin(), dropped.end(), false);
+    apply();
+    return;
+  }
+  std::string kept;
+  for (int c : group) kept += (kept.empty() ? "" : ",") + t.columns[std::size_t(c)];
+  plan.warnings.push_back(t.source + ": column" + (names.find(',') != std::string::npos ? "s " : " ") + names +
+                          " vary per image but do not index the images (per-image measures); ignored, not made tasks "
+                          "(--group-by chooses the task columns" + (kept.empty() ? std::string() : "; here " + kept) + ")");
 }
 
 // --- manifest ---
@@ -467,6 +631,8 @@ void ImportPlanner::place_cameras() {
     m.rig = side.m.rig;
     m.domain = side.m.domain;
     plan.producer = "Panoptes export-cinema (cameras, graph and tasks from panoptes-cinema.json)";
+  } else if (static_camera) {
+    place_static_camera();
   } else {
     camera::Rig rig;
     rig.center = model.center;
@@ -528,6 +694,62 @@ void ImportPlanner::place_cameras() {
   }
 }
 
+// ParaView's camera mode Static (and any table without phi, theta or camera): one camera, where the
+// producer recorded it (info.json metadata camera_eye/camera_at/camera_up, as cinema_python records
+// it), else at an unknown position: the camera entry is a placeholder marked as such, never a
+// direction made up from angles the database does not have.
+void ImportPlanner::place_static_camera() {
+  store::CameraEntry e;
+  e.id = 0;
+  e.labels.patch = "cinema";
+  e.labels.shell = 0;
+  bool recorded = false;
+  const nlohmann::json* meta = t.info && t.info->is_object() && t.info->contains("metadata") && (*t.info)["metadata"].is_object()
+                                   ? &(*t.info)["metadata"]
+                                   : nullptr;
+  auto first_vec = [&](const char* key, Vec3& v) {
+    if (!meta || !meta->contains(key)) return false;
+    const nlohmann::json& a = (*meta)[key];
+    const nlohmann::json& x = a.is_array() && !a.empty() && a[0].is_array() ? a[0] : a;
+    if (!x.is_array() || x.size() != 3) return false;
+    for (int k = 0; k < 3; ++k) {
+      if (!x[std::size_t(k)].is_number() || !std::isfinite(x[std::size_t(k)].get<double>())) return false;
+      v[k] = x[std::size_t(k)].get<double>();
+    }
+    return true;
+  };
+  Vec3 eye, at, up;
+  if (first_vec("camera_eye", eye) && first_vec("camera_at", at) && first_vec("camera_up", up) && norm(eye - at) > 0 &&
+      norm(cross(eye - at, up)) > 1e-12 * norm(eye - at) * norm(up)) {
+    recorded = true;
+    e.position = eye;
+    e.look_at = at;
+    const Vec3 f = normalize(at - eye);
+    e.up = normalize(up - f * dot(up, f));
+    e.fov_y_deg = model.fov_y_deg;
+  } else {
+    e.position = Vec3{0, 0, 1} * model.distance;  // a placeholder; marked unknown below
+    e.look_at = {0, 0, 0};
+    e.up = {0, 1, 0};
+    e.fov_y_deg = model.fov_y_deg;
+    e.labels.extra["cinema_position"] = "unknown";
+  }
+  e.labels.extra["cinema_camera"] = "static";
+  m.cameras.push_back(e);
+  m.graph.neighbours.push_back({-1, -1, -1, -1, -1, -1});
+  m.rig.kind = "cinema";
+  m.rig.parameters = {{"spec", t.spec}, {"cameras", 1}, {"camera_mode", "static"}, {"recorded_camera", recorded}};
+  if (!recorded) m.rig.parameters["camera_position"] = "unknown";
+  const std::string who = model.angles == Angles::paraview && o.angles.empty() ? "ParaView image extractor (camera mode Static)"
+                                                                                : "Cinema database without camera angles";
+  plan.producer = who + ": one camera, " +
+                  (recorded ? std::string("as recorded in info.json metadata camera_eye/camera_at/camera_up")
+                            : std::string("its position not recorded"));
+  if (!recorded)
+    plan.warnings.push_back(t.source + ": no phi, theta or camera column (" + who +
+                            "): one camera whose position the producer did not record; imported as one view of unknown direction");
+}
+
 }  // namespace
 
 // --- import ---
@@ -579,7 +801,7 @@ ImportReport import_cinema(const fs::path& cdb, const fs::path& out, const Impor
     writer.close_stream(int(s / nt), int(s % nt));
   });
   writer.finalize();
-  return {nc, nt, nf, plan.spec, plan.producer};
+  return {nc, nt, nf, plan.spec, plan.producer, plan.warnings};
 }
 
 }  // namespace panoptes::cinema

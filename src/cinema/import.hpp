@@ -29,6 +29,9 @@ struct ImportOptions {
   /// the producer (cinema/conventions.hpp) and refuse when it cannot be told.
   std::string angles;
   std::string azimuth_zero;       ///< "+x" or "-x" for angles "elevation" (empty = +x)
+  /// data.csv's column holding each row's image (--image-column; empty = FILE or FILE_<ext>, the first
+  /// image column when a row has two).
+  std::string image_column;
 };
 
 /// How a Cinema table maps onto a Panoptes database (plan_import's result; no image read yet).
@@ -40,6 +43,11 @@ struct ImportPlan {
   std::vector<bool> rotated;
   std::string spec;               ///< "D" or "A"
   std::string producer;           ///< the recognised producer and why, for the report
+  /// What was read other than at face value (one line each, naming the file, the column or value and
+  /// the option that changes it): a second image column, rows whose FILE is not an image, columns
+  /// ignored as per-image measures, a time column named timestep, latitude-style Ascent theta, a
+  /// Static camera whose position was not recorded.
+  std::vector<std::string> warnings;
 };
 
 /// Reads IN.cdb and plans the database: the producer's convention gives each image's camera (position,
@@ -56,6 +64,7 @@ struct ImportReport {
   int cameras = 0, tasks = 0, frames = 0;
   std::string spec;
   std::string producer;  ///< see ImportPlan::producer
+  std::vector<std::string> warnings;  ///< see ImportPlan::warnings
 };
 
 /// plan_import, then writes the movie database to `out` (DatabaseWriter; refuses an existing database
