@@ -36,6 +36,22 @@ grep -q '^panoptes: error: .*cannot tell which producer.*--angles paraview|cinem
   fail "bad message: $(cat "$tmp/err")"
 out=$("$panoptes" import-cinema "$tmp/x.cdb" "$tmp/amb" --angles elevation --azimuth-zero -x)
 grep "cameras: generic Cinema (theta = elevation) (--angles elevation)" <<<"$out" >/dev/null || fail "unexpected import output: $out"
+# issue 44 point 5: a cinema_python layout under ParaView's image column name is refused naming both
+# pieces of evidence and --angles (it imported mirrored); a second image column is named in a warning.
+mkdir -p "$tmp/cp.cdb/image/0" "$tmp/cp.cdb/image/90"
+cp "$tmp/x.cdb/image/c0/t0_f0.jpg" "$tmp/cp.cdb/image/0/30.jpg"
+cp "$tmp/x.cdb/image/c1/t0_f0.jpg" "$tmp/cp.cdb/image/90/30.jpg"
+printf 'phi,theta,FILE_jpg\n0,30,image/0/30.jpg\n90,30,image/90/30.jpg\n' >"$tmp/cp.cdb/data.csv"
+if "$panoptes" import-cinema "$tmp/cp.cdb" "$tmp/cp" 2>"$tmp/err"; then fail "imported disagreeing evidence"; fi
+[ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "error is not one line: $(cat "$tmp/err")"
+grep -q '^panoptes: error: .*cp.cdb/data.csv: the evidence disagrees .*FILE_jpg.*{phi}/{theta}.*--angles paraview|cinema-python$' "$tmp/err" ||
+  fail "bad message: $(cat "$tmp/err")"
+"$panoptes" import-cinema "$tmp/cp.cdb" "$tmp/cp" --angles cinema-python >/dev/null || fail "--angles cinema-python refused"
+printf 'phi,theta,FILE,FILE2\n0,30,image/0/30.jpg,image/90/30.jpg\n90,30,image/90/30.jpg,image/0/30.jpg\n' >"$tmp/cp.cdb/data.csv"
+"$panoptes" import-cinema "$tmp/cp.cdb" "$tmp/two" --angles elevation 2>"$tmp/err" >/dev/null || fail "FILE2 refused: $(cat "$tmp/err")"
+grep -q '^panoptes: warning: .*data.csv line 2: rows have 2 images (columns FILE, FILE2); imported FILE.*--image-column FILE2' "$tmp/err" ||
+  fail "no FILE2 warning: $(cat "$tmp/err")"
+"$panoptes" import-cinema "$tmp/cp.cdb" "$tmp/two2" --angles elevation --image-column FILE2 >/dev/null 2>&1 || fail "--image-column FILE2"
 # The databases the real producers wrote (src/cinema/fixtures) import as they are, each recognised.
 fixtures=$(cd "$(dirname "$0")/../../cinema/fixtures" && pwd)
 for want in "paraview_extracts:12 cameras x 2 tasks = 24 movies, 3 frames each:ParaView image extractor (camera mode Phi-Theta)" \
