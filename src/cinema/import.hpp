@@ -53,7 +53,8 @@ struct ImportPlan {
 /// Reads IN.cdb and plans the database: the producer's convention gives each image's camera (position,
 /// view direction, up; conventions.hpp), Panoptes' own export restores its cameras, graph and tasks
 /// from panoptes-cinema.json. Time and memory are linear in the table. Throws FileError/Error (naming
-/// the file, the row and the value) for: an unknown phi/theta convention (asks for --angles); a
+/// the file, the row and the value) for: an unknown phi/theta convention, or evidence naming two
+/// producers (asks for --angles); a table with no PNG/JPEG row; a
 /// non-numeric time, phi or theta; two rows for the same (camera, task, frame); a (camera, task,
 /// frame) without an image; a FILE outside the database; a missing or unreadable image; images of
 /// different sizes; a --group-by column that does not exist.
