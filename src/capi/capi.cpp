@@ -1,4 +1,7 @@
 // The C API over insitu::Session: errors become return codes + a thread-local message.
+// Sections: the handle | errors: codes, messages, remembered failures | the session, built at the first
+// collective call | grids | field bindings: layouts, strides, counts | the C functions (create, grid,
+// patch, resample, block, halo, fields, process/due/snapshot/finalize, destroy, errors).
 #include "panoptes.h"
 
 #include <array>
@@ -23,6 +26,7 @@
 
 using namespace panoptes;
 
+// --- the handle ---
 struct panoptes_session {
   insitu::SessionConfig config;
   int fortran_comm = PANOPTES_COMM_WORLD;
@@ -64,6 +68,7 @@ struct panoptes_session {
 
 namespace {
 
+// --- errors: codes, messages, remembered failures ---
 thread_local std::string g_error;
 
 struct UsageError : Error {
@@ -159,6 +164,7 @@ void need(bool ok, const std::string& what) {
 }
 
 // Every patch's state, the selected one included, in patch order (non-uniform grids).
+// --- the session, built at the first collective call ---
 std::map<int, panoptes_session::PatchState> all_patches(const panoptes_session* s) {
   std::map<int, panoptes_session::PatchState> all = s->other_patches;
   all[s->patch] = {s->block, s->fields};
@@ -238,6 +244,7 @@ std::vector<insitu::FieldInput> inputs(const panoptes_session* s) {
 }
 
 // The three non-uniform grid calls: coordinates per axis, validated.
+// --- grids ---
 int set_source_grid(panoptes_session* s, const char* call, grid::GridKind kind, const int dims[3], const double* a,
                     const double* b, const double* c) {
   return guarded(s, [&] {
@@ -258,6 +265,7 @@ int set_source_grid(panoptes_session* s, const char* call, grid::GridKind kind, 
   }, "");
 }
 
+// --- field bindings: layouts, strides, counts ---
 std::string shape_text(const std::array<long long, 3>& v) {
   std::string text = "(";  // appended, not "(" + ...: GCC 12 warns falsely (-Wrestrict) on the latter
   for (int d = 0; d < 3; ++d) text.append(std::to_string(v[d])).append(d < 2 ? ", " : ")");
@@ -399,6 +407,7 @@ void set_field_layout(panoptes_session* s, const std::string& call, const char* 
 
 }  // namespace
 
+// --- the C functions ---
 extern "C" {
 
 int panoptes_create(const char* config, int config_is_file, int fortran_comm, panoptes_session** out) {

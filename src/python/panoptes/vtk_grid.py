@@ -1,5 +1,8 @@
 """VTK XML image, rectilinear and structured grids (.vti, .vtr, .vts, a Yin-Yang .vtm) as input of `panoptes render`.
 
+Sections: results and limits | VTK in a child process | shells: axis order, poles, seam, Yin-Yang |
+reading one file, a .vtm, a series | writing render inputs | command line.
+
 The files are read by VTK's own XML readers (the `vtkmodules` package; on Debian 12 it comes with
 python3-paraview, which scripts/setup installs): Panoptes does not link VTK, whose Debian package is the
 whole toolkit, for three readers. What it writes is what `panoptes render` reads: the point-data array
@@ -44,6 +47,7 @@ _AXES = {"rectilinear": ("x", "y", "z"), "spherical": ("r", "theta", "phi")}
 
 
 @dataclass
+# --- results and limits ---
 class VtkGrid:
     """One file's grid and values. kind: uniform | rectilinear | spherical. coordinates: three 1-D arrays
     (rectilinear: x, y, z; spherical: r, theta, phi in radians); uniform: origin and spacing instead.
@@ -81,6 +85,7 @@ _CHILD = Path(__file__).with_name("_vtk_child.py")  # the script that runs VTK (
 _VTK_OVERHEAD = 1 << 30  # address space of Python, NumPy and VTK's libraries in the child (measured: ~110 MB)
 
 
+# --- VTK in a child process ---
 def _child_limits(address_space, seconds):
     def apply():
         import resource
@@ -144,6 +149,7 @@ def _run_vtk(path, array, work, limits, need):
 
 
 @dataclass
+# --- shells: axis order, poles, seam, Yin-Yang ---
 class _Patch:
     """A .vts's points as a shell: which index axis carries r, theta and phi, which of them run backwards,
     and the frame they were found in ("yin": the world's, "yang": (x, y, z) -> (-x, z, y))."""
@@ -244,6 +250,7 @@ def _close_seam(path, patch, notes):
         patch.coordinates = (r, t, p[:n].copy())
 
 
+# --- reading one file, a .vtm, a series ---
 def _structured(path, pts, dims, notes):
     """A StructuredGrid's points: ("rectilinear", coords, None) or ("spherical" | "yang", coords, _Patch)."""
     n0, n1, n2 = dims
@@ -393,6 +400,7 @@ def read(path, array=None, limits=None):
     return frames[0][0]
 
 
+# --- writing render inputs ---
 def _same_grid(a, b):
     if a.kind != b.kind or a.dims != b.dims:
         return False
@@ -490,6 +498,7 @@ def write_render_inputs(paths, out_dir, array=None, points=None, limits=None):
     return args
 
 
+# --- command line ---
 def _one_line(e):
     return str(e).replace("\r", "\\r").replace("\n", "\\n")
 
