@@ -1,4 +1,5 @@
 #include "insitu/output.hpp"
+#include "insitu/rank_agreement.hpp"
 
 #include <sys/stat.h>
 
@@ -31,15 +32,6 @@ void agree(const std::string& failure, const OutputGroup& g) {
   if (failed != g.size) throw Error(failure);
 }
 
-std::string message_of(std::exception_ptr e) {
-  try {
-    std::rethrow_exception(e);
-  } catch (const std::exception& x) {
-    return x.what();
-  } catch (...) {
-    return "unknown error";
-  }
-}
 
 // What resume may not continue, checked against the database's manifest before the store opens it:
 // a database whose run finished (unless resume_complete), and another schedule than it was written
@@ -159,7 +151,7 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
         out.writer.emplace(store::DatabaseWriter::create(cfg.output_dir, manifest, o));
       }
     } catch (...) {
-      failure = message_of(std::current_exception());
+      failure = exception_message(std::current_exception());
     }
   }
   agree(failure, g);
@@ -185,7 +177,7 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
                              ? store::DatabaseWriter::resume(cfg.output_dir, manifest, o, out.frames)
                              : store::DatabaseWriter::create(cfg.output_dir, manifest, o));
     } catch (...) {
-      failure = message_of(std::current_exception());
+      failure = exception_message(std::current_exception());
     }
   }
   agree(failure, g);

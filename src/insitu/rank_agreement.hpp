@@ -43,6 +43,14 @@ struct CallRecord {
   std::int64_t snapshots = 0;
   bool compare_time = false;
   std::array<double, kShapeValues> shape{};  ///< start only
+  /// A call at a step and time of the simulation (process, due: both compared); step -1: a time only.
+  static CallRecord at(std::int64_t step, double time) {
+    CallRecord r;
+    r.step = step;
+    r.time = time;
+    r.compare_time = true;
+    return r;
+  }
 };
 
 /// How bad a rank's own failure at a call is.

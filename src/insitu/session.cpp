@@ -153,11 +153,7 @@ bool Session::due(std::int64_t step, double time) const {
   OverheadMeter::Scope counted(*m.meter);
   // Collective (issue 42): ranks that disagree here (another step or time, a skipped call) would take
   // different snapshots and wait for each other in the next one.
-  CallRecord r;
-  r.step = step;
-  r.time = time;
-  r.compare_time = true;
-  m.agree(Call::due, r, finite_refusal("due", time), Failure::refused);
+  m.agree(Call::due, CallRecord::at(step, time), finite_refusal("due", time), Failure::refused);
   return m.due_here(step, time);
 }
 
@@ -184,10 +180,7 @@ void Session::Impl::take_snapshot(double time, const std::vector<FieldInput>& fi
     refusal = m.time_refusal(time);
     if (!refusal) refusal = m.adapter ? m.grid_field_refusal(fields) : m.field_refusal(fields);
   }
-  CallRecord r;
-  r.time = time;
-  r.compare_time = true;
-  const int stop = m.agree(Call::snapshot, r, refusal, Failure::refused, stop_requested());
+  const int stop = m.agree(Call::snapshot, CallRecord::at(-1, time), refusal, Failure::refused, stop_requested());
   if (stop)
     throw Interrupted(stop, m.cfg.output_dir + ": stopped by " + signal_name(stop) + " before snapshot " +
                                 std::to_string(m.snapshots) + "; the database is marked interrupted");
@@ -231,11 +224,7 @@ bool Session::process(std::int64_t step, double time, const std::vector<FieldInp
   // One agreement every step (a few microseconds): a rank that skips a step's call, or passes another
   // step or time, is named at once instead of leaving the others waiting in the next snapshot (issue
   // 42). A time that is not finite is refused on every rank (due() cannot answer for it).
-  CallRecord r;
-  r.step = step;
-  r.time = time;
-  r.compare_time = true;
-  m.agree(Call::process, r, finite_refusal("process", time), Failure::refused);
+  m.agree(Call::process, CallRecord::at(step, time), finite_refusal("process", time), Failure::refused);
   if (!m.due_here(step, time)) return false;
   m.take_snapshot(time, fields);
   return true;

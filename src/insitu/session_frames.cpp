@@ -316,10 +316,7 @@ void Session::Impl::checkpoint(double t) {
   }
   // Every rank's encoding and flushing went well, or every rank learns which failed (this rank's
   // failed appends are in deferred_failure, which agree() reports).
-  CallRecord r;
-  r.time = t;
-  r.compare_time = true;
-  agree(Call::frames, r, local, Failure::failed);
+  agree(Call::frames, CallRecord::at(-1, t), local, Failure::failed);
 #ifdef PANOPTES_HAVE_MPI
   if (size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, comm);
 #endif

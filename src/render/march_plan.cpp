@@ -62,14 +62,19 @@ MarchPlan compile_march_plan(std::span<const PreparedField> fields, std::span<co
       luts[2 * i + std::size_t(which)] = TransferLut(tf, w.resolve(ref), opt.sample_distance);
       return luts[2 * i + std::size_t(which)];
     };
+    // The first field's slot and colour-map LUT: volumes and MIPs read them alike.
+    auto first_field = [&]() -> const TransferLut& {
+      r.kind = march_kind(t);
+      r.s1 = slot(t.field);
+      r.slots = 1u << r.s1;
+      const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
+      r.lut1 = &l1.entry(0);
+      r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
+      return l1;
+    };
     switch (t.kind) {
       case TaskKind::volume: {
-        r.kind = march_kind(t);
-        r.s1 = slot(t.field);
-        r.slots = 1u << r.s1;
-        const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
-        r.lut1 = &l1.entry(0);
-        r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
+        const TransferLut& l1 = first_field();
         if (t.field2 < 0) {
           rows[i] = vol_rows(l1);
           r.row1 = rows[i].data();
@@ -119,12 +124,7 @@ MarchPlan compile_march_plan(std::span<const PreparedField> fields, std::span<co
       case TaskKind::mip: {
         // The colour map's LUT gives the window's coordinate of a value (lo, scale, |v|) and, at the
         // maximum's bin, the colour; its opacity is not used.
-        r.kind = march_kind(t);
-        r.s1 = slot(t.field);
-        r.slots = 1u << r.s1;
-        const TransferLut& l1 = bake(t.tf, t.window, t.reference, 0);
-        r.lut1 = &l1.entry(0);
-        r.lo1 = l1.lo(), r.sc1 = l1.scale(), r.last1 = float(l1.bins() - 1), r.abs1 = l1.absolute_value();
+        first_field();
         S.march_mask |= bit;
         S.mip_mask |= bit;
         break;
