@@ -2,7 +2,7 @@
  * some of its ranks. Every rank must get an error from its next Panoptes call, naming the cause, within
  * 10 s, and no rank may hang (ctest's timeout is the hang detector); the database stays readable
  * (misuse_test.sh runs `panoptes info` on it).
- *   misuse_test CASE DIR     (2 ranks; CASE as listed in main)                                        */
+ *   misuse_test CASE DIR     (2-4 ranks, rank 1 misbehaving; CASE as listed in main)                                        */
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -61,7 +61,7 @@ static panoptes_session* start(const char* dir, const double origin_x, int dims_
 }
 
 static double field[NX * NY * (NZ + 2)];
-static const long long kCount = NX * NY * (NZ / 2 + 1);  /* this rank's ghosted block */
+static long long kCount;  /* this rank's ghosted block: its slab and a ghost layer on each inner side */
 
 static void bind(panoptes_session* s) {
   expect_ok(panoptes_set_field_n(s, "T", field, PANOPTES_FLOAT64, NULL, kCount), "set_field_n");
@@ -72,12 +72,13 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   panoptes_set_error_output(PANOPTES_ERRORS_NONE);
-  if (argc != 3 || size != 2) {
-    if (rank == 0) fprintf(stderr, "usage: mpirun -np 2 misuse_test CASE DIR\n");
+  if (argc != 3 || size < 2 || size > 4) {
+    if (rank == 0) fprintf(stderr, "usage: mpirun -np 2..4 misuse_test CASE DIR (rank 1 misbehaves)\n");
     MPI_Finalize();
     return 2;
   }
   for (int i = 0; i < NX * NY * (NZ + 2); ++i) field[i] = sin(0.3 * i);
+  kCount = (long long)NX * NY * (NZ * (rank + 1) / size - NZ * rank / size + (rank > 0) + (rank + 1 < size));
   const char* c = argv[1];
   const char* dir = argv[2];
   int taken = 0;
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
     bind(s);
     expect_ok(panoptes_process(s, 0, 0.0, &taken), "step 0");
     expect_ok(panoptes_process(s, 1, 0.1, &taken), "step 1");
-    if (rank == 0) expect_error(panoptes_process(s, 2, 0.2, &taken), "out of step", "rank 0 at step 2");
+    if (rank != 1) expect_error(panoptes_process(s, 2, 0.2, &taken), "out of step", "the others at step 2");
     expect_error(panoptes_process(s, 3, 0.3, &taken), "out of step", "step 3");
     panoptes_destroy(s);
   } else if (!strcmp(c, "times")) {
@@ -148,7 +149,7 @@ int main(int argc, char** argv) {
     panoptes_session* s = start(dir, 0, NZ);
     bind(s);
     expect_ok(panoptes_process(s, 0, 0.0, &taken), "step 0");
-    if (rank == 0) expect_error(panoptes_process(s, 1, 0.1, &taken), "did not come", "rank 0 waiting for rank 1");
+    if (rank != 1) expect_error(panoptes_process(s, 1, 0.1, &taken), "did not come", "the others waiting for rank 1");
     MPI_Barrier(MPI_COMM_WORLD);  /* rank 1 waits here, in the code's own collective */
     if (rank == 1) expect_error(panoptes_process(s, 2, 0.2, &taken), "out of step", "rank 1 after skipping");
     expect_error(panoptes_finalize(s), "the session stopped", "finalize");

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # One case of the misuse suite (misuse_test.c, issue 42) on 2 ranks; then the database, when the case
 # made one, must still be readable by `panoptes info` (an interrupted or complete database, never a
-# broken one).   misuse_test.sh MPIEXEC EXE PANOPTES CASE DIR
+# broken one).   misuse_test.sh MPIEXEC EXE PANOPTES CASE DIR [RANKS (default 2)]
 set -uo pipefail
-mpiexec=$1 exe=$2 panoptes=$3 case=$4 dir=$5
+mpiexec=$1 exe=$2 panoptes=$3 case=$4 dir=$5 ranks=${6:-2}
 rm -rf "$dir"
-"$mpiexec" --oversubscribe -np 2 "$exe" "$case" "$dir"
+"$mpiexec" --oversubscribe -np "$ranks" "$exe" "$case" "$dir"
 rc=$?
 [ $rc -eq 0 ] || { echo "misuse_test.sh: case $case failed (exit $rc)" >&2; exit 1; }
 if [ -f "$dir/panoptes.json" ]; then
