@@ -267,6 +267,20 @@ int main(int argc, char** argv) {
                                            "-90.0,60.0,1.0,1.0/-90.0_60.0_contour.png\n");
   write(out / "cinema_csv" / "export.csv", "time,phi,theta,shell,task,task_name,FILE\r\n0,-180,30,0,0,iso 0.5,image/c0/t0_f0.png\r\n"
                                            "0.1,90,-30,1,1,\"a, \"\"b\"\"\",image/c1/t1_f1.png\r\n");
+  // Whole Cinema tables for the import plan (cinema_plan): the producers' layouts and the wild ones of
+  // issue 44 (cinema_python's image/{phi}/{theta}.png under FILE_png, timestep, measure columns, .npz
+  // layers, a second image column, a Static camera, latitude-style Ascent theta).
+  write(out / "cinema_plan" / "paraview.csv",
+        "phi,producer,theta,time,FILE_png\n000.00,iso150,000.00,0,iso150_000000p=000.00t=000.00.png\n"
+        "090.00,iso150,120.00,0,iso150_000000p=090.00t=120.00.png\n");
+  write(out / "cinema_plan" / "cinema_python_layout.csv",
+        "phi,theta,FILE_png\n0,-30,image/0/-30.png\n90,-30,image/90/-30.png\n0,30,image/0/30.png\n90,30,image/90/30.png\n");
+  write(out / "cinema_plan" / "wild.csv",
+        "timestep,phi,theta,max_value,FILE,FILE2\n0,0,0,1.5,a/0_0.png,b/0_0.npz\n0,90,0,2.5,a/90_0.png,b/90_0.npz\n"
+        "1,0,0,1.7,a/1_0_0.png,b/1_0_0.npz\n1,90,0,2.9,a/1_90_0.png,b/1_90_0.npz\n");
+  write(out / "cinema_plan" / "static.csv", "time,FILE\n0,img/0.png\n1,img/1.png\n");
+  write(out / "cinema_plan" / "ascent_latitude.csv",
+        "phi,theta,time,FILE\n-180.0,-60.0,0.0,0.0/-180.0_-60.0_contour.png\n-90.0,60.0,0.0,0.0/-90.0_60.0_contour.png\n");
   // Spec A info.json as cinema_python and Ascent write it, and the older parameter_list form.
   write(out / "cinema_spec_a" / "cinema_python.json",
         R"({"arguments": {"Contour1": {"default": 150.0, "role": "control", "type": "hidden", "values": [150.0, 175.0]},)"
