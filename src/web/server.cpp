@@ -211,6 +211,8 @@ struct Server::Impl {
   /// camera table (64 MB, about a second at 10^6 cameras).
   std::uintmax_t manifest_size = 0;
   fs::file_time_type manifest_mtime{};
+  std::chrono::steady_clock::time_point reopened{};
+  static constexpr std::chrono::seconds kRunningRecheck{2};
 
   std::shared_ptr<const store::Database> database(bool reopen) {
     std::lock_guard lock(db_mutex);
@@ -219,9 +221,14 @@ struct Server::Impl {
       const fs::path manifest = db_root.dir() / store::kManifestFileName;
       const auto size = fs::file_size(manifest, ec);
       const auto mtime = fs::last_write_time(manifest, ec);
-      // A running database's status also depends on its writer being alive (store::Database::open):
-      // re-read it every time while it says running.
-      if (ec || size != manifest_size || mtime != manifest_mtime || db->status() == store::Status::running) {
+      // A running database's status also depends on its writer being alive (store::Database::open).
+      // A running database's unchanged manifest is re-read at most every kRunningRecheck seconds, for
+      // its writer's liveness: re-reading it at every request cost seconds each on a 255 MB manifest
+      // (issue 44), and many clients poll.
+      const auto now = std::chrono::steady_clock::now();
+      const bool recheck_running = db->status() == store::Status::running && now - reopened >= kRunningRecheck;
+      if (ec || size != manifest_size || mtime != manifest_mtime || recheck_running) {
+        reopened = now;
         try {
           db = std::make_shared<const store::Database>(store::Database::open(db_root.dir()));
           if (!ec) manifest_size = size, manifest_mtime = mtime;
