@@ -26,10 +26,7 @@ std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), {}};
 }
-void write_file(const fs::path& p, const std::string& s) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << s;
-}
+using store::testing::write_file;
 
 // A smooth picture, as renderings are, that differs with every parameter: a gradient tinted by
 // `tint` and a soft blob whose place follows phi/theta and whose size follows time.

@@ -23,10 +23,7 @@ using store::testing::TempDir;
 
 namespace {
 
-void write_file(const fs::path& p, const std::string& s) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << s;
-}
+using store::testing::write_file;
 
 void small_png(const fs::path& p) {
   fs::create_directories(p.parent_path());

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
 
@@ -11,6 +12,12 @@
 #include "store/manifest.hpp"
 
 namespace panoptes::store::testing {
+
+/// Writes `text` to `path`, creating its directories (test fixtures: tables, manifests, images).
+inline void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary) << text;
+}
 
 /// The message of the panoptes::Error that f() throws, or "<no error>" (tests assert on messages).
 template <class F>
