@@ -1,13 +1,16 @@
 // Compositing traffic of the in-situ session, measured and modelled (issue 46: past one machine).
 //
-//   mpirun -np P compositing_traffic measure W H   one snapshot through insitu::Session on P z-slabs of a
-//                                                  64x128x40 grid, 130 Yin-Yang cameras x 3 tasks at WxH;
+//   mpirun -np P compositing_traffic measure W H [RIG]
+//                                                  one snapshot through insitu::Session on P z-slabs of a
+//                                                  64x128x40 grid, 130 Yin-Yang cameras (or RIG) x 3 tasks at WxH;
 //                                                  every point-to-point message is counted (MPI_Send/Isend/
 //                                                  Recv are interposed below) and compared with the model
 //   compositing_traffic model                      the model at the paper's scale: 256x512x160 points,
 //                                                  130 cameras x 3 tasks at 920x896, 10^2..10^4 ranks on a
-//                                                  3-D block decomposition, direct send against a tiled
-//                                                  direct send and binary swap
+//                                                  3-D block decomposition, direct send against bands
+//                                                  (the session's schedule when ranks outnumber cameras)
+//                                                  and binary swap
+//   compositing_traffic blend LAYERS               CPU-ns per pixel and layer of the owner's blending
 //
 // The model is the session's own rule (session_frames.cpp): per camera, every rank with a brick sends
 // its K partial images - each the brick's projected bounding rectangle (render_brick's rule: the 8 corner
@@ -18,6 +21,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -30,24 +35,31 @@
 #include "insitu/halo.hpp"
 #include "insitu/session.hpp"
 #include "render/field_view.hpp"
+#include "render/partial_image.hpp"
 #include "render/synthetic_fields.hpp"
 
 using namespace panoptes;
 
 // ---- Counting every point-to-point message (PMPI interposition: these definitions replace the MPI
-// library's for the whole process, the session's calls included). Tag 11 is the session's partial images.
+// library's for the whole process, the session's calls included). Tags 11-13 are the session's compositing
+// (partial images, band partials, finished band rows); a message to oneself is not counted.
 namespace {
-constexpr int kCompositingTag = 11;
+constexpr int kCompositingTag = 11, kBandTag = 12, kRowsTag = 13;
 struct Count {
   long long msgs = 0, bytes = 0;
 };
 Count g_sent[2], g_recv[2];  // [0] partial images (tag 11), [1] every other point-to-point message
 long long g_collectives = 0;
 
-void add(Count* table, int tag, long long count, MPI_Datatype type) {
+void add(Count* table, int tag, long long count, MPI_Datatype type, int peer = -1, MPI_Comm comm = MPI_COMM_NULL) {
+  if (comm != MPI_COMM_NULL) {  // a message to oneself is a copy, not traffic
+    int me = -1;
+    PMPI_Comm_rank(comm, &me);
+    if (peer == me) return;
+  }
   int size = 0;
   PMPI_Type_size(type, &size);
-  Count& c = table[tag == kCompositingTag ? 0 : 1];
+  Count& c = table[tag == kCompositingTag || tag == kBandTag || tag == kRowsTag ? 0 : 1];
   ++c.msgs;
   c.bytes += count * size;
 }
@@ -55,11 +67,11 @@ void add(Count* table, int tag, long long count, MPI_Datatype type) {
 
 extern "C" {
 int MPI_Send(const void* buf, int count, MPI_Datatype type, int dest, int tag, MPI_Comm comm) {
-  add(g_sent, tag, count, type);
+  add(g_sent, tag, count, type, dest, comm);
   return PMPI_Send(buf, count, type, dest, tag, comm);
 }
 int MPI_Isend(const void* buf, int count, MPI_Datatype type, int dest, int tag, MPI_Comm comm, MPI_Request* req) {
-  add(g_sent, tag, count, type);
+  add(g_sent, tag, count, type, dest, comm);
   return PMPI_Isend(buf, count, type, dest, tag, comm, req);
 }
 int MPI_Recv(void* buf, int count, MPI_Datatype type, int source, int tag, MPI_Comm comm, MPI_Status* status) {
@@ -68,7 +80,7 @@ int MPI_Recv(void* buf, int count, MPI_Datatype type, int source, int tag, MPI_C
   const int rc = PMPI_Recv(buf, count, type, source, tag, comm, st);
   int got = 0;
   PMPI_Get_count(st, type, &got);
-  add(g_recv, st->MPI_TAG, got, type);
+  add(g_recv, st->MPI_TAG, got, type, st->MPI_SOURCE, comm);
   return rc;
 }
 int MPI_Allreduce(const void* s, void* r, int n, MPI_Datatype t, MPI_Op op, MPI_Comm comm) {
@@ -160,7 +172,8 @@ std::vector<RankTraffic> direct_send(const Setting& s) {
   return t;
 }
 
-/// The alternative when ranks outnumber cameras: each camera's image is cut into T = ceil(P / C) bands of
+/// The session's schedule when ranks outnumber cameras (Session::Impl::render_snapshot_banded): each
+/// camera's image is cut into T = ceil(P / C) bands of
 /// rows, band j of camera c composited by rank (c·T + j) mod P; a brick sends each band its rect meets
 /// the part of its rect inside it, and each band's owner sends the finished band (RGBA8, K tasks) to the
 /// camera's encoder (rank c mod P). Sending is what direct send sends (plus headers); receiving and
@@ -183,7 +196,7 @@ std::vector<RankTraffic> tiled_direct_send(const Setting& s) {
       for (int j = int(std::int64_t(rect.y0) * T / H); j < T && band_y0(j) < rect.y1; ++j) {
         const int a = std::max(rect.y0, band_y0(j)), b = std::min(rect.y1, band_y0(j + 1));
         if (b <= a || band_owner(j) == r) continue;
-        const double bytes = K * (16.0 + 20.0 * double(rect.width()) * (b - a));
+        const double bytes = 8.0 + K * (16.0 + 20.0 * double(rect.width()) * (b - a));
         t[std::size_t(r)].sent_msgs += 1;
         t[std::size_t(r)].sent_bytes += bytes;
         t[std::size_t(band_owner(j))].recv_msgs += 1;
@@ -192,7 +205,7 @@ std::vector<RankTraffic> tiled_direct_send(const Setting& s) {
     }
     for (int j = 0; j < T; ++j) {
       if (band_owner(j) == encoder) continue;
-      const double bytes = K * 4.0 * W * (band_y0(j + 1) - band_y0(j));
+      const double bytes = 8.0 + K * 4.0 * W * (band_y0(j + 1) - band_y0(j));
       t[std::size_t(band_owner(j))].sent_msgs += 1;
       t[std::size_t(band_owner(j))].sent_bytes += bytes;
       t[std::size_t(encoder)].recv_msgs += 1;
@@ -308,7 +321,7 @@ int model() {
     const struct {
       const char* name;
       std::vector<RankTraffic> t;
-    } rows[] = {{"direct send (today)", direct_send(s)}, {"tiled direct send", tiled_direct_send(s)}, {"binary swap", binary_swap(s)}};
+    } rows[] = {{"direct send (today)", direct_send(s)}, {"bands (the session when P > C)", tiled_direct_send(s)}, {"binary swap", binary_swap(s)}};
     for (const auto& row : rows) {
       const Summary m = summarize(row.t);
       std::printf("| %d | %dx%dx%d | %s | %.0f | %.2f | %.2f | %.0f | %.0f | %.1f |\n", P, n[0], n[1], n[2], row.name,
@@ -319,14 +332,48 @@ int model() {
   return 0;
 }
 
-int measure(int width, int height) {
+/// CPU-nanoseconds per received pixel-layer of composite_into (the owner's blending): `layers` partial
+/// images of 920x896 with random depths and colours, one thread, median of 5.
+int blend(int layers) {
+  const int W = 920, H = 896;
+  std::vector<render::PartialImage> parts(static_cast<std::size_t>(layers));
+  std::uint32_t x = 12345;
+  const auto rnd = [&x] {
+    x = x * 1664525u + 1013904223u;
+    return float(x >> 8) / float(1u << 24);
+  };
+  for (render::PartialImage& p : parts) {
+    p.resize(W, H, {0, 0, W, H});
+    for (std::size_t i = 0; i < p.depth.size(); ++i) {
+      const float a = rnd() * 0.5f;
+      p.rgba[4 * i] = a * rnd(), p.rgba[4 * i + 1] = a * rnd(), p.rgba[4 * i + 2] = a * rnd(), p.rgba[4 * i + 3] = a;
+      p.depth[i] = rnd() * 100;
+    }
+  }
+  std::vector<const render::PartialImage*> ptr;
+  for (const render::PartialImage& p : parts) ptr.push_back(&p);
+  render::PartialImage out;
+  std::vector<double> ns;
+  for (int rep = 0; rep < 5; ++rep) {
+    timespec a{}, b{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &a);
+    render::composite_into(render::TaskKind::volume, ptr, out);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &b);
+    ns.push_back(((b.tv_sec - a.tv_sec) * 1e9 + (b.tv_nsec - a.tv_nsec)) / (double(W) * H * layers));
+  }
+  std::sort(ns.begin(), ns.end());
+  std::printf("| %d | %.2f |\n", layers, ns[2]);
+  return 0;
+}
+
+int measure(int width, int height, const std::string& rig) {
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   const render::GridGeometry g{{64, 128, 40}, {0, 0, 0}, {1, 1, 1}};
   const std::string cfg_text = "[output]\ntitle = \"compositing traffic\"\noverwrite = true\n[image]\nwidth = " +
                                std::to_string(width) + "\nheight = " + std::to_string(height) +
-                               "\n[rig]\nspec = \"yinyang\"\n[schedule]\nevery_steps = 1\n[video]\ncrf = 30\n"
+                               "\n[rig]\nspec = \"" + rig + "\"\n[schedule]\nevery_steps = 1\n[video]\ncrf = 30\n"
                                "[[task]]\nname = \"p\"\ntype = \"volume\"\nfield = \"p\"\npreset = \"p-wave\"\n"
                                "[[task]]\nname = \"s\"\ntype = \"volume\"\nfield = \"s\"\npreset = \"s-wave\"\n"
                                "[[task]]\nname = \"p+s\"\ntype = \"volume2\"\nfields = [\"p\", \"s\"]\n";
@@ -358,8 +405,11 @@ int measure(int width, int height) {
   if (rank == 0) {
     std::vector<render::Brick> bricks;
     for (int r = 0; r < size; ++r) bricks.push_back(insitu::halo::block_info(g, insitu::LocalBlock::slab(g, 2, size, r, 2)).brick);
-    const Setting s{g, bricks, yinyang_cameras(g, width, height), 3};
-    const std::vector<RankTraffic> model_t = direct_send(s);
+    const camera::Rig r = camera::make_rig(rig, camera::Domain{g.domain_lo(), g.domain_hi() - g.domain_lo()});
+    std::vector<camera::Camera> cams;
+    for (int c = 0; c < r.size(); ++c) cams.push_back(r.camera(c, width, height));
+    const Setting s{g, bricks, cams, 3};
+    const std::vector<RankTraffic> model_t = size > r.size() ? tiled_direct_send(s) : direct_send(s);
     double meas_sent = 0, model_sent = 0, meas_recv_max = 0, model_recv_max = 0, msgs_max = 0, other_mb = 0;
     long long meas_msgs = 0, model_msgs = 0;
     for (int r = 0; r < size; ++r) {
@@ -372,7 +422,7 @@ int measure(int width, int height) {
       msgs_max = std::max(msgs_max, double(all[std::size_t(4 * r + 2)]));
       other_mb = std::max(other_mb, double(all_other[std::size_t(2 * r + 1)]) / 1e6);
     }
-    std::printf("| %d | %dx%d | %lld | %lld | %.3f | %.3f | %.3f | %.3f | %.0f | %.3f |\n", size, width, height, meas_msgs,
+    std::printf("| %d | %s | %dx%d | %lld | %lld | %.3f | %.3f | %.3f | %.3f | %.0f | %.3f |\n", size, rig.c_str(), width, height, meas_msgs,
                 model_msgs, meas_sent / 1e6 / size, model_sent / 1e6 / size, meas_recv_max / 1e6, model_recv_max / 1e6,
                 msgs_max, other_mb);
     std::filesystem::remove_all(cfg.output_dir);
@@ -384,15 +434,17 @@ int measure(int width, int height) {
 
 int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
-  if (mode == "--help" || mode == "-h" || (mode != "model" && mode != "measure")) {
-    std::printf("usage: compositing_traffic model\n       mpirun -np P compositing_traffic measure [W H]\n");
+  if (mode == "--help" || mode == "-h" || (mode != "model" && mode != "measure" && mode != "blend")) {
+    std::printf("usage: compositing_traffic model\n       compositing_traffic blend LAYERS\n"
+                "       mpirun -np P compositing_traffic measure [W H [RIG]]\n");
     return mode == "--help" || mode == "-h" ? 0 : 2;
   }
   if (mode == "model") return model();
+  if (mode == "blend") return blend(argc > 2 ? std::atoi(argv[2]) : 8);
   MPI_Init(&argc, &argv);
   int rc = 0;
   try {
-    rc = measure(argc > 2 ? std::atoi(argv[2]) : 184, argc > 3 ? std::atoi(argv[3]) : 180);
+    rc = measure(argc > 2 ? std::atoi(argv[2]) : 184, argc > 3 ? std::atoi(argv[3]) : 180, argc > 4 ? argv[4] : "yinyang");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "compositing_traffic: %s\n", e.what());
     rc = 1;

@@ -3,7 +3,8 @@
 // on its owner rank with the same task rendered directly on the whole grid before encoding (max
 // difference <= 1/255), and the databases of all rank counts with each other (PSNR >= 45 dB after
 // H.264). A kind added to the enum without a table here fails at once ("no table for kind ...").
-//   insitu_kinds_mpi_test write DIR          (under mpiexec -np 1..4)
+//   insitu_kinds_mpi_test write DIR [RIG]    (under mpiexec -np 1..4; RIG replaces fibonacci:6, e.g. a
+//                                            rig of fewer cameras than ranks: band compositing)
 //   insitu_kinds_mpi_test compare DIR1 DIR2...
 #include <mpi.h>
 
@@ -65,12 +66,13 @@ std::string config_text() {
   return s;
 }
 
-int write(const std::string& dir) {
+int write(const std::string& dir, const std::string& rig_spec) {
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   insitu::SessionConfig cfg = insitu::parse_session_config_text(config_text(), "kinds_mpi_test config");
   cfg.output_dir = dir;
+  if (!rig_spec.empty()) cfg.rig = rig_spec;
   const render::GridGeometry g = test_grid();
   const insitu::LocalBlock blk = insitu::LocalBlock::slab(g, 2, size, rank, 0);
   // The renderer's tasks as the session plans them (absolute windows: no reference to resolve).
@@ -146,9 +148,9 @@ int main(int argc, char** argv) {
   int rc = 2;
   try {
     const std::string mode = argc > 1 ? argv[1] : "";
-    if (mode == "write" && argc == 3) rc = write(argv[2]);
+    if (mode == "write" && (argc == 3 || argc == 4)) rc = write(argv[2], argc == 4 ? argv[3] : "");
     else if (mode == "compare" && argc >= 4) rc = compare(std::vector<std::string>(argv + 2, argv + argc));
-    else std::fprintf(stderr, "usage: insitu_kinds_mpi_test write DIR | compare DIR1 DIR2...\n");
+    else std::fprintf(stderr, "usage: insitu_kinds_mpi_test write DIR [RIG] | compare DIR1 DIR2...\n");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "insitu_kinds_mpi_test: %s\n", e.what());
     rc = 1;

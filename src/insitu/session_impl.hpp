@@ -104,6 +104,11 @@ struct Session::Impl {
   // no brick reaches (members, so their capacity is reused from camera to camera).
   std::vector<std::vector<const render::PartialImage*>> parts;  // [task]
   render::PartialImage empty_partial;
+  // Band compositing (more ranks than cameras, render_snapshot_banded): messages out and in, the
+  // partials of one band by sender, and one finished task image of a band.
+  std::vector<std::vector<char>> band_send, band_recv;
+  std::vector<std::vector<render::PartialImage>> band_parts;  // [sender][task]
+  Image band_image;
   // Finished frames waiting to be encoded: batch[i][task] of camera batch_camera[i].
   static constexpr int kEncodeBatch = 4;
   std::vector<std::vector<Image>> batch;
@@ -155,6 +160,9 @@ struct Session::Impl {
   double global_percentile(int field);
   double window_reference(int field);
   void render_snapshot(int frame);
+#ifdef PANOPTES_HAVE_MPI
+  void render_snapshot_banded(int frame);
+#endif
   void encode_batch();
   void checkpoint(double time);
 };
