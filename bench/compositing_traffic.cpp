@@ -321,7 +321,7 @@ int model() {
     const struct {
       const char* name;
       std::vector<RankTraffic> t;
-    } rows[] = {{"direct send (today)", direct_send(s)}, {"bands (the session when P > C)", tiled_direct_send(s)}, {"binary swap", binary_swap(s)}};
+    } rows[] = {{"direct send (the session when P <= C)", direct_send(s)}, {"bands (the session when P > C)", tiled_direct_send(s)}, {"binary swap", binary_swap(s)}};
     for (const auto& row : rows) {
       const Summary m = summarize(row.t);
       std::printf("| %d | %dx%dx%d | %s | %.0f | %.2f | %.2f | %.0f | %.0f | %.1f |\n", P, n[0], n[1], n[2], row.name,
