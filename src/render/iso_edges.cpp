@@ -44,7 +44,7 @@ bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double
 
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
                        const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       std::int64_t k_last, double t_exit, float tr_stop, float* a) {
+                       std::int64_t k_last, double t_exit, float tr_stop, float* a, IsoSliver& sliver) {
   const double dt = S.dt, pitch = S.iso_aa_pitch;
   const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
   const float iso = T.iso;
@@ -113,25 +113,6 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (sa != sb) th = ta + (tb - ta) * (sa / (sa - sb));
     return th;
   };
-  // Whether the sliver an EXIT (a grazing crossing whose parabola turns back behind it) closes was
-  // entered: beyond its predicted entry, 2·reach behind the crossing (and a quarter of the reach more
-  // for the fit's error), the ray must have been on the side it now leaves to, not on sp's (sp lies
-  // inside the sliver). Where two sheets meet the fit claims an entry that never was (a valley open
-  // towards the camera): such a crossing is the ray's hit, not an exit that shows what lies behind
-  // (issue 41's cracks seen from inside). The field is read only where every brick owning sample k
-  // can read it: at most 2 voxels below sample k and less than 1 above on each axis (the ghost layers
-  // of render::required_points), so every decomposition decides alike; farther entries are trusted
-  // (telling those apart needs the ray's crossings in the bricks in front).
-  const auto sliver_entered = [&](std::int64_t k, double th, double reach, float sp) {
-    const double entry = th + 2 * reach - (0.25 * std::abs(reach) + 0.05 * dt);
-    const double tk = t0 + double(k) * dt;
-    for (int a = 0; a < 3; ++a) {
-      const double d = (entry - tk) * D[a];
-      if (!(d >= -2.0 && d < 1.0)) return true;
-    }
-    const double se = interp_clamped(f, O[0] + entry * D[0], O[1] + entry * D[1], O[2] + entry * D[2]) - iso;
-    return (se < 0) != (sp < 0);
-  };
   for (; cand; cand &= cand - 1) {
     const int j = std::countr_zero(cand) + 1;
     const float sp = s(j - 1), sc = s(j);
@@ -198,7 +179,8 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
         // exit: a first crossing where the bend does curve back but the region behind is open
         // towards the camera (a valley where two sheets meet); telling it from a real exit needs
         // the ray's earlier crossings, which a brick does not see when they lie in the brick in
-        // front (docs/rendering.md, "Isosurface anti-aliasing").
+        // front: the sliver state below, carried across bricks by compositing (docs/rendering.md,
+        // "Isosurface anti-aliasing").
         double gm[3], gq[3], Hu[3];
         const double tm = t0 + double(k - 1) * dt, tq = tm + dt;
         const double pm[3] = {O[0] + tm * D[0], O[1] + tm * D[1], O[2] + tm * D[2]};
@@ -214,10 +196,35 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
           const double reach = -s1 / s2;  // world units from the hit to the vertex
           if (std::abs(reach) <= max_reach * dt) {
             const double cover = 0.5 + s1 * s1 / (2 * std::abs(s2)) / gn / (th * pitch);
-            if (cover < 1) alpha = reach > 0 ? cover : sliver_entered(k, th, reach, sp) ? 0.0 : 1.0;
+            if (cover < 1) {
+              if (reach > 0) {  // an entry: it takes the coverage, its exit comes later
+                alpha = cover;
+                sliver.state = SliverEnd::open;
+                if (add(rgb, alpha)) return j - 1;
+                continue;
+              }
+              // An exit adds nothing when its entry came before it on the ray. Without one the sliver
+              // the local fit claims behind is open towards the camera (a valley where two sheets
+              // meet, issue 41's cracks and speckles) and the crossing is the ray's hit. Whether an
+              // entry came may be up to the bricks in front (state pass): the march goes on as if
+              // one did and keeps the hit in `alt` (compositing picks, PartialImage::rgba_open).
+              if (sliver.state == SliverEnd::open) {
+                sliver.state = SliverEnd::closed;
+                continue;
+              }
+              if (sliver.state == SliverEnd::pass) {
+                const float T0 = a[3];
+                for (int c = 0; c < 3; ++c) sliver.alt[c] = a[c] + T0 * rgb[c];
+                sliver.alt[3] = 0;
+                sliver.has_alt = true;
+                sliver.state = SliverEnd::closed;
+                continue;
+              }
+            }
           }
         }
       }
+      sliver.state = SliverEnd::closed;  // an opaque hit
       if (alpha <= 0) continue;
       if (add(rgb, alpha)) return j - 1;
       continue;
@@ -296,6 +303,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       alignas(16) float rgb[4];
       shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb);
       add(rgb, 1.0);
+      sliver.state = SliverEnd::closed;
       return n - 1;
     }
   }

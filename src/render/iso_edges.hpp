@@ -8,6 +8,7 @@
 #include "core/vec3.hpp"
 #include "render/field_access.hpp"
 #include "render/march_plan.hpp"
+#include "render/partial_image.hpp"
 #include "render/sample_blocks.hpp"
 
 namespace panoptes::render::march {
@@ -15,6 +16,19 @@ namespace panoptes::render::march {
 /// Angular pitch of a pixel (radians) at the image centre: what RenderOptions::iso_antialias
 /// converts a ray-to-surface distance into pixels with (footprint = distance along the ray × pitch).
 double pixel_pitch(const camera::Camera& cam);
+
+/// One ray's grazing-sliver state of one isosurface task, from where the ray enters a brick to
+/// where it leaves (anti-aliasing only). A grazing ray's entry gets the coverage and its exit adds
+/// nothing; an exit with no entry before it on the ray is no exit but a hit (a valley where two
+/// sheets meet, open towards the camera: issue 41's speckles and cracks). The entry may lie in a
+/// brick in front, so a brick marches as if a sliver were open at its front and keeps, in `alt`, the
+/// colour as if none were (its first exit an opaque hit); compositing picks per brick the colour its
+/// front's state calls for (PartialImage::rgba_open, SliverEnd).
+struct IsoSliver {
+  SliverEnd state;  ///< the ray's state so far in this brick: pass = no entry, exit or hit yet
+  bool has_alt;     ///< the first such event was an exit: `alt` differs from the march's accumulator
+  float alt[4];     ///< colour (premultiplied) and transmittance [3] with no sliver open at the front
+};
 
 /// One block of an isosurface task's march with anti-aliasing (MarchPlan::iso_aa_pitch > 0).
 /// v[0] is the value at sample k0 − 1 (valid when `prev`), v[1 + l] at sample k0 + l, l < n.
@@ -24,10 +38,10 @@ double pixel_pitch(const camera::Camera& cam);
 ///   s'' = u·Hu − (n·Hu)(n·u) from the gradients at samples k − 1 and k, must curve the same way and
 ///   sets the depth s'²/(2|s''|)/|∇f| (the field's own curvature across the surface bends the
 ///   parabola too: issue 41). Coverage c = 0.5 + depth / footprint (box filter); the entry (vertex
-///   ahead) gets α = c, the exit (vertex behind) adds nothing, so both together cover c; a crossing
-///   with c ≥ 1 is opaque (the old hit). An exit whose predicted entry lies within the ghost layers
-///   of its sample (2 voxels below, 1 above) must have the ray on the other side beyond it, else it
-///   is no exit but a hit (two sheets meeting: issue 43).
+///   ahead) gets α = c and opens the sliver, the exit (vertex behind) adds nothing and closes it, so
+///   both together cover c; a crossing with c ≥ 1 is opaque (the old hit). An exit while no sliver
+///   is open is a hit (two sheets meeting); while the brick does not know yet (`sliver.state` pass:
+///   the entry may lie in a brick in front) it adds nothing and `sliver.alt` keeps the hit.
 /// - a local minimum of |s| at sample k (no sign change): the field at the parabola's vertex, one
 ///   extra sample, tells a sliver pierced between two samples (a hit, found by regula falsi towards
 ///   the vertex: the saw teeth of grazing views came from missing those) from a near miss, which
@@ -40,6 +54,6 @@ double pixel_pitch(const camera::Camera& cam);
 /// where the task became opaque, or −1.
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
                        const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       std::int64_t k_last, double t_exit, float tr_stop, float* a);
+                       std::int64_t k_last, double t_exit, float tr_stop, float* a, IsoSliver& sliver);
 
 }  // namespace panoptes::render::march
