@@ -43,8 +43,9 @@ bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double
 }  // namespace
 
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
-                       const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       std::int64_t k_last, double t_exit, float tr_stop, float* a, IsoSliver& sliver) {
+                       const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v,
+                       const float* range, unsigned cand, std::int64_t k_last, double t_exit, float tr_stop, float* a,
+                       IsoSliver& sliver) {
   const double dt = S.dt, pitch = S.iso_aa_pitch;
   const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
   const float iso = T.iso;
@@ -70,38 +71,6 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     a[3] = alpha >= 1 ? 0.0f : float(T0 * (1 - alpha));
     return a[3] <= tr_stop;
   };
-  // Candidate lanes (bit j − 1 for sample j): crossings and local minima of |s|, for the whole block
-  // at once; the last lane's minimum needs the sample after the block, fetched only if it passes
-  // the cell test below.
-  unsigned cand = 0;
-#ifdef PANOPTES_RENDER_AVX2
-  {
-    const __m256 isov = _mm256_set1_ps(iso), sign = _mm256_set1_ps(-0.0f);
-    const __m256 a0 = _mm256_sub_ps(_mm256_loadu_ps(v), isov), b0 = _mm256_sub_ps(_mm256_loadu_ps(v + 1), isov),
-                 c0 = _mm256_sub_ps(_mm256_loadu_ps(v + 2), isov);
-    const __m256 aa = _mm256_andnot_ps(sign, a0), ab = _mm256_andnot_ps(sign, b0), ac = _mm256_andnot_ps(sign, c0);
-    const __m256 zero = _mm256_setzero_ps();
-    const __m256 na = _mm256_cmp_ps(a0, zero, _CMP_LT_OQ), nb = _mm256_cmp_ps(b0, zero, _CMP_LT_OQ),
-                 nc = _mm256_cmp_ps(c0, zero, _CMP_LT_OQ);
-    const __m256 cross = _mm256_xor_ps(na, nb);
-    const __m256 minimum = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ab, aa, _CMP_LT_OQ), _mm256_cmp_ps(ab, ac, _CMP_LE_OQ)),
-                                         _mm256_andnot_ps(_mm256_xor_ps(nb, nc), _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
-    cand = unsigned(_mm256_movemask_ps(_mm256_or_ps(cross, minimum)));
-  }
-#else
-  for (int j = 1; j <= kBlock; ++j) {
-    const float sp = v[j - 1] - iso, sc = v[j] - iso, sn = v[j + 1] - iso;
-    const bool cross = (sp < 0) != (sc < 0);
-    const bool minimum = std::abs(sc) < std::abs(sp) && std::abs(sc) <= std::abs(sn) && (sc < 0) == (sn < 0);
-    cand |= unsigned(cross || minimum) << (j - 1);
-  }
-#endif
-  {  // lane n: its successor is not in v
-    const float sp = v[n - 1] - iso, sc = v[n] - iso;
-    const bool maybe = (sp < 0) != (sc < 0) || std::abs(sc) < std::abs(sp);
-    cand = (cand & ((1u << (n - 1)) - 1)) | (unsigned(maybe) << (n - 1));
-  }
-  if (!prev) cand &= ~1u;
   const float hmin = float(std::min({S.spacing[0], S.spacing[1], S.spacing[2]}));
   // The hit on a bracket [ta, tb] whose field values minus the isovalue (sa, sb) differ in sign: the
   // linear estimate and one regula-falsi step.
@@ -119,7 +88,9 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     const bool cross = (sp < 0) != (sc < 0);
     const std::int64_t k = k0 - 1 + j;
     float cell_range = 0;
-    if (!cross) {
+    if (!cross && range) {
+      cell_range = range[j - 1];  // tested above
+    } else if (!cross) {
       // A near miss needs the surface within half a voxel: in this grid cell, |∇f| per voxel is at
       // most √3 × the corners' range r, so |s| > r (a factor 2 of margin) cannot be one. 8 loads
       // instead of a gradient for most local minima of a wavy field.

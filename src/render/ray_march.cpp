@@ -337,6 +337,9 @@ class RayMarch {
       // Isosurfaces and maxima read the float field (vb), volumes their classification values (vq).
       (T.kind == MarchKind::iso || T.kind == MarchKind::mip ? smask : vmask) |= T.slots;
     }
+    // Anti-aliased isosurfaces also take each sample's cell range from the gathers (near misses).
+    const std::uint32_t rmask = S.iso_aa_pitch > 0 && (lm & S.iso_mask) ? smask : 0;
+    ranged = 0;
     // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_mates, found at
     // setup; a joint copy's partner first: their records share a cache line and one prefetch).
     std::uint32_t cm = vmask & S.corner_slots;
@@ -385,7 +388,11 @@ class RayMarch {
         vb[s][0] = interp_clamped(fa[s], P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
         prev_valid |= 1u << s;
       }
-      interp_block(fa[s], P, k0, n, safe, &vb[s][1]);
+      if (rmask >> s & 1) {
+        if (interp_block(fa[s], P, k0, n, safe, &vb[s][1], vr[s])) ranged |= 1u << s;
+      } else {
+        interp_block(fa[s], P, k0, n, safe, &vb[s][1]);
+      }
     }
     for (std::uint32_t m = vq_from_vb; m; m &= m - 1) {
       const int s = std::countr_zero(m);
@@ -442,8 +449,11 @@ class RayMarch {
           const float* v = vb[T.s1];
           const int l0 = (prev_valid >> T.s1 & 1) ? 0 : 1;
           if (S.iso_aa_pitch > 0) {
-            stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, l0 == 0, k_last, t_exit, tr_stop, a,
-                                      sliver[i]);
+            const float* range = ranged >> T.s1 & 1 ? vr[T.s1] : nullptr;
+            const unsigned cand = iso_aa_candidates(v, range, n, l0 == 0, T.iso);
+            if (cand || k0 + n - 1 == k_last)
+              stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, range, cand, k_last, t_exit, tr_stop, a,
+                                        sliver[i]);
             break;
           }
           // Lanes whose segment (sample l − 1 … l) changes sign, found for the whole block at once.
@@ -522,6 +532,8 @@ class RayMarch {
   // values; prev_valid: slots whose vb[s][0] is that previous sample (isosurface crossings need it).
   alignas(32) float vb[8][2 * kBlock];
   alignas(32) float vq[8][kBlock];
+  alignas(32) float vr[8][kBlock];  // per slot: the cell range of each sample of the block (when `ranged`)
+  std::uint32_t ranged = 0;
   std::uint32_t prev_valid = 0, vq_from_vb = 0;
   const std::int64_t k_last;  // the ray's last sample in the domain, and where it leaves the domain
   const double t_exit;        // (isosurface anti-aliasing looks at the stretch between them)
