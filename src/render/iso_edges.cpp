@@ -55,7 +55,25 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
   // s(j) = f − iso at sample k0 − 1 + j; j = n + 1 (the sample after the block) only on demand.
   float after = 0;
   bool have_after = false;
+  // The previous block's pending last lane (sample k0 − 1, lane j = 0 below) when this block follows
+  // it; otherwise it is looked at alone first.
+  bool lane0 = false;
+  float pend_sp = 0;
+  if (sliver.pending) {
+    if (k0 == sliver.pend_k + 1) {
+      sliver.pending = false;
+      lane0 = true;
+      pend_sp = sliver.pend_v[0];
+    } else if (resolve_pending_lane(S, T, f, P, O, D, dir, t0, k_last, t_exit, tr_stop, a, sliver) >= 0) {
+      return 0;
+    }
+  }
+  // This block's last lane waits for the next block when it is a minimum candidate only (not the
+  // ray's last sample: no block follows that; nor a block of one sample).
+  const bool defer = (cand >> (n - 1) & 1) && n > 1 && k0 + n - 1 != k_last && (v[n - 1] < iso) == (v[n] < iso);
+  if (defer) cand &= ~(1u << (n - 1));
   auto s = [&](int j) -> float {
+    if (j < 0) return pend_sp - iso;
     if (j <= n) return v[j] - iso;
     if (!have_after) {
       const float fk = float(k0 + n);  // the march's float positions (as interp_block's)
@@ -82,13 +100,16 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (sa != sb) th = ta + (tb - ta) * (sa / (sa - sb));
     return th;
   };
-  for (; cand; cand &= cand - 1) {
-    const int j = std::countr_zero(cand) + 1;
+  // Bit j for lane j: sample k0 − 1 + j (lane 0: the previous block's pending lane).
+  for (std::uint32_t lanes = cand << 1 | unsigned(lane0); lanes; lanes &= lanes - 1) {
+    const int j = std::countr_zero(lanes);
     const float sp = s(j - 1), sc = s(j);
     const bool cross = (sp < 0) != (sc < 0);
     const std::int64_t k = k0 - 1 + j;
     float cell_range = 0;
-    if (!cross && range) {
+    if (!cross && j == 0 && sliver.pend_ranged) {
+      cell_range = sliver.pend_range;  // tested in the previous block
+    } else if (!cross && j > 0 && range) {
       cell_range = range[j - 1];  // tested above
     } else if (!cross) {
       // A near miss needs the surface within half a voxel: in this grid cell, |∇f| per voxel is at
@@ -171,7 +192,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
               if (reach > 0) {  // an entry: it takes the coverage, its exit comes later
                 alpha = cover;
                 sliver.state = SliverEnd::open;
-                if (add(rgb, alpha)) return j - 1;
+                if (add(rgb, alpha)) return std::max(j - 1, 0);
                 continue;
               }
               // An exit adds nothing when its entry came before it on the ray. Without one the sliver
@@ -197,7 +218,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       }
       sliver.state = SliverEnd::closed;  // an opaque hit
       if (alpha <= 0) continue;
-      if (add(rgb, alpha)) return j - 1;
+      if (add(rgb, alpha)) return std::max(j - 1, 0);
       continue;
     }
     // A local minimum of |s|: the ray passes near the surface, or pierces a sliver of it between
@@ -239,7 +260,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
       // Its depth is at least |s| at the point found / |∇f|: coverage of the pair in one event.
       const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_out) / gn / (th * pitch) : 1.0;
-      if (add(rgb, std::min(1.0, cover))) return j - 1;
+      if (add(rgb, std::min(1.0, cover))) return std::max(j - 1, 0);
       continue;
     }
     const double tv = t0 + (double(k) + ub) * dt, s_v = fb;
@@ -256,7 +277,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
     const double cover = 0.5 - x / footprint;
     if (cover <= 0) continue;
-    if (add(rgb, cover)) return j - 1;
+    if (add(rgb, cover)) return std::max(j - 1, 0);
   }
   if (k0 + n - 1 == k_last && t_exit > t0 + double(k_last) * dt) {
     // The ray's last stretch in the domain, after its last sample.
@@ -278,7 +299,26 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       return n - 1;
     }
   }
+  if (defer) {
+    sliver.pending = true;
+    sliver.pend_k = k0 + n - 1;
+    sliver.pend_v[0] = v[n - 1], sliver.pend_v[1] = v[n];
+    sliver.pend_ranged = range != nullptr;
+    sliver.pend_range = range ? range[n - 1] : 0.0f;
+  }
   return -1;
+}
+
+int resolve_pending_lane(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
+                         const double D[3], const Vec3& dir, double t0, std::int64_t k_last, double t_exit, float tr_stop,
+                         float* a, IsoSliver& sliver) {
+  sliver.pending = false;
+  // A block of one sample (pend_k; v[0] the sample before), its lane a candidate: the sample after it
+  // is interpolated on demand, as before the lane waited.
+  const float v[2] = {sliver.pend_v[0], sliver.pend_v[1]};
+  const float range = sliver.pend_range;
+  return march_iso_block_aa(S, T, f, P, O, D, dir, t0, sliver.pend_k, 1, v, sliver.pend_ranged ? &range : nullptr, 1u,
+                            k_last, t_exit, tr_stop, a, sliver);
 }
 
 }  // namespace panoptes::render::march

@@ -29,6 +29,15 @@ struct IsoSliver {
   SliverEnd state;  ///< the ray's state so far in this brick: pass = no entry, exit or hit yet
   bool has_alt;     ///< the first such event was an exit: `alt` differs from the march's accumulator
   float alt[4];     ///< colour (premultiplied) and transmittance [3] with no sliver open at the front
+  /// A block's last lane whose |s| falls is a near-miss candidate only if |s| rises again at the
+  /// sample after the block, which the next block interpolates anyway: the lane waits for it
+  /// (`pending`, sample pend_k with the values pend_v of samples pend_k − 1 and pend_k and its cell
+  /// range) instead of interpolating that sample alone (most such lanes are then no minimum).
+  bool pending;
+  bool pend_ranged;
+  float pend_v[2];
+  float pend_range;
+  std::int64_t pend_k;
 };
 
 /// The lanes of a block that an anti-aliased isosurface must look at (bit j − 1 for sample k0 − 1 + j,
@@ -74,8 +83,8 @@ inline unsigned iso_aa_candidates(const float* v, const float* range, int n, boo
 }
 
 /// One block of an isosurface task's march with anti-aliasing (MarchPlan::iso_aa_pitch > 0), for the
-/// candidate lanes `cand` of iso_aa_candidates() (called when there are some, or when the block holds
-/// the ray's last sample in the domain).
+/// candidate lanes `cand` of iso_aa_candidates() (called when there are some, when a lane of the
+/// previous block is pending, or when the block holds the ray's last sample in the domain).
 /// v[0] is the value at sample k0 − 1 (valid when bit 0 of cand may be set), v[1 + l] at sample
 /// k0 + l, l < n; range[l] (may be null: then read here) the range of the eight corners of sample
 /// k0 + l's cell.
@@ -103,5 +112,12 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
                        const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v,
                        const float* range, unsigned cand, std::int64_t k_last, double t_exit, float tr_stop, float* a,
                        IsoSliver& sliver);
+
+/// A pending last lane (IsoSliver::pending) whose next block did not follow (the run or the brick's
+/// part of the ray ended): looks at it with the sample after it interpolated alone. Returns ≥ 0
+/// when the task became opaque there, else −1.
+int resolve_pending_lane(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
+                         const double D[3], const Vec3& dir, double t0, std::int64_t k_last, double t_exit, float tr_stop,
+                         float* a, IsoSliver& sliver);
 
 }  // namespace panoptes::render::march

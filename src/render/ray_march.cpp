@@ -114,6 +114,19 @@ class RayMarch {
     }
   }
 
+  // After the march: anti-aliased isosurface tasks still live whose last block left a lane pending
+  // (IsoSliver::pending) look at it now, before the accumulators are read.
+  void resolve_pending_lanes() {
+    if (!(S.iso_aa_pitch > 0)) return;
+    for (std::uint64_t m = live & S.iso_mask; m; m &= m - 1) {
+      const int i = std::countr_zero(m);
+      if (!sliver[i].pending) continue;
+      const MarchTask& T = S.rt[std::size_t(i)];
+      if (resolve_pending_lane(S, T, fa[T.s1], P, O, D, dir, t0, k_last, t_exit, tr_stop, acc[i], sliver[i]) >= 0)
+        live &= ~(std::uint64_t(1) << i);
+    }
+  }
+
   // Dense scenes (S.direct): whether the ray's samples ks … ke meet none of the plan's exception
   // boxes, so that one run over the whole ray is the merged walk.
   bool clear_of_exceptions(std::int64_t ks, std::int64_t ke) const {
@@ -451,7 +464,7 @@ class RayMarch {
           if (S.iso_aa_pitch > 0) {
             const float* range = ranged >> T.s1 & 1 ? vr[T.s1] : nullptr;
             const unsigned cand = iso_aa_candidates(v, range, n, l0 == 0, T.iso);
-            if (cand || k0 + n - 1 == k_last)
+            if (cand || sliver[i].pending || k0 + n - 1 == k_last)
               stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, range, cand, k_last, t_exit, tr_stop, a,
                                         sliver[i]);
             break;
@@ -563,6 +576,7 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
     IsoSliver& sl = sliver[std::countr_zero(m)];
     sl.state = ks == 0 ? SliverEnd::closed : SliverEnd::pass;
     sl.has_alt = false;
+    sl.pending = false;
   }
   RayMarch ray(S, O, D, dir, t0, tg1, ke, kg_last, mm, acc, marched, sliver);
   if (S.direct && ray.clear_of_exceptions(ks, ke)) {
@@ -572,6 +586,7 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   } else {
     ray.walk_macro_cells(ks, ke);
   }
+  ray.resolve_pending_lanes();
   for (std::uint64_t m = mm & ~S.mip_mask; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
