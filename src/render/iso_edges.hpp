@@ -1,8 +1,10 @@
 #pragma once
 // Isosurface anti-aliasing in the march (issue 32): partial coverage where a ray passes within a
 // pixel footprint of the surface, so silhouettes are not stair-stepped. Compositing-exact: every
-// contribution is a sample of one ray at one owned position, and every decision uses the brick's
-// data within its ghost layers, so bricks still composite to the single-brick image.
+// contribution is a sample of one ray at one owned position, every local decision uses the brick's
+// data within its ghost layers, and the one that needs the ray's history (was a grazing sliver
+// entered before this exit?) is carried across bricks by compositing (IsoSliver, PartialImage::slivers),
+// so bricks still composite to the single-brick image.
 #include <cmath>
 #include <cstdint>
 
