@@ -278,7 +278,8 @@ SessionStats Session::stats() const {
   for (const auto& b : m.buffers) s.field_buffer_bytes += std::int64_t(b.capacity() * sizeof(float));
   for (const auto& p : m.prepared) s.field_buffer_bytes += std::int64_t(p.corners.bytes());
   auto add = [&](const render::PartialImage& p) {
-    s.partial_buffer_bytes += std::int64_t((p.rgba.capacity() + p.depth.capacity()) * sizeof(float));
+    s.partial_buffer_bytes += std::int64_t((p.rgba.capacity() + p.depth.capacity() + p.rgba_open.capacity()) * sizeof(float) +
+                                           p.sliver_end.capacity());
   };
   for (const auto& v : m.partials)
     for (const auto& p : v) add(p);

@@ -147,31 +147,50 @@ double Session::Impl::window_reference(int f) {
 
 namespace {
 
+// A partial image as a message: its rect and whether it carries sliver state (5 int32), then per
+// pixel premultiplied RGBA and depth (5 floats); an anti-aliased isosurface of a brick that is not
+// the whole domain adds its colour if a sliver is open at its front (4 floats) and its end state
+// (1 byte, render::SliverEnd): 9 floats and a byte per pixel instead of 5 floats, for those tasks only.
 void pack(const render::PartialImage& p, std::vector<char>& out) {
-  const std::int32_t rect[4] = {p.rect.x0, p.rect.y0, p.rect.x1, p.rect.y1};
+  const std::int32_t head[5] = {p.rect.x0, p.rect.y0, p.rect.x1, p.rect.y1, p.slivers ? 1 : 0};
   const std::size_t n = p.rect.empty() ? 0 : std::size_t(p.rect.width()) * std::size_t(p.rect.height());
   const std::size_t at = out.size();
-  out.resize(at + sizeof rect + n * 5 * sizeof(float));
-  std::memcpy(out.data() + at, rect, sizeof rect);
-  if (n) {
-    std::memcpy(out.data() + at + sizeof rect, p.rgba.data(), n * 4 * sizeof(float));
-    std::memcpy(out.data() + at + sizeof rect + n * 4 * sizeof(float), p.depth.data(), n * sizeof(float));
-  }
+  const std::size_t extra = p.slivers ? n * (4 * sizeof(float) + 1) : 0;
+  out.resize(at + sizeof head + n * 5 * sizeof(float) + extra);
+  char* q = out.data() + at;
+  std::memcpy(q, head, sizeof head);
+  q += sizeof head;
+  if (!n) return;
+  std::memcpy(q, p.rgba.data(), n * 4 * sizeof(float));
+  std::memcpy(q + n * 4 * sizeof(float), p.depth.data(), n * sizeof(float));
+  if (!p.slivers) return;
+  q += n * 5 * sizeof(float);
+  std::memcpy(q, p.rgba_open.data(), n * 4 * sizeof(float));
+  std::memcpy(q + n * 4 * sizeof(float), p.sliver_end.data(), n);
 }
 
 const char* unpack(const char* in, const char* end, int width, int height, render::PartialImage& p) {
-  std::int32_t rect[4];
-  if (end - in < std::ptrdiff_t(sizeof rect)) throw Error("in-situ compositing: truncated partial-image message");
-  std::memcpy(rect, in, sizeof rect);
-  in += sizeof rect;
-  p.reset(width, height, {rect[0], rect[1], rect[2], rect[3]});
+  std::int32_t head[5];
+  if (end - in < std::ptrdiff_t(sizeof head)) throw Error("in-situ compositing: truncated partial-image message");
+  std::memcpy(head, in, sizeof head);
+  in += sizeof head;
+  p.slivers = head[4] != 0;
+  p.reset(width, height, {head[0], head[1], head[2], head[3]});
   const std::size_t n = p.rect.empty() ? 0 : std::size_t(p.rect.width()) * std::size_t(p.rect.height());
-  if (end - in < std::ptrdiff_t(n * 5 * sizeof(float))) throw Error("in-situ compositing: truncated partial-image message");
+  const std::size_t bytes = n * 5 * sizeof(float) + (p.slivers ? n * (4 * sizeof(float) + 1) : 0);
+  if (end - in < std::ptrdiff_t(bytes))
+    throw Error("in-situ compositing: truncated partial-image message (" + std::to_string(end - in) + " bytes left, " +
+                std::to_string(bytes) + " expected for a " + std::to_string(p.rect.width()) + "x" +
+                std::to_string(p.rect.height()) + " rect)");
   if (n) {
     std::memcpy(p.rgba.data(), in, n * 4 * sizeof(float));
     std::memcpy(p.depth.data(), in + n * 4 * sizeof(float), n * sizeof(float));
+    if (p.slivers) {
+      std::memcpy(p.rgba_open.data(), in + n * 5 * sizeof(float), n * 4 * sizeof(float));
+      std::memcpy(p.sliver_end.data(), in + n * 9 * sizeof(float), n);
+    }
   }
-  return in + n * 5 * sizeof(float);
+  return in + bytes;
 }
 
 // Rows [y0, y1) of `p` (inside its rect) as a partial-image message, in pack()'s format.

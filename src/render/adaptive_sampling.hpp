@@ -187,6 +187,10 @@ class AdaptiveTile {
           continue;
         }
       }
+      if (o.slivers && !slivers_agree(o, x0, y0, x1, y1)) {
+        r |= m & -m;
+        continue;
+      }
       const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *d = o.rgba_at(x1, y1);
       // Plain comparisons, not std::fmin/fmax (libm calls here, NaN-aware): the march writes finite
       // colours (LUT entries times opacities), and the range of finite values is the same.
@@ -202,6 +206,24 @@ class AdaptiveTile {
       }
     }
     return r ? r | (mask & follow_) : 0;
+  }
+
+  // An anti-aliased isosurface's sliver state (PartialImage::slivers) at the cell's corners: the same
+  // end state, and colours if a sliver is open at the brick's front within the tolerance, so that
+  // both of the brick's colours may be interpolated (the bricks in front pick one per pixel).
+  bool slivers_agree(const PartialImage& o, int x0, int y0, int x1, int y1) const {
+    const std::size_t i[4] = {o.index(x0, y0), o.index(x1, y0), o.index(x0, y1), o.index(x1, y1)};
+    const SliverEnd e = o.sliver_end[i[0]];
+    if (o.sliver_end[i[1]] != e || o.sliver_end[i[2]] != e || o.sliver_end[i[3]] != e) return false;
+    for (int k = 0; k < 4; ++k) {
+      float lo = o.rgba_open[4 * i[0] + k], hi = lo;
+      for (int c = 1; c < 4; ++c) {
+        const float v = o.rgba_open[4 * i[c] + std::size_t(k)];
+        lo = v < lo ? v : lo, hi = hi < v ? v : hi;
+      }
+      if (hi - lo > tolerance_) return false;
+    }
+    return true;
   }
 
   template <class March, class Locate>
@@ -265,11 +287,23 @@ class AdaptiveTile {
             const auto& [a, b, c, e] = corners[i];
             float* q = out_[i].rgba_at(x, y);
             for (int k = 0; k < 4; ++k) q[k] = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k];
+            if (PartialImage& o = out_[i]; o.slivers) {  // the corners' end state agrees (rough())
+              const float *oa = &o.rgba_open[4 * o.index(x0, y0)], *ob = &o.rgba_open[4 * o.index(x1, y0)],
+                          *oc = &o.rgba_open[4 * o.index(x0, y1)], *od = &o.rgba_open[4 * o.index(x1, y1)];
+              float* qo = &o.rgba_open[4 * o.index(x, y)];
+              for (int k = 0; k < 4; ++k) qo[k] = w00 * oa[k] + w10 * ob[k] + w01 * oc[k] + w11 * od[k];
+              o.sliver_end[o.index(x, y)] = o.sliver_end[o.index(x0, y0)];
+            }
           }
         } else {
           for (std::uint64_t m = pending; m; m &= m - 1) {
-            float* q = out_[std::size_t(std::countr_zero(m))].rgba_at(x, y);
+            PartialImage& o = out_[std::size_t(std::countr_zero(m))];
+            float* q = o.rgba_at(x, y);
             q[0] = q[1] = q[2] = q[3] = 0.0f;
+            if (o.slivers) {
+              std::fill_n(&o.rgba_open[4 * o.index(x, y)], 4, 0.0f);
+              o.sliver_end[o.index(x, y)] = SliverEnd::pass;
+            }
           }
         }
         for (std::size_t i = 0; i < out_.size(); ++i) {  // the same exact depth for every image but keyed ones

@@ -43,8 +43,9 @@ bool near_surface(const FieldAcc& f, const MarchPlan& S, float iso, const double
 }  // namespace
 
 int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
-                       const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v, bool prev,
-                       std::int64_t k_last, double t_exit, float tr_stop, float* a) {
+                       const double D[3], const Vec3& dir, double t0, std::int64_t k0, int n, const float* v,
+                       const float* range, unsigned cand, std::int64_t k_last, double t_exit, float tr_stop, float* a,
+                       IsoSliver& sliver) {
   const double dt = S.dt, pitch = S.iso_aa_pitch;
   const double half_voxel = 0.5 * std::min({S.spacing[0], S.spacing[1], S.spacing[2]});
   const float iso = T.iso;
@@ -54,7 +55,25 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
   // s(j) = f − iso at sample k0 − 1 + j; j = n + 1 (the sample after the block) only on demand.
   float after = 0;
   bool have_after = false;
+  // The previous block's pending last lane (sample k0 − 1, lane j = 0 below) when this block follows
+  // it; otherwise it is looked at alone first.
+  bool lane0 = false;
+  float pend_sp = 0;
+  if (sliver.pending) {
+    if (k0 == sliver.pend_k + 1) {
+      sliver.pending = false;
+      lane0 = true;
+      pend_sp = sliver.pend_v[0];
+    } else if (resolve_pending_lane(S, T, f, P, O, D, dir, t0, k_last, t_exit, tr_stop, a, sliver) >= 0) {
+      return 0;
+    }
+  }
+  // This block's last lane waits for the next block when it is a minimum candidate only (not the
+  // ray's last sample: no block follows that; nor a block of one sample).
+  const bool defer = (cand >> (n - 1) & 1) && n > 1 && k0 + n - 1 != k_last && (v[n - 1] < iso) == (v[n] < iso);
+  if (defer) cand &= ~(1u << (n - 1));
   auto s = [&](int j) -> float {
+    if (j < 0) return pend_sp - iso;
     if (j <= n) return v[j] - iso;
     if (!have_after) {
       const float fk = float(k0 + n);  // the march's float positions (as interp_block's)
@@ -70,38 +89,6 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     a[3] = alpha >= 1 ? 0.0f : float(T0 * (1 - alpha));
     return a[3] <= tr_stop;
   };
-  // Candidate lanes (bit j − 1 for sample j): crossings and local minima of |s|, for the whole block
-  // at once; the last lane's minimum needs the sample after the block, fetched only if it passes
-  // the cell test below.
-  unsigned cand = 0;
-#ifdef PANOPTES_RENDER_AVX2
-  {
-    const __m256 isov = _mm256_set1_ps(iso), sign = _mm256_set1_ps(-0.0f);
-    const __m256 a0 = _mm256_sub_ps(_mm256_loadu_ps(v), isov), b0 = _mm256_sub_ps(_mm256_loadu_ps(v + 1), isov),
-                 c0 = _mm256_sub_ps(_mm256_loadu_ps(v + 2), isov);
-    const __m256 aa = _mm256_andnot_ps(sign, a0), ab = _mm256_andnot_ps(sign, b0), ac = _mm256_andnot_ps(sign, c0);
-    const __m256 zero = _mm256_setzero_ps();
-    const __m256 na = _mm256_cmp_ps(a0, zero, _CMP_LT_OQ), nb = _mm256_cmp_ps(b0, zero, _CMP_LT_OQ),
-                 nc = _mm256_cmp_ps(c0, zero, _CMP_LT_OQ);
-    const __m256 cross = _mm256_xor_ps(na, nb);
-    const __m256 minimum = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(ab, aa, _CMP_LT_OQ), _mm256_cmp_ps(ab, ac, _CMP_LE_OQ)),
-                                         _mm256_andnot_ps(_mm256_xor_ps(nb, nc), _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
-    cand = unsigned(_mm256_movemask_ps(_mm256_or_ps(cross, minimum)));
-  }
-#else
-  for (int j = 1; j <= kBlock; ++j) {
-    const float sp = v[j - 1] - iso, sc = v[j] - iso, sn = v[j + 1] - iso;
-    const bool cross = (sp < 0) != (sc < 0);
-    const bool minimum = std::abs(sc) < std::abs(sp) && std::abs(sc) <= std::abs(sn) && (sc < 0) == (sn < 0);
-    cand |= unsigned(cross || minimum) << (j - 1);
-  }
-#endif
-  {  // lane n: its successor is not in v
-    const float sp = v[n - 1] - iso, sc = v[n] - iso;
-    const bool maybe = (sp < 0) != (sc < 0) || std::abs(sc) < std::abs(sp);
-    cand = (cand & ((1u << (n - 1)) - 1)) | (unsigned(maybe) << (n - 1));
-  }
-  if (!prev) cand &= ~1u;
   const float hmin = float(std::min({S.spacing[0], S.spacing[1], S.spacing[2]}));
   // The hit on a bracket [ta, tb] whose field values minus the isovalue (sa, sb) differ in sign: the
   // linear estimate and one regula-falsi step.
@@ -113,32 +100,18 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (sa != sb) th = ta + (tb - ta) * (sa / (sa - sb));
     return th;
   };
-  // Whether the sliver an EXIT (a grazing crossing whose parabola turns back behind it) closes was
-  // entered: beyond its predicted entry, 2·reach behind the crossing (and a quarter of the reach more
-  // for the fit's error), the ray must have been on the side it now leaves to, not on sp's (sp lies
-  // inside the sliver). Where two sheets meet the fit claims an entry that never was (a valley open
-  // towards the camera): such a crossing is the ray's hit, not an exit that shows what lies behind
-  // (issue 41's cracks seen from inside). The field is read only where every brick owning sample k
-  // can read it: at most 2 voxels below sample k and less than 1 above on each axis (the ghost layers
-  // of render::required_points), so every decomposition decides alike; farther entries are trusted
-  // (telling those apart needs the ray's crossings in the bricks in front).
-  const auto sliver_entered = [&](std::int64_t k, double th, double reach, float sp) {
-    const double entry = th + 2 * reach - (0.25 * std::abs(reach) + 0.05 * dt);
-    const double tk = t0 + double(k) * dt;
-    for (int a = 0; a < 3; ++a) {
-      const double d = (entry - tk) * D[a];
-      if (!(d >= -2.0 && d < 1.0)) return true;
-    }
-    const double se = interp_clamped(f, O[0] + entry * D[0], O[1] + entry * D[1], O[2] + entry * D[2]) - iso;
-    return (se < 0) != (sp < 0);
-  };
-  for (; cand; cand &= cand - 1) {
-    const int j = std::countr_zero(cand) + 1;
+  // Bit j for lane j: sample k0 − 1 + j (lane 0: the previous block's pending lane).
+  for (std::uint32_t lanes = cand << 1 | unsigned(lane0); lanes; lanes &= lanes - 1) {
+    const int j = std::countr_zero(lanes);
     const float sp = s(j - 1), sc = s(j);
     const bool cross = (sp < 0) != (sc < 0);
     const std::int64_t k = k0 - 1 + j;
     float cell_range = 0;
-    if (!cross) {
+    if (!cross && j == 0 && sliver.pend_ranged) {
+      cell_range = sliver.pend_range;  // tested in the previous block
+    } else if (!cross && j > 0 && range) {
+      cell_range = range[j - 1];  // tested above
+    } else if (!cross) {
       // A near miss needs the surface within half a voxel: in this grid cell, |∇f| per voxel is at
       // most √3 × the corners' range r, so |s| > r (a factor 2 of margin) cannot be one. 8 loads
       // instead of a gradient for most local minima of a wavy field.
@@ -198,7 +171,8 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
         // exit: a first crossing where the bend does curve back but the region behind is open
         // towards the camera (a valley where two sheets meet); telling it from a real exit needs
         // the ray's earlier crossings, which a brick does not see when they lie in the brick in
-        // front (docs/rendering.md, "Isosurface anti-aliasing").
+        // front: the sliver state below, carried across bricks by compositing (docs/rendering.md,
+        // "Isosurface anti-aliasing").
         double gm[3], gq[3], Hu[3];
         const double tm = t0 + double(k - 1) * dt, tq = tm + dt;
         const double pm[3] = {O[0] + tm * D[0], O[1] + tm * D[1], O[2] + tm * D[2]};
@@ -214,12 +188,37 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
           const double reach = -s1 / s2;  // world units from the hit to the vertex
           if (std::abs(reach) <= max_reach * dt) {
             const double cover = 0.5 + s1 * s1 / (2 * std::abs(s2)) / gn / (th * pitch);
-            if (cover < 1) alpha = reach > 0 ? cover : sliver_entered(k, th, reach, sp) ? 0.0 : 1.0;
+            if (cover < 1) {
+              if (reach > 0) {  // an entry: it takes the coverage, its exit comes later
+                alpha = cover;
+                sliver.state = SliverEnd::open;
+                if (add(rgb, alpha)) return std::max(j - 1, 0);
+                continue;
+              }
+              // An exit adds nothing when its entry came before it on the ray. Without one the sliver
+              // the local fit claims behind is open towards the camera (a valley where two sheets
+              // meet, issue 41's cracks and speckles) and the crossing is the ray's hit. Whether an
+              // entry came may be up to the bricks in front (state pass): the march goes on as if
+              // one did and keeps the hit in `alt` (compositing picks, PartialImage::rgba_open).
+              if (sliver.state == SliverEnd::open) {
+                sliver.state = SliverEnd::closed;
+                continue;
+              }
+              if (sliver.state == SliverEnd::pass) {
+                const float T0 = a[3];
+                for (int c = 0; c < 3; ++c) sliver.alt[c] = a[c] + T0 * rgb[c];
+                sliver.alt[3] = 0;
+                sliver.has_alt = true;
+                sliver.state = SliverEnd::closed;
+                continue;
+              }
+            }
           }
         }
       }
+      sliver.state = SliverEnd::closed;  // an opaque hit
       if (alpha <= 0) continue;
-      if (add(rgb, alpha)) return j - 1;
+      if (add(rgb, alpha)) return std::max(j - 1, 0);
       continue;
     }
     // A local minimum of |s|: the ray passes near the surface, or pierces a sliver of it between
@@ -261,7 +260,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
       // Its depth is at least |s| at the point found / |∇f|: coverage of the pair in one event.
       const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_out) / gn / (th * pitch) : 1.0;
-      if (add(rgb, std::min(1.0, cover))) return j - 1;
+      if (add(rgb, std::min(1.0, cover))) return std::max(j - 1, 0);
       continue;
     }
     const double tv = t0 + (double(k) + ub) * dt, s_v = fb;
@@ -278,7 +277,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
     const double cover = 0.5 - x / footprint;
     if (cover <= 0) continue;
-    if (add(rgb, cover)) return j - 1;
+    if (add(rgb, cover)) return std::max(j - 1, 0);
   }
   if (k0 + n - 1 == k_last && t_exit > t0 + double(k_last) * dt) {
     // The ray's last stretch in the domain, after its last sample.
@@ -296,10 +295,30 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       alignas(16) float rgb[4];
       shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb);
       add(rgb, 1.0);
+      sliver.state = SliverEnd::closed;
       return n - 1;
     }
   }
+  if (defer) {
+    sliver.pending = true;
+    sliver.pend_k = k0 + n - 1;
+    sliver.pend_v[0] = v[n - 1], sliver.pend_v[1] = v[n];
+    sliver.pend_ranged = range != nullptr;
+    sliver.pend_range = range ? range[n - 1] : 0.0f;
+  }
   return -1;
+}
+
+int resolve_pending_lane(const MarchPlan& S, const MarchTask& T, const FieldAcc& f, const RayPos& P, const double O[3],
+                         const double D[3], const Vec3& dir, double t0, std::int64_t k_last, double t_exit, float tr_stop,
+                         float* a, IsoSliver& sliver) {
+  sliver.pending = false;
+  // A block of one sample (pend_k; v[0] the sample before), its lane a candidate: the sample after it
+  // is interpolated on demand, as before the lane waited.
+  const float v[2] = {sliver.pend_v[0], sliver.pend_v[1]};
+  const float range = sliver.pend_range;
+  return march_iso_block_aa(S, T, f, P, O, D, dir, t0, sliver.pend_k, 1, v, sliver.pend_ranged ? &range : nullptr, 1u,
+                            k_last, t_exit, tr_stop, a, sliver);
 }
 
 }  // namespace panoptes::render::march

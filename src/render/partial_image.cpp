@@ -26,12 +26,16 @@ void PartialImage::resize(int w, int h, PixelRect r) {
   const std::size_t n = std::size_t(r.width()) * r.height();
   rgba.resize(4 * n);
   depth.resize(n);
+  rgba_open.resize(slivers ? 4 * n : 0);
+  sliver_end.resize(slivers ? n : 0);
 }
 
 void PartialImage::reset(int w, int h, PixelRect r) {
   resize(w, h, r);
   std::fill(rgba.begin(), rgba.end(), 0.0f);
   std::fill(depth.begin(), depth.end(), kNoDepth);
+  std::fill(rgba_open.begin(), rgba_open.end(), 0.0f);
+  std::fill(sliver_end.begin(), sliver_end.end(), SliverEnd::pass);
 }
 
 namespace {
@@ -54,8 +58,37 @@ void union_target(std::span<const PartialImage* const> parts, PartialImage& out)
     u.y1 = std::max(u.y1, p->rect.y1);
   }
   if (u.empty()) u = {};
+  out.slivers = false;
+  for (const PartialImage* p : parts) out.slivers = out.slivers || p->slivers;
   out.reset(parts[0]->width, parts[0]->height, u);
 }
+
+// Front-to-back join of an anti-aliased isosurface's partials with their sliver state
+// (PartialImage::slivers): the composite as a function of the state at its front, with no sliver
+// open there (colour acc, state sc) and with one (acc_open, so). A partial adds the colour that
+// state calls for and sets the state unless it passes it on. Each partial is such a function of two
+// states and this is their composition, so the join is associative (trees and direct send keep
+// working) and the composite's acc is what one march through all the bricks gives.
+struct SliverChain {
+  float* acc;
+  float* acc_open;
+  SliverEnd sc = SliverEnd::closed, so = SliverEnd::open;
+  void add(const PartialImage& p, int x, int y) {
+    const float* closed = p.rgba_at(x, y);
+    if (!p.slivers) {  // no sliver state (e.g. no anti-aliasing): the same colour for both
+      over(acc, closed);
+      over(acc_open, closed);
+      return;
+    }
+    const std::size_t i = p.index(x, y);
+    const float* open = &p.rgba_open[4 * i];
+    over(acc, sc == SliverEnd::open ? open : closed);
+    over(acc_open, so == SliverEnd::open ? open : closed);
+    if (p.sliver_end[i] != SliverEnd::pass) sc = so = p.sliver_end[i];
+  }
+  // Two functions of {pass, closed, open} compose to pass or a constant, so so != sc means pass.
+  SliverEnd end() const { return sc == so ? sc : SliverEnd::pass; }
+};
 }  // namespace
 
 void composite_into(Blend blend, std::span<const PartialImage* const> parts, PartialImage& out) {
@@ -78,7 +111,12 @@ void composite_into(Blend blend, std::span<const PartialImage* const> parts, Par
         // order of arrival, which a max blend's equal maxima of different colours would otherwise not be.
         std::sort(order.begin(), order.begin() + m);
         float* acc = out.rgba_at(x, y);
-        if (over_all) {
+        if (over_all && out.slivers) {
+          const std::size_t i = out.index(x, y);
+          SliverChain chain{acc, &out.rgba_open[4 * i]};
+          for (int r = 0; r < m; ++r) chain.add(*parts[order[std::size_t(r)].second], x, y);
+          out.sliver_end[i] = chain.end();
+        } else if (over_all) {
           for (int r = 0; r < m; ++r) over(acc, parts[order[std::size_t(r)].second]->rgba_at(x, y));
         } else if (m) {  // max: the partial holding the largest maximum decides alone
           std::copy_n(parts[order[0].second]->rgba_at(x, y), 4, acc);
@@ -109,11 +147,18 @@ PartialImage composite_ordered(TaskKind kind, std::span<const PartialImage* cons
     for (int x = out.rect.x0; x < out.rect.x1; ++x) {
       float* acc = out.rgba_at(x, y);
       float dmin = PartialImage::kNoDepth;
+      const std::size_t i = out.index(x, y);
+      SliverChain chain{acc, out.slivers ? &out.rgba_open[4 * i] : nullptr};
       for (const PartialImage* p : parts) {
         if (!p->rect.contains(x, y)) continue;
-        over(acc, p->rgba_at(x, y));
+        if (out.slivers) {
+          if (p->depth_at(x, y) != PartialImage::kNoDepth) chain.add(*p, x, y);  // a miss has no event
+        } else {
+          over(acc, p->rgba_at(x, y));
+        }
         dmin = std::min(dmin, p->depth_at(x, y));
       }
+      if (out.slivers) out.sliver_end[i] = chain.end();
       out.depth[std::size_t(y - out.rect.y0) * out.rect.width() + (x - out.rect.x0)] = dmin;
     }
   return out;

@@ -25,6 +25,12 @@ struct PixelRect {
   bool operator==(const PixelRect&) const = default;
 };
 
+/// An isosurface task's grazing-sliver state (anti-aliasing, iso_edges.hpp) where a ray leaves a
+/// brick, as a function of the state where it enters: `pass` keeps the front's state (the ray met
+/// no entry, exit or hit of a sliver in the brick), `closed` and `open` set it (the last such event
+/// was an exit or hit, or an entry whose exit is still to come).
+enum class SliverEnd : std::uint8_t { pass = 0, closed = 1, open = 2 };
+
 /// What one brick contributes to one (camera, task) image: premultiplied RGBA floats for the pixels
 /// of `rect` (the brick's screen footprint; pixels outside it are transparent), and per pixel the
 /// depth — the ray parameter (world distance from the camera) where the ray ENTERS the brick, +∞
@@ -44,8 +50,18 @@ struct PartialImage {
   PixelRect rect;
   std::vector<float> rgba;   ///< 4 floats per pixel of rect, row-major, premultiplied by alpha
   std::vector<float> depth;  ///< 1 float per pixel of rect
+  /// Isosurface tasks with anti-aliasing from a brick that is not the whole domain (`slivers`): a
+  /// grazing ray's exit adds nothing only when its entry came before it on the ray, maybe in a brick
+  /// in front. `rgba` is then the colour if no sliver is open where the ray enters the brick (the
+  /// state at the ray's start), `rgba_open` (4 floats per pixel) the colour if one is, and
+  /// `sliver_end` (1 per pixel) the state where the ray leaves the brick. composite() chains them
+  /// front to back, so the composite's `rgba` is the single brick's; empty when `slivers` is false.
+  bool slivers = false;
+  std::vector<float> rgba_open;
+  std::vector<SliverEnd> sliver_end;
 
-  /// Resizes to a w×h image holding `r` (clipped to the image), all transparent, depth +∞.
+  /// Resizes to a w×h image holding `r` (clipped to the image), all transparent, depth +∞ (and, with
+  /// `slivers`, rgba_open transparent, sliver_end pass).
   /// Reuses the buffers' capacity (no allocation once warm).
   void reset(int w, int h, PixelRect r);
   /// As reset() but leaves the pixels unspecified (old contents or zeros), for writers that set every
@@ -56,6 +72,7 @@ struct PartialImage {
   const float* rgba_at(int x, int y) const {
     return rgba.data() + 4 * (std::size_t(y - rect.y0) * rect.width() + (x - rect.x0));
   }
+  std::size_t index(int x, int y) const { return std::size_t(y - rect.y0) * rect.width() + (x - rect.x0); }
   float depth_at(int x, int y) const {
     return rect.contains(x, y) ? depth[std::size_t(y - rect.y0) * rect.width() + (x - rect.x0)] : kNoDepth;
   }

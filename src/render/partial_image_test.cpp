@@ -117,3 +117,57 @@ TEST(PartialImage, VisibilityOrderPutsTheBrickNearerTheCameraFirst) {
   EXPECT_EQ(visibility_order(above, g, bricks), (std::vector<int>{1, 0}));
   EXPECT_EQ(visibility_order(below, g, bricks), (std::vector<int>{0, 1}));
 }
+
+namespace {
+
+// A 1x1 anti-aliased isosurface partial at depth d with its sliver state (PartialImage::slivers):
+// colour `closed` if no sliver is open at its front, `open` if one is, and its end state.
+PartialImage sliver_part(std::array<float, 4> closed, std::array<float, 4> open, SliverEnd end, float d) {
+  PartialImage p;
+  p.slivers = true;
+  p.reset(1, 1, {0, 0, 1, 1});
+  std::copy(closed.begin(), closed.end(), p.rgba_at(0, 0));
+  std::copy(open.begin(), open.end(), p.rgba_open.begin());
+  p.sliver_end[0] = end;
+  p.depth[0] = d;
+  return p;
+}
+
+}  // namespace
+
+// A grazing sliver's entry in one brick and its exit in the brick behind: the exit adds nothing only
+// because the front brick ends with the sliver open, so the join picks the back brick's colour for an
+// open front; with the front ending closed the back brick's exit is a hit (its `rgba`). The join is
+// the composition of functions of the state, so any grouping gives the same pixel.
+TEST(PartialImage, SliverStateChainsFromBrickToBrick) {
+  const PartialImage entry = sliver_part({0.3f, 0, 0, 0.3f}, {0.3f, 0, 0, 0.3f}, SliverEnd::open, 1);
+  const PartialImage plain = sliver_part({0.2f, 0, 0, 0.2f}, {0.2f, 0, 0, 0.2f}, SliverEnd::closed, 1);
+  const PartialImage pass = sliver_part({0.1f, 0.1f, 0, 0.1f}, {0.1f, 0.1f, 0, 0.1f}, SliverEnd::pass, 2);
+  // Its first event an exit: a hit (opaque) with nothing open at its front, nothing added with.
+  const PartialImage exit = sliver_part({0, 0, 1, 1}, {0, 0, 0, 0}, SliverEnd::closed, 3);
+  const PartialImage back = sliver_part({0, 1, 0, 1}, {0, 1, 0, 1}, SliverEnd::closed, 4);
+  auto join = [](std::vector<const PartialImage*> parts) { return composite(TaskKind::isosurface, parts); };
+  // Open in front (through a brick that passes the state on): the exit adds nothing, the back shows.
+  const PartialImage a = join({&entry, &pass, &exit, &back});
+  EXPECT_NEAR(px(a, 0, 0)[1], 0.7f * 0.1f + 0.7f * 0.9f, 1e-6);
+  EXPECT_NEAR(px(a, 0, 0)[2], 0.0f, 1e-6);
+  EXPECT_NEAR(px(a, 0, 0)[3], 1.0f, 1e-6);
+  // Closed in front: the exit is a hit, the back is hidden.
+  const PartialImage b = join({&plain, &pass, &exit, &back});
+  EXPECT_NEAR(px(b, 0, 0)[1], 0.8f * 0.1f, 1e-6);
+  EXPECT_NEAR(px(b, 0, 0)[2], 0.8f * 0.9f, 1e-6);
+  // Associative: joined in pairs first, and in either order of arrival.
+  for (const PartialImage* front : {&entry, &plain}) {
+    const PartialImage whole = join({front, &pass, &exit, &back});
+    const PartialImage fp = join({&exit, front, &pass}), xb = join({&back, &exit});
+    const PartialImage ppx = join({&pass, &exit});
+    for (const PartialImage& c : {join({&fp, &back}), join({front, &pass, &xb}), join({front, &ppx, &back})})
+      for (int k = 0; k < 4; ++k) EXPECT_NEAR(px(c, 0, 0)[k], px(whole, 0, 0)[k], 1e-6) << "channel " << k;
+    EXPECT_EQ(fp.sliver_end[0], SliverEnd::closed);
+  }
+  // A join that only passes the state on stays pass; one whose result depends on its front keeps both colours.
+  EXPECT_EQ(join({&pass, &pass}).sliver_end[0], SliverEnd::pass);
+  const PartialImage pe = join({&pass, &exit});
+  EXPECT_EQ(pe.sliver_end[0], SliverEnd::closed);
+  EXPECT_NE(px(pe, 0, 0)[3], pe.rgba_open[3]);
+}

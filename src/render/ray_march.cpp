@@ -59,9 +59,9 @@ class RayMarch {
  public:
   RayMarch(const MarchPlan& plan, const double* origin, const double* direction, const Vec3& world_dir, double t_0,
            double tg1, std::int64_t ke, std::int64_t kg_last, std::uint64_t tasks, float (*accumulators)[4],
-           std::uint64_t& marched_samples)
+           std::uint64_t& marched_samples, IsoSliver* iso_sliver)
       : S(plan), O(origin), D(direction), dir(world_dir), t0(t_0), dt(plan.dt), live(tasks), acc(accumulators),
-        marched(marched_samples), k_last(kg_last), t_exit(tg1) {
+        marched(marched_samples), k_last(kg_last), t_exit(tg1), sliver(iso_sliver) {
     for (std::size_t s = 0; s < S.acc.size(); ++s) fa[s] = S.acc[s];
     // The last sample of the ray in the whole domain stands for a shorter segment.
     if (ke == kg_last) {
@@ -111,6 +111,19 @@ class RayMarch {
       }
       general_block(lm, k0, kend, safe);
       k0 += kBlock;
+    }
+  }
+
+  // After the march: anti-aliased isosurface tasks still live whose last block left a lane pending
+  // (IsoSliver::pending) look at it now, before the accumulators are read.
+  void resolve_pending_lanes() {
+    if (!(S.iso_aa_pitch > 0)) return;
+    for (std::uint64_t m = live & S.iso_mask; m; m &= m - 1) {
+      const int i = std::countr_zero(m);
+      if (!sliver[i].pending) continue;
+      const MarchTask& T = S.rt[std::size_t(i)];
+      if (resolve_pending_lane(S, T, fa[T.s1], P, O, D, dir, t0, k_last, t_exit, tr_stop, acc[i], sliver[i]) >= 0)
+        live &= ~(std::uint64_t(1) << i);
     }
   }
 
@@ -337,6 +350,9 @@ class RayMarch {
       // Isosurfaces and maxima read the float field (vb), volumes their classification values (vq).
       (T.kind == MarchKind::iso || T.kind == MarchKind::mip ? smask : vmask) |= T.slots;
     }
+    // Anti-aliased isosurfaces also take each sample's cell range from the gathers (near misses).
+    const std::uint32_t rmask = S.iso_aa_pitch > 0 && (lm & S.iso_mask) ? smask : 0;
+    ranged = 0;
     // Corner-copy fields of one layout in pairs: one geometry for both (S.corner_mates, found at
     // setup; a joint copy's partner first: their records share a cache line and one prefetch).
     std::uint32_t cm = vmask & S.corner_slots;
@@ -385,7 +401,11 @@ class RayMarch {
         vb[s][0] = interp_clamped(fa[s], P.bx + fk * P.sx, P.by + fk * P.sy, P.bz + fk * P.sz);
         prev_valid |= 1u << s;
       }
-      interp_block(fa[s], P, k0, n, safe, &vb[s][1]);
+      if (rmask >> s & 1) {
+        if (interp_block(fa[s], P, k0, n, safe, &vb[s][1], vr[s])) ranged |= 1u << s;
+      } else {
+        interp_block(fa[s], P, k0, n, safe, &vb[s][1]);
+      }
     }
     for (std::uint32_t m = vq_from_vb; m; m &= m - 1) {
       const int s = std::countr_zero(m);
@@ -442,7 +462,11 @@ class RayMarch {
           const float* v = vb[T.s1];
           const int l0 = (prev_valid >> T.s1 & 1) ? 0 : 1;
           if (S.iso_aa_pitch > 0) {
-            stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, l0 == 0, k_last, t_exit, tr_stop, a);
+            const float* range = ranged >> T.s1 & 1 ? vr[T.s1] : nullptr;
+            const unsigned cand = iso_aa_candidates(v, range, n, l0 == 0, T.iso);
+            if (cand || sliver[i].pending || k0 + n - 1 == k_last)
+              stop = march_iso_block_aa(S, T, fa[T.s1], P, O, D, dir, t0, k0, n, v, range, cand, k_last, t_exit, tr_stop, a,
+                                        sliver[i]);
             break;
           }
           // Lanes whose segment (sample l − 1 … l) changes sign, found for the whole block at once.
@@ -521,16 +545,19 @@ class RayMarch {
   // values; prev_valid: slots whose vb[s][0] is that previous sample (isosurface crossings need it).
   alignas(32) float vb[8][2 * kBlock];
   alignas(32) float vq[8][kBlock];
+  alignas(32) float vr[8][kBlock];  // per slot: the cell range of each sample of the block (when `ranged`)
+  std::uint32_t ranged = 0;
   std::uint32_t prev_valid = 0, vq_from_vb = 0;
   const std::int64_t k_last;  // the ray's last sample in the domain, and where it leaves the domain
   const double t_exit;        // (isosurface anti-aliasing looks at the stretch between them)
+  IsoSliver* sliver;          // per isosurface task with anti-aliasing: its sliver state (iso_edges.hpp)
 };
 
 }  // namespace
 
 void march_ray(const MarchPlan& S, const double O[3], const double D[3], const Vec3& dir, double t0, double tg1,
                double tb0, double tb1, std::uint64_t tasks, float (*acc)[4], std::uint64_t& effective,
-               std::uint64_t& marched) {
+               std::uint64_t& marched, IsoSliver* sliver) {
   const std::uint64_t mm = S.march_mask & tasks;  // the march tasks of this ray
   std::int64_t ks, ke, kg_last;
   if (!brick_samples(S, O, D, t0, tg1, tb0, tb1, ks, ke, kg_last)) return;
@@ -542,7 +569,16 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   // them still has its maximum 0.
   for (std::uint64_t m = mm; m; m &= m - 1) acc[std::countr_zero(m)][3] = 1.0f;
   for (std::uint64_t m = mm & S.mip_mask; m; m &= m - 1) acc[std::countr_zero(m)][0] = 0.0f;
-  RayMarch ray(S, O, D, dir, t0, tg1, ke, kg_last, mm, acc, marched);
+  // Anti-aliased isosurfaces: the brick that owns the ray's first sample knows that no sliver is
+  // open where the ray enters it; the others learn it from the bricks in front when compositing.
+  const std::uint64_t aa_iso = S.iso_aa_pitch > 0 ? mm & S.iso_mask : 0;
+  for (std::uint64_t m = aa_iso; m; m &= m - 1) {
+    IsoSliver& sl = sliver[std::countr_zero(m)];
+    sl.state = ks == 0 ? SliverEnd::closed : SliverEnd::pass;
+    sl.has_alt = false;
+    sl.pending = false;
+  }
+  RayMarch ray(S, O, D, dir, t0, tg1, ke, kg_last, mm, acc, marched, sliver);
   if (S.direct && ray.clear_of_exceptions(ks, ke)) {
     // One run over the whole ray: the samples and their order are those of the merged walk, so
     // images are the same bits; `safe` = false only means clamped indices (same bits, see interp()).
@@ -550,9 +586,14 @@ void march_ray(const MarchPlan& S, const double O[3], const double D[3], const V
   } else {
     ray.walk_macro_cells(ks, ke);
   }
+  ray.resolve_pending_lanes();
   for (std::uint64_t m = mm & ~S.mip_mask; m; m &= m - 1) {
     float* a = acc[std::countr_zero(m)];
     a[3] = 1.0f - a[3];  // transmittance back to opacity
+  }
+  for (std::uint64_t m = aa_iso; m; m &= m - 1) {
+    IsoSliver& sl = sliver[std::countr_zero(m)];
+    if (sl.has_alt) sl.alt[3] = 1.0f - sl.alt[3];
   }
   // MIP tasks keep a[3] = 1: the ray has samples in this brick (the pixel loop colours them).
 }

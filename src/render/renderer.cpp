@@ -112,8 +112,16 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   if (all) rect = {0, 0, W, H};
   // The brick's silhouette, for adaptive cells of misses (only when every corner projected).
   const Silhouette silhouette(cpx, cpy, all ? 0 : 8);
+  // Anti-aliased isosurfaces of a brick that is not the whole domain carry their sliver state
+  // (PartialImage::slivers): a grazing ray's entry may lie in a brick in front of its exit.
+  const bool whole = S.brick.lo == Index3{0, 0, 0} &&
+                     S.brick.hi == Index3{S.grid.dims[0] - 1, S.grid.dims[1] - 1, S.grid.dims[2] - 1};
+  const std::uint64_t sliver_tasks = S.iso_aa_pitch > 0 && !whole ? S.iso_mask : 0;
   // Every pixel of the rect is written below (a miss as transparent, +∞): no clearing first.
-  for (PartialImage& o : out) o.resize(W, H, rect);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i].slivers = sliver_tasks >> i & 1;
+    out[i].resize(W, H, rect);
+  }
   rect = out.empty() ? PixelRect{} : out[0].rect;
   if (tasks.empty()) return stats;
 
@@ -220,10 +228,16 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   };
   // Marches a located ray for every task and writes pixel (x, y) of every image.
   // Marches a located ray for the tasks in `tasks` and writes their pixel (x, y); every image's depth.
-  auto shade = [&](int x, int y, const PixelRay& r, std::uint64_t tasks, float (*acc)[4], std::uint64_t& eff,
-                   std::uint64_t& marched) {
+  auto shade = [&](int x, int y, const PixelRay& r, std::uint64_t tasks, float (*acc)[4], march::IsoSliver* sl,
+                   std::uint64_t& eff, std::uint64_t& marched) {
     for (int i = 0; i < K; ++i) acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
-    if (S.march_mask & tasks) march::march_ray(S, r.O, r.D, r.dir, r.t0, r.tg1, r.tb0, r.tb1, tasks, acc, eff, marched);
+    const std::uint64_t aa_iso = S.iso_aa_pitch > 0 ? S.iso_mask & tasks : 0;
+    for (std::uint64_t m = aa_iso; m; m &= m - 1) {  // a task not marched: no event
+      sl[std::countr_zero(m)].state = SliverEnd::pass;
+      sl[std::countr_zero(m)].has_alt = false;
+    }
+    if (S.march_mask & tasks)
+      march::march_ray(S, r.O, r.D, r.dir, r.t0, r.tg1, r.tb0, r.tb1, tasks, acc, eff, marched, sl);
     for (int i : S.slices) {
       if (!(tasks >> i & 1)) continue;
       const MarchTask& rt = S.rt[std::size_t(i)];
@@ -268,7 +282,19 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       }
       if (tasks >> i & 1) {
         float* dst = o.rgba_at(x, y);
-        dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
+        if (aa_iso >> i & 1) {
+          // acc: the colour if a sliver is open at the brick's front; the pixel's colour is the one
+          // if none is (the state at the ray's start), which differs after an exit before any entry.
+          const float* c = sl[i].has_alt ? sl[i].alt : acc[i];
+          dst[0] = c[0], dst[1] = c[1], dst[2] = c[2], dst[3] = c[3];
+          if (o.slivers) {
+            const std::size_t p = o.index(x, y);
+            std::copy_n(acc[i], 4, &o.rgba_open[4 * p]);
+            o.sliver_end[p] = sl[i].state;
+          }
+        } else {
+          dst[0] = acc[i][0], dst[1] = acc[i][1], dst[2] = acc[i][2], dst[3] = acc[i][3];
+        }
       }
       depth = r.depth;
     }
@@ -280,12 +306,18 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
       float* dst = o.rgba_at(x, y);
       dst[0] = dst[1] = dst[2] = dst[3] = 0;
       o.depth[std::size_t(y - o.rect.y0) * o.rect.width() + (x - o.rect.x0)] = PartialImage::kNoDepth;
+      if (o.slivers) {
+        const std::size_t p = o.index(x, y);
+        std::fill_n(&o.rgba_open[4 * p], 4, 0.0f);
+        o.sliver_end[p] = SliverEnd::pass;
+      }
     }
   };
 
 #pragma omp parallel reduction(+ : n_rays, n_eff, n_marched, n_interpolated)
   {
     alignas(64) float acc[kMaxTasksPerMarch][4];
+    march::IsoSliver sliver[kMaxTasksPerMarch];
     AdaptiveTile refiner(stride, opt.adaptive_tolerance);
 #pragma omp for schedule(dynamic, 1)
     for (int ti = 0; ti < ntx * nty; ++ti) {
@@ -300,14 +332,14 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
               continue;
             }
             ++n_rays;
-            shade(x, y, r, all_tasks, acc, n_eff, n_marched);
+            shade(x, y, r, all_tasks, acc, sliver, n_eff, n_marched);
           }
         continue;
       }
       auto march = [&](int x, int y, std::uint64_t tasks) -> std::uint8_t {
         if (locate(x, y, r)) {
           ++n_rays;
-          shade(x, y, r, tasks, acc, n_eff, n_marched);
+          shade(x, y, r, tasks, acc, sliver, n_eff, n_marched);
           return r.face;
         }
         clear_pixel(x, y);

@@ -23,7 +23,9 @@ inline int lut_bin(float v, float lo, float sc, float last, bool absv) {
 // The trilinear field at 8 index-space positions (cell indices clamped into the data): eight AVX2
 // gathers with 32-bit offsets and seven lerps. Shared by the march's sample blocks and the
 // isosurface hit's gradient points, so both evaluate the field with the same operations.
-inline __m256 trilinear8(const FieldAcc& f, __m256 x, __m256 y, __m256 z) {
+// With `range`: also the range (max − min) of each lane's eight corners (isosurface anti-aliasing's
+// near-miss test, iso_edges.hpp), from the gathered values at no extra load.
+inline __m256 trilinear8(const FieldAcc& f, __m256 x, __m256 y, __m256 z, __m256* range = nullptr) {
   auto cell = [](__m256 p, int lo, int hi) {
     return _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(p), _mm256_set1_epi32(lo)), _mm256_set1_epi32(hi));
   };
@@ -42,6 +44,13 @@ inline __m256 trilinear8(const FieldAcc& f, __m256 x, __m256 y, __m256 z) {
   const __m256 c010 = _mm256_i32gather_ps(d + sy, off, 4), c110 = _mm256_i32gather_ps(d + sy + sx, off, 4);
   const __m256 c001 = _mm256_i32gather_ps(d + sz, off, 4), c101 = _mm256_i32gather_ps(d + sz + sx, off, 4);
   const __m256 c011 = _mm256_i32gather_ps(d + sz + sy, off, 4), c111 = _mm256_i32gather_ps(d + sz + sy + sx, off, 4);
+  if (range) {
+    const __m256 lo = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(c000, c100), _mm256_min_ps(c010, c110)),
+                                    _mm256_min_ps(_mm256_min_ps(c001, c101), _mm256_min_ps(c011, c111)));
+    const __m256 hi = _mm256_max_ps(_mm256_max_ps(_mm256_max_ps(c000, c100), _mm256_max_ps(c010, c110)),
+                                    _mm256_max_ps(_mm256_max_ps(c001, c101), _mm256_max_ps(c011, c111)));
+    *range = _mm256_sub_ps(hi, lo);
+  }
   const __m256 c00 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c100, c000), c000);
   const __m256 c10 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c110, c010), c010);
   const __m256 c01 = _mm256_fmadd_ps(fx, _mm256_sub_ps(c101, c001), c001);
@@ -69,7 +78,10 @@ constexpr int kBlock = 8;
 // v[l] = the field at sample k0 + l for l < n (1 ≤ n ≤ kBlock); lanes l ≥ n repeat sample
 // k0 + n − 1 (valid memory, ignored). `safe`: every sample lies at least one cell inside the data,
 // so the scalar fallback may skip the index clamps (the vector version always clamps: it is cheap).
-inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, bool safe, float* v) {
+// `range` (optional, 8 floats): each lane's cell's corner range, written only by the gather path
+// (returns whether it did; the caller computes it otherwise).
+inline bool interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, bool safe, float* v,
+                         float* range = nullptr) {
 #ifdef PANOPTES_RENDER_AVX2
   if (f.gather32) {
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -79,8 +91,14 @@ inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
     const __m256 x = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sx), _mm256_set1_ps(P.bx));
     const __m256 y = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sy), _mm256_set1_ps(P.by));
     const __m256 z = _mm256_fmadd_ps(fk, _mm256_set1_ps(P.sz), _mm256_set1_ps(P.bz));
-    _mm256_storeu_ps(v, trilinear8(f, x, y, z));
-    return;
+    if (!range) {
+      _mm256_storeu_ps(v, trilinear8(f, x, y, z));
+      return false;
+    }
+    __m256 r;
+    _mm256_storeu_ps(v, trilinear8(f, x, y, z, &r));
+    _mm256_storeu_ps(range, r);
+    return true;
   }
 #endif
   for (int l = 0; l < kBlock; ++l) {
@@ -88,6 +106,7 @@ inline void interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, in
     const float x = P.bx + fk * P.sx, y = P.by + fk * P.sy, z = P.bz + fk * P.sz;
     v[l] = safe ? interp<false>(f, x, y, z) : interp<true>(f, x, y, z);
   }
+  return false;
 }
 
 // The same block from the CornerFields of N fields that share one corner layout (same ilo, ihi, ccx,
