@@ -15,7 +15,7 @@
 // The model is the session's own rule (session_frames.cpp): per camera, every rank with a brick sends
 // its K partial images - each the brick's projected bounding rectangle (render_brick's rule: the 8 corner
 // projections, one pixel of margin, clipped to the image; the whole image when a corner does not
-// project) with 20 bytes per pixel and a 16-byte header - to the camera's owner, rank c mod P, which
+// project) with 20 bytes per pixel and a 20-byte header - to the camera's owner, rank c mod P, which
 // composites and encodes. Output: Markdown tables (scripts/bench runs bench/compositing_bench).
 #include <mpi.h>
 #include <unistd.h>
@@ -162,7 +162,7 @@ std::vector<RankTraffic> direct_send(const Setting& s) {
     const int owner = c % P;
     for (int r = 0; r < P; ++r) {
       if (r == owner || !has_cells(s.bricks[std::size_t(r)])) continue;
-      const double bytes = K * (16.0 + 20.0 * double(footprint_pixels(s.cameras[std::size_t(c)], s.grid, s.bricks[std::size_t(r)])));
+      const double bytes = K * (20.0 + 20.0 * double(footprint_pixels(s.cameras[std::size_t(c)], s.grid, s.bricks[std::size_t(r)])));
       t[std::size_t(r)].sent_msgs += 1;
       t[std::size_t(r)].sent_bytes += bytes;
       t[std::size_t(owner)].recv_msgs += 1;
@@ -196,7 +196,7 @@ std::vector<RankTraffic> tiled_direct_send(const Setting& s) {
       for (int j = int(std::int64_t(rect.y0) * T / H); j < T && band_y0(j) < rect.y1; ++j) {
         const int a = std::max(rect.y0, band_y0(j)), b = std::min(rect.y1, band_y0(j + 1));
         if (b <= a || band_owner(j) == r) continue;
-        const double bytes = 8.0 + K * (16.0 + 20.0 * double(rect.width()) * (b - a));
+        const double bytes = 8.0 + K * (20.0 + 20.0 * double(rect.width()) * (b - a));
         t[std::size_t(r)].sent_msgs += 1;
         t[std::size_t(r)].sent_bytes += bytes;
         t[std::size_t(band_owner(j))].recv_msgs += 1;

@@ -147,13 +147,16 @@ double Session::Impl::window_reference(int f) {
 
 namespace {
 
-// A partial image as a message: its rect and whether it carries sliver state (5 int32), then per
-// pixel premultiplied RGBA and depth (5 floats); an anti-aliased isosurface of a brick that is not
-// the whole domain adds its colour if a sliver is open at its front (4 floats) and its end state
+// Rows [y0, y1) of a partial image (inside its rect; the whole rect for direct send, one band's rows
+// for band compositing) as a message: the rows' rect and whether it carries sliver state (5 int32),
+// then per pixel premultiplied RGBA and depth (5 floats); an anti-aliased isosurface of a brick that is
+// not the whole domain adds its colour if a sliver is open at its front (4 floats) and its end state
 // (1 byte, render::SliverEnd): 9 floats and a byte per pixel instead of 5 floats, for those tasks only.
-void pack(const render::PartialImage& p, std::vector<char>& out) {
-  const std::int32_t head[5] = {p.rect.x0, p.rect.y0, p.rect.x1, p.rect.y1, p.slivers ? 1 : 0};
-  const std::size_t n = p.rect.empty() ? 0 : std::size_t(p.rect.width()) * std::size_t(p.rect.height());
+void pack_rows(const render::PartialImage& p, int y0, int y1, std::vector<char>& out) {
+  const bool empty = p.rect.empty() || y1 <= y0;
+  const std::int32_t head[5] = {p.rect.x0, empty ? p.rect.y0 : y0, p.rect.x1, empty ? p.rect.y1 : y1, p.slivers ? 1 : 0};
+  const std::size_t w = std::size_t(std::max(p.rect.width(), 0));
+  const std::size_t n = empty ? 0 : w * std::size_t(y1 - y0), first = empty ? 0 : w * std::size_t(y0 - p.rect.y0);
   const std::size_t at = out.size();
   const std::size_t extra = p.slivers ? n * (4 * sizeof(float) + 1) : 0;
   out.resize(at + sizeof head + n * 5 * sizeof(float) + extra);
@@ -161,13 +164,15 @@ void pack(const render::PartialImage& p, std::vector<char>& out) {
   std::memcpy(q, head, sizeof head);
   q += sizeof head;
   if (!n) return;
-  std::memcpy(q, p.rgba.data(), n * 4 * sizeof(float));
-  std::memcpy(q + n * 4 * sizeof(float), p.depth.data(), n * sizeof(float));
+  std::memcpy(q, p.rgba.data() + 4 * first, n * 4 * sizeof(float));
+  std::memcpy(q + n * 4 * sizeof(float), p.depth.data() + first, n * sizeof(float));
   if (!p.slivers) return;
   q += n * 5 * sizeof(float);
-  std::memcpy(q, p.rgba_open.data(), n * 4 * sizeof(float));
-  std::memcpy(q + n * 4 * sizeof(float), p.sliver_end.data(), n);
+  std::memcpy(q, p.rgba_open.data() + 4 * first, n * 4 * sizeof(float));
+  std::memcpy(q + n * 4 * sizeof(float), p.sliver_end.data() + first, n);
 }
+
+void pack(const render::PartialImage& p, std::vector<char>& out) { pack_rows(p, p.rect.y0, p.rect.y1, out); }
 
 const char* unpack(const char* in, const char* end, int width, int height, render::PartialImage& p) {
   std::int32_t head[5];
@@ -191,20 +196,6 @@ const char* unpack(const char* in, const char* end, int width, int height, rende
     }
   }
   return in + bytes;
-}
-
-// Rows [y0, y1) of `p` (inside its rect) as a partial-image message, in pack()'s format.
-void pack_rows(const render::PartialImage& p, int y0, int y1, std::vector<char>& out) {
-  const std::int32_t rect[4] = {p.rect.x0, y0, p.rect.x1, y1};
-  const std::size_t w = std::size_t(p.rect.width()), n = w * std::size_t(y1 - y0);
-  const std::size_t first = w * std::size_t(y0 - p.rect.y0);
-  const std::size_t at = out.size();
-  out.resize(at + sizeof rect + n * 5 * sizeof(float));
-  std::memcpy(out.data() + at, rect, sizeof rect);
-  if (n) {
-    std::memcpy(out.data() + at + sizeof rect, p.rgba.data() + 4 * first, n * 4 * sizeof(float));
-    std::memcpy(out.data() + at + sizeof rect + n * 4 * sizeof(float), p.depth.data() + first, n * sizeof(float));
-  }
 }
 
 }  // namespace
