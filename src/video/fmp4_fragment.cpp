@@ -108,7 +108,7 @@ void append_fragment(std::vector<std::uint8_t>& o, std::uint32_t sequence, std::
   const std::size_t n = samples.size();
   const std::size_t moof = kMoofFixed + kPerSample * n;
   if (moof > 0xffffffffu || data_size + 8 > 0xffffffffu) throw Error("fragment too large for 32-bit box sizes");
-  o.reserve(o.size() + moof + 8 + data_size);
+  // No reserve(): callers batch many fragments into one buffer, which must grow geometrically.
   box(o, std::uint32_t(moof), "moof");
   box(o, 16, "mfhd");
   put32(o, 0);  // version, flags
