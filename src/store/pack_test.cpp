@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/frame_stamp.hpp"
 #include "store/database.hpp"
+#include "store/pack_convert.hpp"
 #include "store/synthetic.hpp"
 #include "store/test_support.hpp"
 
@@ -432,4 +433,56 @@ TEST(Pack, IdleStreamsHoldAFewHundredBytes) {
   EXPECT_LT(per_stream, 512);
   EXPECT_LT(growth, 64);
   w.finalize();
+}
+
+// `panoptes pack` / `unpack`: every packet bitwise the source's, both ways, with P-frames too.
+TEST(Pack, PackAndUnpackKeepEveryPacketBitwise) {
+  for (const int gop : {1, 3}) {
+    TempDir files, packed, unpacked;
+    Manifest m = sample_manifest(3, 2, 48, 40);
+    m.video.gop = gop;
+    {
+      WriterOptions o;
+      o.layout = LayoutChoice::files;
+      DatabaseWriter w = DatabaseWriter::create(files.path, m, o);
+      for (int f = 0; f < 4; ++f) {
+        append_snapshot(w, m, f);
+        w.checkpoint();
+      }
+      w.finalize();
+    }
+    fs::remove_all(packed.path);
+    pack_database(files.path, packed.path);
+    fs::remove_all(unpacked.path);
+    unpack_database(packed.path, unpacked.path);
+    const Database a = Database::open(files.path), b = Database::open(packed.path), c = Database::open(unpacked.path);
+    ASSERT_TRUE(b.packed());
+    ASSERT_FALSE(c.packed());
+    EXPECT_EQ(b.frame_count(), 4);
+    EXPECT_EQ(count_files(packed.path), 4u);
+    EXPECT_EQ(count_files(unpacked.path), 2u + 6u);
+    std::vector<std::uint8_t> pa, pb, pc;
+    for (int cam = 0; cam < 3; ++cam)
+      for (int t = 0; t < 2; ++t) {
+        auto ra = a.stream(cam, t), rb = b.stream(cam, t), rc = c.stream(cam, t);
+        ASSERT_EQ(rb->frame_count(), 4);
+        ASSERT_EQ(rc->frame_count(), 4);
+        for (int f = 0; f < 4; ++f) {
+          ra->read_packet(f, pa);
+          rb->read_packet(f, pb);
+          rc->read_packet(f, pc);
+          EXPECT_EQ(pa, pb) << "gop " << gop << " camera " << cam << " task " << t << " frame " << f;
+          EXPECT_EQ(pa, pc) << "gop " << gop << " camera " << cam << " task " << t << " frame " << f;
+          EXPECT_EQ(rb->is_keyframe(f), ra->is_keyframe(f));
+        }
+        expect_stamps(b, cam, t, 4);
+      }
+    EXPECT_TRUE(b.validate_streams(1, true).problems.empty());
+    EXPECT_TRUE(c.validate_streams(1, true).problems.empty());
+    // Refusals: into a database, or packing a packed one.
+    EXPECT_THROW(pack_database(files.path, unpacked.path), FileError);
+    TempDir again;
+    fs::remove_all(again.path);
+    EXPECT_THROW(pack_database(packed.path, again.path), Error);
+  }
 }
