@@ -154,6 +154,7 @@ struct DatabaseWriter::Impl {
   // Packed layout: one encoder shared by every stream, this writer's pack, and the slot of each owned
   // camera in it (the pack lists cameras ascending).
   bool packed = false;
+  bool pack_failed = false;  // a pack or index write failed: nothing more is written
   std::unique_ptr<video::IntraPacketEncoder> encoder;
   std::unique_ptr<PackWriter> pack;
   std::vector<int> camera_of_slot;
@@ -198,6 +199,17 @@ struct DatabaseWriter::Impl {
   // then the index round naming them. After it returns, the frames are in the pack and indexed.
   void flush_packed() {
     if (!pack) return;
+    if (pack_failed)
+      throw FileError(pack->pack_path().string(), "an earlier write failed; the database ends at its last checkpoint");
+    try {
+      write_packed_round();
+    } catch (...) {
+      pack_failed = true;  // frames of this round are lost: later rounds would leave a gap
+      throw;
+    }
+  }
+
+  void write_packed_round() {
     const int tasks = manifest.task_count();
     std::vector<PackRecord> records(streams.size());
     std::vector<std::uint8_t> batch;
@@ -466,6 +478,8 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
   if (frame.channels != 3 && frame.channels != 4)
     throw Error(impl_->dir.string() + ": frame has " + std::to_string(frame.channels) + " channels, expected 3 or 4");
   if (impl_->packed) {
+    if (impl_->pack_failed)
+      throw FileError(impl_->pack->pack_path().string(), "an earlier write failed; the database ends at its last checkpoint");
     std::optional<video::MovieIdentity> identity;
     if (impl_->manifest.frame_checks.recorded()) identity = movie_identity(impl_->manifest, camera, task);
     const std::size_t n = impl_->encoder->encode(frame, std::uint32_t(s.frames), identity,
