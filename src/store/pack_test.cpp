@@ -486,3 +486,31 @@ TEST(Pack, PackAndUnpackKeepEveryPacketBitwise) {
     EXPECT_THROW(pack_database(packed.path, again.path), Error);
   }
 }
+
+// The manifest's layout fields: round trip, and clear refusals of what this build cannot read.
+TEST(Pack, ManifestLayoutFieldsAreCheckedOnRead) {
+  Manifest m = packed_manifest(2, 1);
+  m.layout = Layout::packed;
+  m.packs = {{0, 0, 4}, {1, 7, 2}};
+  const nlohmann::json j = to_json(m);
+  const Manifest back = manifest_from_json(j, "test", {});
+  EXPECT_EQ(back.layout, Layout::packed);
+  EXPECT_EQ(back.packs, m.packs);
+  auto error_of = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json k = j;
+    edit(k);
+    try {
+      manifest_from_json(k, "test", {});
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of([](nlohmann::json& k) { k["layout"] = "zip"; }).find("\"zip\" is not a layout"), std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& k) { k.erase("packs"); }).find("must list its segments"), std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& k) { k["packs"][1]["segment"] = 0; }).find("ascending"), std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& k) { k["packs"][1]["first_frame"] = -1; }).find("non-decreasing"), std::string::npos);
+  EXPECT_NE(error_of([](nlohmann::json& k) { k["packs"][0]["ranks"] = 0; }).find("1..1000000"), std::string::npos);
+  // A files database writes no layout field (older readers see what they always saw).
+  EXPECT_FALSE(to_json(packed_manifest(2, 1)).contains("layout"));
+}
