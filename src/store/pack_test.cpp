@@ -514,3 +514,37 @@ TEST(Pack, ManifestLayoutFieldsAreCheckedOnRead) {
   // A files database writes no layout field (older readers see what they always saw).
   EXPECT_FALSE(to_json(packed_manifest(2, 1)).contains("layout"));
 }
+
+// Overwriting a packed database removes exactly its packs (every segment), not a user's file beside.
+TEST(Pack, OverwriteRemovesEverySegmentsPacks) {
+  TempDir dir;
+  const Manifest m = packed_manifest(2, 1);
+  {
+    DatabaseWriter w = DatabaseWriter::create(dir.path, m, packed_options());
+    append_snapshot(w, m, 0);
+    w.checkpoint();
+  }
+  {
+    DatabaseWriter w = DatabaseWriter::resume(dir.path, m, packed_options());
+    append_snapshot(w, m, 1);
+    w.finalize();
+  }
+  ASSERT_TRUE(fs::exists(dir.path / "packs" / pack_file_name(1, 0)));
+  write_bytes(dir.path / "packs" / "notes.txt", {'k'});
+  WriterOptions o;
+  o.overwrite = true;
+  o.layout = LayoutChoice::files;
+  {
+    DatabaseWriter w = DatabaseWriter::create(dir.path, m, o);
+    append_snapshot(w, m, 0);
+    w.finalize();
+  }
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_FALSE(fs::exists(dir.path / "packs" / pack_file_name(s, 0)));
+    EXPECT_FALSE(fs::exists(dir.path / "packs" / pack_index_name(s, 0)));
+  }
+  EXPECT_TRUE(fs::exists(dir.path / "packs" / "notes.txt"));
+  const Database db = Database::open(dir.path);
+  EXPECT_FALSE(db.packed());
+  expect_stamps(db, 1, 0, 1);
+}
