@@ -1070,12 +1070,12 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
         std::int64_t n = 0;
         for (std::size_t k = 1; k < ps.pieces.size(); ++k) n += std::int64_t(ps.pieces[k].size);
         bytes += file_bytes = n;
-        const std::string which = "stream camera " + std::to_string(camera) + ", task " + std::to_string(task);
+        auto which = [&] { return "stream camera " + std::to_string(camera) + ", task " + std::to_string(task); };
         if (ps.pieces.size() < 2 && frame_count() > 0)
-          throw StreamFileError(dir_ / kPackDirectory, "movie missing (" + which + ": no pack indexes a fragment of it)",
+          throw StreamFileError(dir_ / kPackDirectory, "movie missing (" + which() + ": no pack indexes a fragment of it)",
                                 StreamProblem::Kind::missing);
         if (ps.frames() < frame_count())
-          throw StreamFileError(ps.pieces.front().file, "truncated movie (" + which + "): its index names " +
+          throw StreamFileError(ps.pieces.front().file, "truncated movie (" + which() + "): its index names " +
                                                             std::to_string(ps.frames()) + " of the " +
                                                             std::to_string(frame_count()) + " frames the manifest records",
                                 StreamProblem::Kind::truncated);
