@@ -1,6 +1,7 @@
 #pragma once
 // The movie database: a directory holding panoptes.json (the manifest) and one movie per
-// (camera, task) found by the manifest's file-name pattern.
+// (camera, task): a file found by the manifest's file-name pattern, or (packed layout, pack.hpp) byte
+// ranges of a pack file that a binary index lists.
 //
 // Writing: DatabaseWriter::create → append(camera, task, frame) ... → checkpoint() after each snapshot
 // → finalize(). Reading: Database::open (manifest only, no movie opened, no directory scan) →
@@ -74,7 +75,9 @@ struct WriterOptions {
 /// bench/video_bench (docs/formats.md, Movies): about 1 MB with gop 1 (the default: no encoder is
 /// kept between frames), about 25 MB with gop > 1 (a live x264 encoder with reference frames). So
 /// 10^4 streams of one rank need ~10 GB at gop 1: spread cameras over ranks (MPI), or write offline
-/// stream by stream with close_stream(). The writer's own bookkeeping is 16 bytes per stream.
+/// stream by stream with close_stream(). In the packed layout (WriterOptions::layout) no stream keeps
+/// an encoder or muxer: one encoder pool serves all, and a stream holds a 96-byte record plus its
+/// compressed frames until the next flush (docs/formats.md, Packed layout).
 class DatabaseWriter {
  public:
   /// Creates the directory (and parents) and writes the manifest with status `running`,
