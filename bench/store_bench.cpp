@@ -2,6 +2,8 @@
 // manifest size. Only manifests are written in the fixture: open() never touches a movie, which is
 // exactly the claim measured here (open time independent of the number of streams).
 #include <benchmark/benchmark.h>
+#include <malloc.h>
+#include <sys/resource.h>
 
 #include <filesystem>
 #include <map>
@@ -105,6 +107,57 @@ void BM_SyntheticDatabase(benchmark::State& state) {
 }
 BENCHMARK(BM_SyntheticDatabase)->ArgNames({"cameras", "tasks"})->Args({1000, 10})->Iterations(1)
     ->Unit(benchmark::kSecond)->UseRealTime();
+
+// Issue 46, in situ: every stream gets one 40x32 frame per snapshot, then a checkpoint, through one
+// DatabaseWriter (one rank). Args: layout (0 files, 1 packed), cameras, tasks. Counters: process CPU
+// (getrusage: all threads) per stream per snapshot, heap in use (mallinfo2) per stream after the
+// first snapshot beyond what create() left, and files in the database. The files layout keeps a
+// muxer per stream (~1 MB), so it runs at 10^3 streams only.
+double process_cpu_seconds() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+void BM_InsituSnapshot(benchmark::State& state) {
+  const bool packed = state.range(0) == 1;
+  const int cameras = int(state.range(1)), tasks = int(state.range(2));
+  testing::TempDir dir("bench-pack");
+  Manifest m = testing::sample_manifest(cameras, tasks, 40, 32);
+  m.video.gop = 1;
+  WriterOptions o;
+  o.layout = packed ? LayoutChoice::packed : LayoutChoice::files;
+  const panoptes::Image frame = synthetic_frame(0, 0, 0, 40, 32);
+  DatabaseWriter w = DatabaseWriter::create(dir.path / "db", m, o);
+  w.append(0, 0, frame);  // one-time encoder set-up outside the measurement
+  const double heap0 = double(mallinfo2().uordblks);
+  double heap1 = 0, cpu = 0;
+  int snapshot = 0;
+  for (auto _ : state) {
+    const double c0 = process_cpu_seconds();
+    for (int c = 0; c < cameras; ++c)
+      for (int t = (snapshot == 0 && c == 0) ? 1 : 0; t < tasks; ++t) w.append(c, t, frame);
+    w.checkpoint();
+    cpu += process_cpu_seconds() - c0;
+    if (snapshot++ == 0) heap1 = double(mallinfo2().uordblks);
+  }
+  const double streams = double(cameras) * tasks;
+  w.finalize();
+  std::int64_t files = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path / "db")) files += e.is_regular_file();
+  state.counters["streams"] = streams;
+  state.counters["cpu_us_per_stream"] = 1e6 * cpu / double(state.iterations()) / streams;
+  state.counters["heap_bytes_per_stream"] = (heap1 - heap0) / streams;
+  state.counters["files"] = double(files);
+}
+BENCHMARK(BM_InsituSnapshot)
+    ->ArgNames({"packed", "cameras", "tasks"})
+    ->Args({0, 100, 10})    // files, 10^3 streams
+    ->Args({1, 100, 10})    // packed, 10^3
+    ->Args({1, 100, 100})   // packed, 10^4
+    ->Args({1, 1000, 100})  // packed, 10^5
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -110,6 +110,13 @@ void run(const Args& a) {
     j["video"] = {{"codec", "h264"}, {"crf", m.video.crf}, {"preset", m.video.preset},
                   {"gop", m.video.gop}, {"fps", m.video.fps}};
     j["movie_pattern"] = m.movie_pattern;
+    j["layout"] = std::string(store::to_string(m.layout));
+    if (m.layout == store::Layout::packed) {
+      std::int64_t ranks = 0;
+      for (const auto& seg : m.packs) ranks += seg.ranks;
+      j["pack_segments"] = m.packs.size();
+      j["pack_files_max"] = 2 * ranks;
+    }
     j["frame_checks"] = m.frame_checks.recorded() ? nlohmann::json(m.frame_checks.scheme) : nlohmann::json(nullptr);
     // What a frame read as good proves (issue 44): "all" (scheme 3), "frames" (scheme 2: not the
     // parameter sets), "none" (written before frame checks: unverified).
@@ -160,7 +167,14 @@ void run(const Args& a) {
                 m.image.padded_height);
     std::printf("video      h264, crf %d, preset %s, gop %d, %g fps\n", m.video.crf, m.video.preset.c_str(),
                 m.video.gop, m.video.fps);
-    std::printf("streams    %lld (movies %s)\n", (long long)db.stream_count(), m.movie_pattern.c_str());
+    if (m.layout == store::Layout::packed) {
+      std::int64_t ranks = 0;
+      for (const auto& seg : m.packs) ranks += seg.ranks;
+      std::printf("streams    %lld (packed: %zu segment(s), at most %lld pack and index files in packs/)\n",
+                  (long long)db.stream_count(), m.packs.size(), (long long)(2 * ranks));
+    } else {
+      std::printf("streams    %lld (movies %s)\n", (long long)db.stream_count(), m.movie_pattern.c_str());
+    }
     std::printf("checks     %s\n", m.frame_checks.binds_parameter_sets()
                                       ? "every frame: checksum, movie identity, index, timestamp and the stream's parameter "
                                         "sets (panoptes-frame-3)"

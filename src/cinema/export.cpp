@@ -166,7 +166,8 @@ ExportReport export_cinema(const fs::path& db_dir, const fs::path& out, const Ex
 
   // Every movie exists before anything is created (a manifest listing 10^4 tasks without movies must
   // not leave 40,000 directories behind); stream() checks each one fully when it is decoded.
-  for (int c = 0; c < cams; ++c)
+  // (A packed database has no per-stream file: its index is checked when each stream opens.)
+  for (int c = 0; c < cams && !db.packed(); ++c)
     for (int t = 0; t < tasks; ++t) {
       const fs::path movie = db.stream_path(c, t);
       std::error_code ec;

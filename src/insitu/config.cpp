@@ -118,7 +118,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   only_keys(c, root, "", allowed);
   SessionConfig s;
   if (const auto* o = table(c, root, "output")) {
-    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "resume_complete", "keep_interrupted", "title", "units", "time_units", "field_units"});
+    only_keys(c, *o, "output", {"dir", "mode", "overwrite", "resume_complete", "keep_interrupted", "layout", "title", "units", "time_units", "field_units"});
     s.output_dir = str(c, *o, "dir", "output.", s.output_dir);
     // `overwrite = true/false` is the key's old spelling: it still means mode "overwrite"/"create".
     if (o->get("mode") && o->get("overwrite"))
@@ -136,6 +136,9 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     }
     s.resume_complete = boolean(c, *o, "resume_complete", "output.", false);
     s.keep_interrupted = boolean(c, *o, "keep_interrupted", "output.", true);
+    s.layout = str(c, *o, "layout", "output.", "auto");
+    if (s.layout != "auto" && s.layout != "files" && s.layout != "packed")
+      c.fail("output.layout", "\"" + s.layout + "\"; expected \"auto\", \"files\" or \"packed\"");
     s.title = str(c, *o, "title", "output.", s.title);
     s.units = str(c, *o, "units", "output.", "");
     s.time_units = str(c, *o, "time_units", "output.", "");
@@ -332,7 +335,9 @@ const char* config_keys_help() {
             the restarted run (time <= the last written time) are skipped, the movies go on; rig, tasks,
             grid, image, video settings and schedule must be the ones it was written with; a complete
             database is refused unless resume_complete = true, which appends to the finished run);
-            overwrite = true | false is the old spelling of mode = "overwrite" | "create"
+            overwrite = true | false is the old spelling of mode = "overwrite" | "create";
+            layout = "auto" (packed from 1024 streams at gop 1, else files) | "files" (one movie file per
+            stream) | "packed" (per rank and run segment one pack file + index: bounded file count)
 [image]     width = 920, height = 896 (pixels); background = [0, 0, 0]; outline = true (domain box);
             compass = true (360-degree frames: horizon, a tick every 45 degrees, N/E/S/W)
 [rig]       spec = "yinyang" (yinyang[:NTxNP] | latlon[:NLATxNLON[+poles]] | fibonacci[:N] | file:PATH,

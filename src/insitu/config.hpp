@@ -113,6 +113,9 @@ struct SessionConfig {
   /// DIR.interrupted-N, instead of deleting it (issue 42: a restart meant to resume lost part 1 of its
   /// run without a word). The commands' explicit --overwrite sets it false.
   bool keep_interrupted = true;
+  /// [output] layout: "auto" (packed from store::kPackedAutoStreams streams at gop 1, else files),
+  /// "files" (one movie file per stream) or "packed" (per rank and run segment one pack + index).
+  std::string layout = "auto";
   std::string title = "in-situ visualization";
   std::string program = "panoptes insitu";  ///< recorded in the manifest's provenance
   std::string command_line;

@@ -128,6 +128,9 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
     try {
       store::WriterOptions o;
       o.owned_cameras = owned;
+      o.layout = store::parse_layout_choice(cfg.layout);
+      o.rank = g.rank;
+      o.ranks = g.size;
       if (cfg.mode == OutputMode::resume) {
         refuse_resume(cfg, manifest);
         out.writer.emplace(store::DatabaseWriter::resume(cfg.output_dir, manifest, o));
@@ -173,6 +176,8 @@ SessionOutput open_session_output(const SessionConfig& cfg, const store::Manifes
       store::WriterOptions o;
       o.owned_cameras = owned;
       o.writes_manifest = false;
+      o.rank = g.rank;
+      o.ranks = g.size;
       out.writer.emplace(cfg.mode == OutputMode::resume
                              ? store::DatabaseWriter::resume(cfg.output_dir, manifest, o, out.frames)
                              : store::DatabaseWriter::create(cfg.output_dir, manifest, o));

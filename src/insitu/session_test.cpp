@@ -262,8 +262,10 @@ TEST(InsituSession, SnapshotsScheduleAndFinalize) {
 }
 
 // Runs a session that SIGKILLs itself in the middle of its third snapshot (camera 2 of frame 2).
-void run_until_killed(const fs::path& dir) {
-  insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
+void run_until_killed(const fs::path& dir, const std::string& layout = "auto") {
+  auto cfg = small_config(dir);
+  cfg.layout = layout;
+  insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
   s.set_frame_observer([](int camera, int, int frame, const Image&) {
     if (frame == 2 && camera == 2) ::raise(SIGKILL);
   });
@@ -299,6 +301,46 @@ TEST(InsituSession, KilledRunOpensInterrupted) {
       const Image img = r->read_rgba(1);
       EXPECT_EQ(img.width, 32);
     }
+  fs::remove_all(dir);
+}
+
+// Issue 46: the same with [output] layout = "packed": one pack and one index, no movie file; a kill
+// in the third snapshot keeps two; resume continues into a new segment and every frame plays.
+TEST(InsituSession, PackedLayoutSurvivesAKillAndResumes) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  if (!std::getenv("PANOPTES_TEST_PACKED_DIR")) {
+    const fs::path d = fs::temp_directory_path() / ("insitu_packed_" + std::to_string(::getpid()));
+    ::setenv("PANOPTES_TEST_PACKED_DIR", d.c_str(), 1);
+  }
+  const fs::path dir = std::getenv("PANOPTES_TEST_PACKED_DIR");
+  fs::remove_all(dir);
+  EXPECT_EXIT(run_until_killed(dir, "packed"), ::testing::KilledBySignal(SIGKILL), "");
+  {
+    const auto db = store::Database::open(dir);
+    ASSERT_TRUE(db.packed());
+    EXPECT_EQ(db.frame_count(), 2);
+    EXPECT_FALSE(fs::exists(dir / "movies"));
+    EXPECT_TRUE(db.validate_streams(1, true).problems.empty());
+  }
+  auto cfg = small_config(dir.string());
+  cfg.mode = insitu::OutputMode::resume;
+  {
+    insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
+    for (int step = 0; step < 5; ++step) {
+      const auto f = field(0.2 * step);
+      s.process(step, 0.2 * step, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+    }
+    s.finalize();
+  }
+  const auto db = store::Database::open(dir);
+  EXPECT_EQ(db.status(), store::Status::complete);
+  EXPECT_EQ(db.frame_count(), 5);
+  EXPECT_EQ(db.manifest().packs.size(), 2u);
+  const store::StreamReport report = db.validate_streams(1, true);
+  EXPECT_TRUE(report.problems.empty()) << report.problems.front().message;
+  std::size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 6u);  // manifest, camera table, 2 segments x (pack + index)
   fs::remove_all(dir);
 }
 

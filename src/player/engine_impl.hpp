@@ -131,9 +131,12 @@ struct Engine::Impl {
     } catch (const std::exception& e) {
       std::error_code ec;
       const auto path = db.stream_path(s.camera, s.task);
-      const bool exists = std::filesystem::exists(path, ec);
+      // A packed database has no file per stream: its reader says when the index names no fragment.
+      const bool exists = db.packed() ? std::string(e.what()).find("movie missing") == std::string::npos
+                                      : std::filesystem::exists(path, ec);
       const FrameStatus status = exists ? FrameStatus::unreadable : FrameStatus::missing;
-      const std::string message = exists ? std::string(e.what()) : path.string() + ": movie file is missing";
+      const std::string message =
+          exists || db.packed() ? std::string(e.what()) : path.string() + ": movie file is missing";
       mark_bad(stream, status, message);
       return {status, message, nullptr};
     }

@@ -144,6 +144,15 @@ void bind_database(py::module_& m) {
       .def("manifest_json", &PyDatabase::manifest_json)
       .def("cameras", &PyDatabase::cameras)
       .def("stream_path", [](const PyDatabase& d, int c, int t) { return d.database().stream_path(c, t); })
+      // Issue 46: a packed database's stream as byte ranges of its packs (init segment first).
+      .def_property_readonly("packed", [](const PyDatabase& d) { return d.database().packed(); })
+      .def("packed_stream", [](const PyDatabase& d, int c, int t) {
+        py::list pieces;
+        for (const auto& p : d.database().packed_stream(c, t).pieces)
+          pieces.append(py::dict(py::arg("file") = p.file.string(), py::arg("offset") = p.offset, py::arg("size") = p.size,
+                                 py::arg("first_frame") = p.first_frame, py::arg("frames") = p.frames));
+        return pieces;
+      })
       .def("frame", &PyDatabase::frame, py::arg("camera"), py::arg("task"), py::arg("frame"));
 }
 

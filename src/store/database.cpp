@@ -40,6 +40,9 @@
 #include "store/manifest_diff.hpp"
 #include "store/owned_files.hpp"
 #include "store/safe_file.hpp"
+#include "store/pack.hpp"
+#include "video/fmp4_fragment.hpp"
+#include "video/intra_packet_encoder.hpp"
 #include "video/movie_reader.hpp"
 #include "video/movie_writer.hpp"
 
@@ -92,11 +95,24 @@ FrameCheckRecord frame_checks_on_disk(int dir_fd, const fs::path& dir) {
   return record;
 }
 
+// The layout and last pack segment the root writer recorded in dir (non-root ranks write their packs
+// into that segment). Files layout if it cannot be read.
+std::pair<Layout, PackSegment> layout_on_disk(int dir_fd, const fs::path& dir) {
+  try {
+    const Manifest m = read_manifest(dir / kManifestFileName);
+    if (m.layout == Layout::packed && !m.packs.empty()) return {Layout::packed, m.packs.back()};
+  } catch (const std::exception&) {
+  }
+  (void)dir_fd;
+  return {Layout::files, {}};
+}
+
 // The overwrite of an old database: removes the movies its manifest lists (and the directories
 // left empty); reports its camera table for removal after the new one is written.
 void remove_old_database_files(int dir_fd, const fs::path& dir, std::string* old_table) {
   const OldDatabaseFiles old = describe_old_database(dir_fd, dir);
   remove_owned_files(dir_fd, find_listed_movies(dir_fd, old.movie_pattern, old.cameras, old.tasks), dir);
+  if (!old.packs.empty()) remove_owned_files(dir_fd, old.packs, dir);
   *old_table = old.camera_table;
 }
 
@@ -104,11 +120,24 @@ void remove_old_database_files(int dir_fd, const fs::path& dir, std::string* old
 
 // --- writer ---
 
+LayoutChoice parse_layout_choice(std::string_view text) {
+  if (text == "auto") return LayoutChoice::automatic;
+  if (text == "files") return LayoutChoice::files;
+  if (text == "packed") return LayoutChoice::packed;
+  throw Error("layout \"" + std::string(text.substr(0, 64)) + "\" is not one of auto, files, packed");
+}
+
 struct DatabaseWriter::Impl {
   struct Stream {
-    std::unique_ptr<video::MovieWriter> writer;
+    std::unique_ptr<video::MovieWriter> writer;  // files layout
     int frames = 0;
     bool closed = false;
+    // Packed layout: samples appended since the last fragment (MP4 form, back to back) and their
+    // sizes; frames before `flushed` are in the pack. An idle stream holds no heap memory.
+    int flushed = 0;
+    std::vector<std::uint8_t> pending;
+    std::vector<std::uint32_t> pending_sizes;
+    PackRecord written;  // a fragment close_stream() wrote that the next index round must name
   };
 
   fs::path dir;
@@ -122,6 +151,96 @@ struct DatabaseWriter::Impl {
   FileHandle dir_fd;  // the database directory: every name inside is opened relative to it
   bool finalized = false;
   CameraTableRef table;  // the camera table written by create() (manifest writer only)
+  // Packed layout: one encoder shared by every stream, this writer's pack, and the slot of each owned
+  // camera in it (the pack lists cameras ascending).
+  bool packed = false;
+  bool pack_failed = false;  // a pack or index write failed: nothing more is written
+  std::unique_ptr<video::IntraPacketEncoder> encoder;
+  std::unique_ptr<PackWriter> pack;
+  std::vector<int> camera_of_slot;
+  std::uint32_t frame_ticks = 0;
+
+  // Opens this writer's pack of `segment` starting at `first_frame` (packs/ is created if missing).
+  void open_pack(int segment, int first_frame) {
+    packed = true;
+    const auto& im = manifest.image;
+    encoder = std::make_unique<video::IntraPacketEncoder>(im.width, im.height, manifest.video,
+                                                          (dir / kPackDirectory).string());
+    manifest.image.padded_width = encoder->padded_width();
+    manifest.image.padded_height = encoder->padded_height();
+    std::uint32_t timescale = 0;
+    const std::vector<std::uint8_t> init = video::make_init_segment(
+        encoder->header(), encoder->padded_width(), encoder->padded_height(), manifest.video, &timescale, &frame_ticks);
+    FileHandle packs_dir = open_subdirectory(dir_fd.get(), kPackDirectory, true, dir);
+    pack = std::make_unique<PackWriter>(packs_dir.get(), dir / kPackDirectory, segment, options.rank, camera_of_slot,
+                                        manifest.task_count(), first_frame, init, timescale, frame_ticks);
+  }
+
+  // Appends the pending samples of s as one fragment to `out` and returns its record (offset relative
+  // to `out`'s start); the samples are freed.
+  PackRecord make_fragment(Stream& s, std::vector<std::uint8_t>& out) {
+    PackRecord r;
+    r.first_frame = std::uint32_t(s.flushed);
+    r.frames = std::uint32_t(s.pending_sizes.size());
+    r.offset = out.size();
+    std::vector<video::FragmentSample> samples;
+    samples.reserve(s.pending_sizes.size());
+    for (std::uint32_t n : s.pending_sizes) samples.push_back({n, true});
+    video::append_fragment(out, std::uint32_t(s.flushed) + 1, std::uint64_t(s.flushed) * frame_ticks, frame_ticks,
+                           samples, s.pending.data(), s.pending.size());
+    r.size = std::uint32_t(out.size() - r.offset);
+    s.flushed += int(r.frames);
+    std::vector<std::uint8_t>().swap(s.pending);
+    std::vector<std::uint32_t>().swap(s.pending_sizes);
+    return r;
+  }
+
+  // Packed: writes every stream's pending frames as one fragment each (batched into large writes),
+  // then the index round naming them. After it returns, the frames are in the pack and indexed.
+  void flush_packed() {
+    if (!pack) return;
+    if (pack_failed)
+      throw FileError(pack->pack_path().string(), "an earlier write failed; the database ends at its last checkpoint");
+    try {
+      write_packed_round();
+    } catch (...) {
+      pack_failed = true;  // frames of this round are lost: later rounds would leave a gap
+      throw;
+    }
+  }
+
+  void write_packed_round() {
+    const int tasks = manifest.task_count();
+    std::vector<PackRecord> records(streams.size());
+    std::vector<std::uint8_t> batch;
+    std::vector<std::size_t> in_batch;  // records whose offset is relative to the batch
+    auto write_batch = [&] {
+      if (batch.empty()) return;
+      const std::uint64_t base = pack->append(batch.data(), batch.size());
+      for (std::size_t i : in_batch) records[i].offset += base;
+      batch.clear();
+      in_batch.clear();
+    };
+    constexpr std::size_t kBatch = std::size_t(8) << 20;
+    for (std::size_t i = 0; i < streams.size(); ++i) {
+      Stream& s = streams[i];
+      const int camera = camera_of_slot[i / std::size_t(tasks)];
+      const std::size_t at = std::size_t(pack->slot(camera)) * std::size_t(tasks) + i % std::size_t(tasks);
+      if (!s.pending_sizes.empty()) {
+        records[at] = make_fragment(s, batch);
+        in_batch.push_back(at);
+        if (batch.size() >= kBatch) write_batch();
+      } else if (s.written.frames > 0) {
+        records[at] = s.written;
+        s.written = {};
+      }
+    }
+    write_batch();
+    // A round that names nothing is not written (a flush with no new frame costs no index space).
+    if (std::none_of(records.begin(), records.end(), [](const PackRecord& r) { return r.frames > 0; })) return;
+    // Only now the records: an index never names bytes that are not yet in the pack.
+    pack->write_round(records);
+  }
 
   Stream& stream(int camera, int task) {
     if (finalized) throw Error(dir.string() + ": database already finalized; cannot append");
@@ -145,6 +264,10 @@ struct DatabaseWriter::Impl {
 
   // Flushes every open movie in parallel; the first failure is rethrown naming its stream.
   void flush_all() {
+    if (packed) {
+      flush_packed();
+      return;
+    }
     const int threads = int(std::max(1u, std::thread::hardware_concurrency()));
     parallel_for(std::int64_t(streams.size()), streams.size() > 16 ? threads : 1, [&](std::int64_t i) {
       if (streams[std::size_t(i)].writer) streams[std::size_t(i)].writer->flush();
@@ -254,6 +377,20 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     }
   }
   impl->streams.resize(std::size_t(impl->owned) * std::size_t(manifest.task_count()));
+  impl->camera_of_slot.resize(std::size_t(impl->owned));
+  for (int c = 0; c < manifest.camera_count(); ++c)
+    if (impl->slot_of_camera[std::size_t(c)] >= 0) impl->camera_of_slot[std::size_t(impl->slot_of_camera[std::size_t(c)])] = c;
+  const bool want_packed = options.layout == LayoutChoice::packed ||
+                           (options.layout == LayoutChoice::automatic && manifest.video.gop == 1 &&
+                            manifest.stream_count() >= kPackedAutoStreams);
+  if (options.rank < 0 || options.ranks < 1 || options.rank >= options.ranks)
+    throw Error(dir.string() + ": writer rank " + std::to_string(options.rank) + " of " + std::to_string(options.ranks) +
+                " ranks; expected 0 <= rank < ranks");
+  if (options.writes_manifest) {
+    manifest.layout = want_packed ? Layout::packed : Layout::files;
+    manifest.packs.clear();
+    if (want_packed) manifest.packs.push_back({0, 0, options.ranks});
+  }
   impl->manifest = std::move(manifest);
 
   if (!options.writes_manifest) {
@@ -261,6 +398,9 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
     if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist (create it on the root writer first)");
     impl->dir_fd = open_directory(dir);
     impl->manifest.frame_checks = frame_checks_on_disk(impl->dir_fd.get(), dir);
+    const auto [layout, segment] = layout_on_disk(impl->dir_fd.get(), dir);
+    impl->manifest.layout = layout;
+    if (layout == Layout::packed) impl->open_pack(segment.segment, segment.first_frame);
     return DatabaseWriter(std::move(impl));
   }
 
@@ -293,6 +433,8 @@ DatabaseWriter DatabaseWriter::create(const fs::path& dir, Manifest manifest, co
   }
   remove_stale_temp_files(impl->dir_fd.get());  // a killed writer's half-written manifest or table
   try {
+    // The pack first: its encoder settles the padded size the manifest records.
+    if (impl->manifest.layout == Layout::packed) impl->open_pack(0, 0);
     impl->table = write_camera_table(dir, impl->manifest);
     impl->write_manifest(Status::running, 0);
   } catch (...) {
@@ -335,6 +477,17 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
                 ", expected the database image size " + std::to_string(im.width) + "x" + std::to_string(im.height));
   if (frame.channels != 3 && frame.channels != 4)
     throw Error(impl_->dir.string() + ": frame has " + std::to_string(frame.channels) + " channels, expected 3 or 4");
+  if (impl_->packed) {
+    if (impl_->pack_failed)
+      throw FileError(impl_->pack->pack_path().string(), "an earlier write failed; the database ends at its last checkpoint");
+    std::optional<video::MovieIdentity> identity;
+    if (impl_->manifest.frame_checks.recorded()) identity = movie_identity(impl_->manifest, camera, task);
+    const std::size_t n = impl_->encoder->encode(frame, std::uint32_t(s.frames), identity,
+                                                 impl_->manifest.frame_checks.binds_parameter_sets(), s.pending);
+    s.pending_sizes.push_back(std::uint32_t(n));
+    ++s.frames;
+    return;
+  }
   if (!s.writer) {
     const std::string relative = impl_->manifest.stream_relative_path(camera, task);
     const fs::path path = impl_->dir / relative;
@@ -367,6 +520,13 @@ void DatabaseWriter::append(int camera, int task, const Image& frame) {
 
 void DatabaseWriter::close_stream(int camera, int task) {
   auto& s = impl_->stream(camera, task);
+  if (impl_->packed && !s.pending_sizes.empty()) {
+    // Written now (memory stays bounded), named by the next index round.
+    std::vector<std::uint8_t> bytes;
+    PackRecord r = impl_->make_fragment(s, bytes);
+    r.offset = impl_->pack->append(bytes.data(), bytes.size());
+    s.written = r;
+  }
   if (s.writer) {
     s.writer->close();
     s.writer.reset();
@@ -423,6 +583,7 @@ void DatabaseWriter::finalize() { finalize(-1); }
 void DatabaseWriter::finalize(int frames_written) {
   if (impl_->finalized) return;
   auto& streams = impl_->streams;
+  if (impl_->packed) impl_->flush_packed();
   parallel_for(std::int64_t(streams.size()), streams.size() > 16 ? 0 : 1, [&](std::int64_t i) {
     if (streams[std::size_t(i)].writer) streams[std::size_t(i)].writer->close();
   });
@@ -474,6 +635,7 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
     }
   }
   impl->streams.resize(std::size_t(impl->owned) * std::size_t(manifest.task_count()));
+  impl->camera_of_slot = owned;
   impl->manifest = std::move(manifest);
   if (!fs::is_directory(dir, ec)) throw FileError(dir.string(), "database directory does not exist; nothing to resume");
   impl->dir_fd = open_directory(dir);
@@ -499,6 +661,10 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
       m.provenance.extra["resumed"] = before + utc_now_iso8601() + "@" + std::to_string(frames);
       for (const auto& [key, value] : old.provenance.extra) m.provenance.extra.try_emplace(key, value);
       old_table = referenced_camera_table(dir / kManifestFileName);
+      // A packed database stays packed: the continuation goes into a new segment of packs.
+      m.layout = old.layout;
+      m.packs = old.packs;
+      if (old.layout == Layout::packed) m.packs.push_back({old.packs.back().segment + 1, frames, options.ranks});
     } catch (...) {
       impl->release_lock();
       throw;
@@ -550,11 +716,47 @@ DatabaseWriter DatabaseWriter::resume(const fs::path& dir, Manifest manifest, co
   };
   Impl& m = *impl;
   const int tasks = m.manifest.task_count();
+  if (!options.writes_manifest) {
+    const auto [layout, segment] = layout_on_disk(m.dir_fd.get(), dir);
+    m.manifest.layout = layout;
+    if (layout == Layout::packed) m.manifest.packs = {segment};
+  }
   try {
-    parallel_for(std::int64_t(m.streams.size()), m.streams.size() > 16 ? 0 : 1, [&](std::int64_t i) {
-      const int slot = int(i / tasks);
-      resume_stream(m, owned[std::size_t(slot)], int(i % tasks), frames, m.streams[std::size_t(i)]);
-    });
+    if (m.manifest.layout == Layout::packed) {
+      // Each owned stream continues from its indexed fragments: a fragment holding the seam is cut by
+      // copying its frames before the seam into the new segment's first fragment.
+      const Database old_db = Database::open(dir);
+      if (old_db.manifest().layout != Layout::packed)
+        throw FileError(dir.string(), "resume: the manifest on disk is not packed; cannot continue its packs");
+      parallel_for(std::int64_t(m.streams.size()), m.streams.size() > 16 ? 0 : 1, [&](std::int64_t i) {
+        const int camera = owned[std::size_t(i / tasks)], task = int(i % tasks);
+        Impl::Stream& s = m.streams[std::size_t(i)];
+        s.frames = s.flushed = frames;
+        if (frames == 0) return;
+        const PackedStream ps = old_db.packed_stream(camera, task);
+        if (ps.frames() < frames)
+          throw FileError(dir.string(), "resume: stream camera " + std::to_string(camera) + ", task " + std::to_string(task) +
+                                            " holds " + std::to_string(ps.frames()) + " indexed frames, the last checkpoint " +
+                                            std::to_string(frames) + "; cannot resume it");
+        for (const auto& piece : ps.pieces) {
+          if (piece.frames == 0 || piece.first_frame >= frames || piece.first_frame + piece.frames <= frames) continue;
+          video::MovieReader reader(ps.file_pieces(), ps.pieces.front().file.string());
+          std::vector<std::uint8_t> bytes;
+          for (int f = piece.first_frame; f < frames; ++f) {
+            reader.read_packet(f, bytes);
+            s.pending.insert(s.pending.end(), bytes.begin(), bytes.end());
+            s.pending_sizes.push_back(std::uint32_t(bytes.size()));
+          }
+          s.flushed = piece.first_frame;
+        }
+      });
+      m.open_pack(m.manifest.packs.back().segment, frames);
+    } else {
+      parallel_for(std::int64_t(m.streams.size()), m.streams.size() > 16 ? 0 : 1, [&](std::int64_t i) {
+        const int slot = int(i / tasks);
+        resume_stream(m, owned[std::size_t(slot)], int(i % tasks), frames, m.streams[std::size_t(i)]);
+      });
+    }
     if (options.writes_manifest) {
       m.table = write_camera_table(dir, m.manifest);
       m.write_manifest(Status::running, frames);
@@ -619,6 +821,7 @@ Database Database::open(const fs::path& dir) {
   db.manifest_ = read_manifest(dir / kManifestFileName);
   db.stored_status_ = db.manifest_.status;
   if (db.manifest_.status == Status::running && !writer_is_alive(dir)) db.manifest_.status = Status::interrupted;
+  if (db.packed()) db.packs_ = std::make_shared<PackCatalog>();
   return db;
 }
 
@@ -675,7 +878,89 @@ fs::path resolve_stream(const fs::path& dir, const fs::path& path, int camera, i
 
 }  // namespace
 
+// --- packed reading ---
+
+// The index headers of a packed database's segments, read once on first use (Database::packs_).
+struct PackCatalog {
+  std::once_flag once;
+  std::exception_ptr failure;
+  struct Segment {
+    std::vector<PackIndexInfo> packs;   // the ranks' indexes that exist
+    std::vector<FileHandle> index_fds;  // open, one per pack
+    std::vector<std::int32_t> owner;    // camera -> position in packs, -1 if none holds it
+  };
+  std::vector<Segment> segments;
+
+  void load(const fs::path& dir, const Manifest& m) {
+    std::error_code ec;
+    const fs::path packs_dir = dir / kPackDirectory;
+    FileHandle root = open_directory(dir);
+    FileHandle pd;
+    try {
+      pd = open_subdirectory(root.get(), kPackDirectory, false, dir);
+    } catch (const FileError&) {
+      // No packs directory: a database killed before its first pack was made holds no stream.
+    }
+    for (const PackSegment& seg : m.packs) {
+      Segment s;
+      s.owner.assign(std::size_t(m.camera_count()), -1);
+      for (int r = 0; pd && r < seg.ranks; ++r) {
+        struct stat st{};
+        if (::fstatat(pd.get(), pack_index_name(seg.segment, r).c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) continue;
+        PackIndexInfo info = read_pack_index(pd.get(), packs_dir, seg.segment, r, m.task_count(), m.camera_count());
+        for (int c : info.cameras) {
+          if (s.owner[std::size_t(c)] >= 0)
+            throw FileError(info.index.string(), "camera " + std::to_string(c) + " is also in " +
+                                                     s.packs[std::size_t(s.owner[std::size_t(c)])].index.string() +
+                                                     " (each camera belongs to one pack of a segment)");
+          s.owner[std::size_t(c)] = std::int32_t(s.packs.size());
+        }
+        s.index_fds.push_back(open_regular_file(pd.get(), pack_index_name(seg.segment, r), std::uint64_t(1) << 40,
+                                                "pack index", packs_dir));
+        s.packs.push_back(std::move(info));
+      }
+      segments.push_back(std::move(s));
+    }
+    // Fragments of one stream come from several segments' packs behind one init segment: their
+    // timing must agree.
+    const PackIndexInfo* first = nullptr;
+    for (const Segment& s : segments)
+      for (const PackIndexInfo& p : s.packs) {
+        if (!first) first = &p;
+        if (p.timescale != first->timescale || p.frame_ticks != first->frame_ticks)
+          throw FileError(p.index.string(), "time scale " + std::to_string(p.timescale) + "/" + std::to_string(p.frame_ticks) +
+                                                " differs from " + first->index.string() + "'s " +
+                                                std::to_string(first->timescale) + "/" + std::to_string(first->frame_ticks));
+      }
+  }
+};
+
+PackedStream Database::packed_stream(int camera, int task) const {
+  if (!packed() || !packs_) throw Error(dir_.string() + ": not a packed database (its movies are files)");
+  if (camera < 0 || camera >= camera_count() || task < 0 || task >= task_count())
+    throw Error(dir_.string() + ": stream camera " + std::to_string(camera) + ", task " + std::to_string(task) +
+                " out of range");
+  PackCatalog& cat = *packs_;
+  std::call_once(cat.once, [&] {
+    try {
+      cat.load(dir_, manifest_);
+    } catch (...) {
+      cat.failure = std::current_exception();
+    }
+  });
+  if (cat.failure) std::rethrow_exception(cat.failure);
+  std::vector<std::pair<const PackIndexInfo*, std::vector<PackRecord>>> per_segment;
+  for (const PackCatalog::Segment& s : cat.segments) {
+    const std::int32_t k = s.owner[std::size_t(camera)];
+    if (k < 0) continue;
+    per_segment.emplace_back(&s.packs[std::size_t(k)],
+                             read_stream_records(s.index_fds[std::size_t(k)].get(), s.packs[std::size_t(k)], camera, task));
+  }
+  return assemble_stream(per_segment, camera, task);
+}
+
 std::unique_ptr<video::MovieReader> Database::stream(int camera, int task) const {
+  if (packed()) return packed_reader(camera, task);
   const fs::path path = stream_path(camera, task);
   const fs::path resolved = resolve_stream(dir_, path, camera, task);
   const std::string which = " (stream camera " + std::to_string(camera) + ", task " + std::to_string(task) + ")";
@@ -692,6 +977,38 @@ std::unique_ptr<video::MovieReader> Database::stream(int camera, int task) const
     throw StreamFileError(path,
                     "truncated movie" + which + ": holds " + std::to_string(reader->frame_count()) + " of the " +
                         std::to_string(manifest_.frames_written) + " frames the manifest records",
+                          StreamProblem::Kind::truncated);
+  return reader;
+}
+
+std::unique_ptr<video::MovieReader> Database::packed_reader(int camera, int task) const {
+  const std::string which = "stream camera " + std::to_string(camera) + ", task " + std::to_string(task);
+  PackedStream ps;
+  try {
+    ps = packed_stream(camera, task);
+  } catch (const FileError& e) {
+    throw StreamFileError(dir_ / kPackDirectory, std::string("damaged pack index (") + which + "): " + e.what(),
+                          StreamProblem::Kind::unreadable);
+  }
+  const fs::path where = ps.pieces.empty() ? dir_ / kPackDirectory : ps.pieces.front().file;
+  if (ps.pieces.size() < 2 && manifest_.frames_written > 0)
+    throw StreamFileError(where, "movie missing (" + which + ": no pack indexes a fragment of it)",
+                          StreamProblem::Kind::missing);
+  if (ps.pieces.empty()) throw StreamFileError(where, "movie missing (" + which + ")", StreamProblem::Kind::missing);
+  const std::string name = where.string() + "#c" + std::to_string(camera) + "t" + std::to_string(task);
+  std::unique_ptr<video::MovieReader> reader;
+  try {
+    reader = std::make_unique<video::MovieReader>(ps.file_pieces(), name, frame_checks(camera, task));
+  } catch (const Error& e) {
+    throw StreamFileError(name, std::string("not a readable movie (") + which + "): " + without_path(e, name),
+                          StreamProblem::Kind::unreadable);
+  }
+  if (reader->width() != manifest_.image.width || reader->height() != manifest_.image.height)
+    reader->set_crop(manifest_.image.width, manifest_.image.height);
+  if (reader->frame_count() < manifest_.frames_written)
+    throw StreamFileError(name,
+                          "truncated movie (" + which + "): holds " + std::to_string(reader->frame_count()) + " of the " +
+                              std::to_string(manifest_.frames_written) + " frames the manifest records",
                           StreamProblem::Kind::truncated);
   return reader;
 }
@@ -746,10 +1063,32 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
     StreamProblem problem{camera, task, StreamProblem::Kind::missing, {}};
     std::int64_t file_bytes = -1;
     try {
-      const fs::path resolved = resolve_stream(dir_, stream_path(camera, task), camera, task);
-      std::error_code ec;
-      const auto size = fs::file_size(resolved, ec);
-      if (!ec) bytes += file_bytes = std::int64_t(size);
+      if (packed()) {
+        // The index alone tells whether every checkpointed frame is there (no movie is opened):
+        // checking 10^6 streams reads their records, not 10^6 movies. A deep check decodes.
+        const PackedStream ps = packed_stream(camera, task);
+        std::int64_t n = 0;
+        for (std::size_t k = 1; k < ps.pieces.size(); ++k) n += std::int64_t(ps.pieces[k].size);
+        bytes += file_bytes = n;
+        auto which = [&] { return "stream camera " + std::to_string(camera) + ", task " + std::to_string(task); };
+        if (ps.pieces.size() < 2 && frame_count() > 0)
+          throw StreamFileError(dir_ / kPackDirectory, "movie missing (" + which() + ": no pack indexes a fragment of it)",
+                                StreamProblem::Kind::missing);
+        if (ps.frames() < frame_count())
+          throw StreamFileError(ps.pieces.front().file, "truncated movie (" + which() + "): its index names " +
+                                                            std::to_string(ps.frames()) + " of the " +
+                                                            std::to_string(frame_count()) + " frames the manifest records",
+                                StreamProblem::Kind::truncated);
+        if (!decode_all) {
+          ++done;
+          return;
+        }
+      } else {
+        const fs::path resolved = resolve_stream(dir_, stream_path(camera, task), camera, task);
+        std::error_code ec;
+        const auto size = fs::file_size(resolved, ec);
+        if (!ec) bytes += file_bytes = std::int64_t(size);
+      }
       auto reader = stream(camera, task);
       problem.message.clear();
       if (decode_all) {
@@ -769,7 +1108,8 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
             list += (k ? ", " : "") + std::to_string(problem.damaged_frames[k]);
           if (problem.damaged_frames.size() > 20) list += ", ...";
           problem.kind = StreamProblem::Kind::damaged;
-          problem.message = stream_path(camera, task).string() + ": " + std::to_string(problem.damaged_frames.size()) +
+          problem.message = (packed() ? reader->path() : stream_path(camera, task).string()) + ": " +
+                            std::to_string(problem.damaged_frames.size()) +
                             " of " + std::to_string(frame_count()) + " frames damaged (" + list + "); first: " +
                             first_error;
         }

@@ -1,6 +1,7 @@
 #pragma once
 // The movie database: a directory holding panoptes.json (the manifest) and one movie per
-// (camera, task) found by the manifest's file-name pattern.
+// (camera, task): a file found by the manifest's file-name pattern, or (packed layout, pack.hpp) byte
+// ranges of a pack file that a binary index lists.
 //
 // Writing: DatabaseWriter::create → append(camera, task, frame) ... → checkpoint() after each snapshot
 // → finalize(). Reading: Database::open (manifest only, no movie opened, no directory scan) →
@@ -21,12 +22,26 @@
 
 #include "core/image.hpp"
 #include "store/manifest.hpp"
+#include "store/pack.hpp"
 #include "video/movie_reader.hpp"
 
 namespace panoptes::store {
 
 /// Name of the liveness lock file inside the database directory.
 inline constexpr const char* kLockFileName = ".panoptes.lock";
+
+/// Which layout a new database gets (WriterOptions::layout, `[output] layout`).
+enum class LayoutChoice {
+  /// Packed when the database has at least kPackedAutoStreams streams and gop 1 (the packed writer
+  /// encodes intra-only movies), else files: small databases stay one playable file per stream.
+  automatic,
+  files,
+  packed,
+};
+/// Stream count from which LayoutChoice::automatic packs (docs/formats.md, Packed layout).
+inline constexpr std::int64_t kPackedAutoStreams = 1024;
+/// Parses "auto" / "files" / "packed"; throws Error naming the value otherwise.
+LayoutChoice parse_layout_choice(std::string_view text);
 
 /// Options of DatabaseWriter::create.
 struct WriterOptions {
@@ -42,6 +57,13 @@ struct WriterOptions {
   /// How the refusal of an existing database says to replace it: the caller's own option (a
   /// command's "--overwrite"); empty = this struct's field, for C++ callers (issue 44).
   std::string overwrite_option;
+  /// The layout of a new database (resume keeps the database's own; non-root writers follow the
+  /// manifest the root wrote).
+  LayoutChoice layout = LayoutChoice::automatic;
+  /// Packed layout: this writer's rank (names its pack) and the number of ranks that write (the root
+  /// records it in the manifest; a rank that owns no camera may create no writer).
+  int rank = 0;
+  int ranks = 1;
 };
 
 /// Writes a database. Not thread-safe except append(): appends to *different* streams may run
@@ -53,7 +75,9 @@ struct WriterOptions {
 /// bench/video_bench (docs/formats.md, Movies): about 1 MB with gop 1 (the default: no encoder is
 /// kept between frames), about 25 MB with gop > 1 (a live x264 encoder with reference frames). So
 /// 10^4 streams of one rank need ~10 GB at gop 1: spread cameras over ranks (MPI), or write offline
-/// stream by stream with close_stream(). The writer's own bookkeeping is 16 bytes per stream.
+/// stream by stream with close_stream(). In the packed layout (WriterOptions::layout) no stream keeps
+/// an encoder or muxer: one encoder pool serves all, and a stream holds a 96-byte record plus its
+/// compressed frames until the next flush (docs/formats.md, Packed layout).
 class DatabaseWriter {
  public:
   /// Creates the directory (and parents) and writes the manifest with status `running`,
@@ -147,6 +171,8 @@ struct StreamReport {
   std::vector<StreamProblem> problems;
 };
 
+struct PackCatalog;
+
 /// An opened database (reader side). Cheap to copy; const methods are thread-safe (stream() returns
 /// an independent reader each call).
 class Database {
@@ -177,6 +203,14 @@ class Database {
   /// truncated to nothing or not a movie.
   std::unique_ptr<video::MovieReader> stream(int camera, int task) const;
 
+  /// True for a packed database (Manifest::layout).
+  bool packed() const { return manifest_.layout == Layout::packed; }
+  /// A stream of a packed database as byte ranges of its packs (init segment, then its fragments with
+  /// their frame numbers), for servers and exporters that hand out bytes without decoding: the
+  /// concatenation of the pieces is a standard fragmented MP4. Covers every indexed fragment (may be
+  /// more than frame_count()). Throws Error for a files database, FileError for a damaged index.
+  PackedStream packed_stream(int camera, int task) const;
+
   /// What readers of the stream's movie demand of every frame: with frame checks recorded in the
   /// manifest (databases written since they are), a good checksum, this stream's identity, the
   /// frame's index and timestamp; without (older databases), checksums when the movie carries them.
@@ -198,6 +232,8 @@ class Database {
   std::filesystem::path dir_;
   Manifest manifest_;
   Status stored_status_ = Status::running;
+  std::unique_ptr<video::MovieReader> packed_reader(int camera, int task) const;
+  std::shared_ptr<PackCatalog> packs_;  // packed layout: the index headers, read on first use
 };
 
 /// The identity stamped on every frame of stream (camera, task): the manifest's database id (8 bytes),

@@ -387,6 +387,63 @@ TEST(Database, FullDiskSurfacesTheErrorAndKeepsTheManifestValid) {
   EXPECT_EQ(leftovers, 0);
 }
 
+// The same in the packed layout (issue 46): the pack write fails, the index never names the lost
+// bytes, the manifest keeps the last checkpoint, and every checkpointed frame plays.
+TEST(Database, FullDiskInThePackedLayoutKeepsTheCheckpoint) {
+  TempDir dir;
+  Manifest m = sample_manifest(2, 1, 256, 256);
+  m.video.crf = 0;
+  m.video.gop = 1;
+  const fs::path message_file = dir / "child-message.txt";
+  const fs::path db_dir = dir / "db";
+  const int code = in_child([&] {
+    WriterOptions o;
+    o.layout = LayoutChoice::packed;
+    DatabaseWriter w = DatabaseWriter::create(db_dir, m, o);
+    ::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit{600 * 1024, 600 * 1024};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    std::mt19937 rng(3);
+    Image frame(256, 256, 4);
+    try {
+      for (int f = 0; f < 200; ++f) {
+        for (int c = 0; c < 2; ++c) {
+          for (auto& p : frame.pixels) p = std::uint8_t(rng());
+          draw_frame_stamp(frame, {std::uint32_t(c), 0, std::uint32_t(f)});
+          w.append(c, 0, frame);
+        }
+        w.checkpoint();
+      }
+    } catch (const FileError& e) {
+      std::ofstream(message_file) << e.what();
+      try {
+        w.checkpoint();  // refused: the pack would have a gap
+        return 4;
+      } catch (const FileError&) {
+      }
+      return 0;
+    }
+    return 2;
+  });
+  ASSERT_EQ(code, 0) << "child did not see a write error, or wrote after it";
+  std::ifstream in(message_file);
+  const std::string message((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_CONTAINS(message, "packs/s0-r0.pack");
+  EXPECT_CONTAINS(message, "File too large");
+  const Database db = Database::open(db_dir);
+  EXPECT_EQ(db.status(), Status::interrupted);
+  ASSERT_GT(db.frame_count(), 0);
+  for (int c = 0; c < 2; ++c) {
+    auto reader = db.stream(c, 0);
+    for (int f = 0; f < db.frame_count(); ++f) {
+      const auto stamp = read_frame_stamp(reader->read_rgba(f));
+      ASSERT_TRUE(stamp.has_value());
+      EXPECT_EQ(*stamp, (FrameStamp{std::uint32_t(c), 0, std::uint32_t(f)}));
+    }
+  }
+  EXPECT_TRUE(db.validate_streams(1, true).problems.empty());
+}
+
 TEST(Database, KilledWriterLeavesAnInterruptedDatabaseWithItsCheckpointedFrames) {
   TempDir dir;
   const Manifest m = sample_manifest(3, 2);

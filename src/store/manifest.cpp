@@ -26,6 +26,8 @@ namespace panoptes::store {
 
 using nlohmann::json;
 
+std::string_view to_string(Layout layout) { return layout == Layout::packed ? "packed" : "files"; }
+
 std::string_view to_string(Status status) {
   switch (status) {
     case Status::running: return "running";
@@ -248,6 +250,7 @@ json manifest_json(const Manifest& m, const CameraTableRef* table) {
   write_domain(j, m);
   write_playback(j, m);
   write_frame_checks(j, m);
+  write_layout(j, m);
   write_times(j, m);
   write_fields(j, m);
   write_image(j, m);
@@ -273,6 +276,7 @@ Manifest manifest_from_json(const json& j, const std::string& source, const std:
   read_domain(r, j, m);
   read_playback(r, j, m);
   read_frame_checks(r, j, m);
+  read_layout(r, j, m);
   read_times(r, j, m);
   read_fields(r, j, m);
   read_image(r, j, m);

@@ -192,6 +192,20 @@ inline constexpr const char* kFrameCheckScheme = "panoptes-frame-3";
 inline constexpr const char* kFrameCheckSchemeUnboundHeader = "panoptes-frame-2";
 inline bool FrameCheckRecord::binds_parameter_sets() const { return scheme == kFrameCheckScheme; }
 
+/// Where a database keeps its movies (field `layout`): one file per stream named by `movie_pattern`,
+/// or packs (store/pack.hpp: per writing rank and output segment one pack file and one index).
+enum class Layout { files, packed };
+std::string_view to_string(Layout layout);
+
+/// One output segment of a packed database (a run, or a resumed continuation of it): its packs are
+/// packs/s<segment>-r<rank>.pack/.idx for rank 0 .. ranks-1 (a rank that owned no camera has none).
+struct PackSegment {
+  int segment = 0;
+  int first_frame = 0;  ///< frames before it come from earlier segments
+  int ranks = 1;
+  bool operator==(const PackSegment&) const = default;
+};
+
 /// Lifecycle of a database. `running` on disk with no live writer is reported as interrupted by
 /// Database::open (see database.hpp).
 enum class Status { running, complete, interrupted };
@@ -226,6 +240,9 @@ struct Manifest {
   std::vector<FieldInfo> fields;
   /// How its movies prove their frames (empty in older databases; DatabaseWriter::create fills it in).
   FrameCheckRecord frame_checks;
+  /// Movies in files (the pattern) or in packs; packs lists the segments of a packed database.
+  Layout layout = Layout::files;
+  std::vector<PackSegment> packs;
 
   int camera_count() const { return int(cameras.size()); }
   int task_count() const { return int(tasks.size()); }

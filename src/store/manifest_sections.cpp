@@ -139,6 +139,51 @@ void read_frame_checks(const Reader& r, const json& j, Manifest& m) {
   }
 }
 
+// --- layout ---
+
+void write_layout(json& j, const Manifest& m) {
+  if (m.layout != Layout::packed) return;  // absent = files, as every database before it
+  j["layout"] = "packed";
+  json segs = json::array();
+  for (const PackSegment& s : m.packs)
+    segs.push_back({{"segment", s.segment}, {"first_frame", s.first_frame}, {"ranks", s.ranks}});
+  j["packs"] = segs;
+}
+
+void read_layout(const Reader& r, const json& j, Manifest& m) {
+  const std::string layout = r.opt_str(j, "layout", "");
+  if (layout.empty() || layout == "files") {
+    m.layout = Layout::files;
+  } else if (layout == "packed") {
+    m.layout = Layout::packed;
+  } else {
+    r.fail("layout", "\"" + layout.substr(0, 64) + "\" is not a layout this build reads (files, packed)");
+  }
+  if (const json* p = r.optional(j, "packs", "")) {
+    if (!p->is_array()) r.fail("packs", "expected an array of segments");
+    if (p->size() > 100000) r.fail("packs", "lists " + std::to_string(p->size()) + " segments (at most 100000)");
+    for (std::size_t i = 0; i < p->size(); ++i) {
+      const std::string path = "packs[" + std::to_string(i) + "]";
+      const json& e = (*p)[i];
+      if (!e.is_object()) r.fail(path, "expected an object");
+      PackSegment s;
+      const std::int64_t seg = r.integer(r.field(e, "segment", path), path + ".segment");
+      const std::int64_t first = r.integer(r.field(e, "first_frame", path), path + ".first_frame");
+      const std::int64_t ranks = r.integer(r.field(e, "ranks", path), path + ".ranks");
+      if (seg < 0 || seg > 100000 || (!m.packs.empty() && seg <= m.packs.back().segment))
+        r.fail(path + ".segment", std::to_string(seg) + "; expected ascending segment numbers in 0..100000");
+      if (first < 0 || first > INT32_MAX || (!m.packs.empty() && first < m.packs.back().first_frame))
+        r.fail(path + ".first_frame", std::to_string(first) + "; expected non-decreasing frame numbers >= 0");
+      if (ranks < 1 || ranks > 1000000) r.fail(path + ".ranks", std::to_string(ranks) + "; expected 1..1000000");
+      s.segment = int(seg);
+      s.first_frame = int(first);
+      s.ranks = int(ranks);
+      m.packs.push_back(s);
+    }
+  }
+  if (m.layout == Layout::packed && m.packs.empty()) r.fail("packs", "a packed database must list its segments");
+}
+
 // --- times ---
 
 void write_times(json& j, const Manifest& m) {

@@ -88,6 +88,8 @@ void read_playback(const Reader& r, const json& j, Manifest& m);
 // frame_checks
 void write_frame_checks(json& j, const Manifest& m);
 void read_frame_checks(const Reader& r, const json& j, Manifest& m);
+void write_layout(json& j, const Manifest& m);
+void read_layout(const Reader& r, const json& j, Manifest& m);
 // times, time_units
 void write_times(json& j, const Manifest& m);
 void read_times(const Reader& r, const json& j, Manifest& m);

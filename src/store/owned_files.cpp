@@ -1,4 +1,5 @@
 #include "store/owned_files.hpp"
+#include "store/pack.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -48,6 +49,21 @@ OldDatabaseFiles describe_old_database(int dirfd, const fs::path& display) {
       old.movie_pattern = p->get<std::string>();
     } catch (const Error&) {
       // An unsafe pattern lists no movie.
+    }
+  }
+  // A packed database's packs: packs/s<segment>-r<rank>.pack and .idx of every segment it lists (at
+  // most 10^6 names in all: a hostile manifest cannot make the overwrite walk more).
+  if (const auto p = j.find("packs"); p != j.end() && p->is_array()) {
+    for (const auto& seg : *p) {
+      if (!seg.is_object()) continue;
+      const auto s = seg.find("segment"), r = seg.find("ranks");
+      if (s == seg.end() || r == seg.end() || !s->is_number_integer() || !r->is_number_integer()) continue;
+      const std::int64_t segment = s->get<std::int64_t>(), ranks = r->get<std::int64_t>();
+      if (segment < 0 || segment > 100000 || ranks < 1) continue;
+      for (std::int64_t k = 0; k < ranks && old.packs.size() < 1000000; ++k) {
+        old.packs.push_back(std::string(kPackDirectory) + "/" + pack_file_name(int(segment), int(k)));
+        old.packs.push_back(std::string(kPackDirectory) + "/" + pack_index_name(int(segment), int(k)));
+      }
     }
   }
   return old;

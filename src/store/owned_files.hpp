@@ -17,6 +17,7 @@ struct OldDatabaseFiles {
   std::string movie_pattern;  ///< empty: unreadable manifest
   std::int64_t cameras = -1, tasks = -1;
   std::string camera_table;  ///< the camera table file it references, or empty
+  std::vector<std::string> packs;  ///< a packed database's pack and index files (relative paths)
 };
 
 /// Reads what the manifest `kManifestFileName` in `dirfd` lists (safe bounded read; never throws:

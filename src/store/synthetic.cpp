@@ -190,6 +190,7 @@ void write_synthetic_database(const std::filesystem::path& dir, const SyntheticO
   WriterOptions w;
   w.overwrite = o.overwrite;
   w.overwrite_option = o.overwrite_option;
+  w.layout = parse_layout_choice(o.layout);
   DatabaseWriter writer = DatabaseWriter::create(dir, m, w);
   const std::int64_t total = m.stream_count();
   std::atomic<std::int64_t> done{0};

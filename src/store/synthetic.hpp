@@ -22,6 +22,8 @@ struct SyntheticOptions {
   int width = 64, height = 64;
   video::VideoSettings video;   ///< encoder settings of every stream
   bool overwrite = false;
+  /// WriterOptions::layout as text: "auto", "files" or "packed" (packed needs video.gop 1).
+  std::string layout = "auto";
   std::string overwrite_option;  ///< named by the refusal of an existing database (WriterOptions)
   int threads = 0;              ///< streams encoded in parallel (0 = hardware concurrency)
   std::string title = "synthetic database";

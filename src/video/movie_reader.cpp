@@ -59,7 +59,15 @@ constexpr int kMaxMovieStreams = 16;
 // --- state ---
 struct MovieReader::Impl {
   std::string path;
-  int fd = -1;
+  // The movie's bytes: one whole file, or (a packed database) byte ranges of files read as their
+  // concatenation. pieces[i] covers the movie's bytes [start, start + size).
+  struct Piece {
+    int fd = -1;
+    std::int64_t offset = 0, size = 0, start = 0;
+  };
+  std::vector<Piece> pieces;
+  std::vector<int> fds;  // owned, one per distinct file
+  std::vector<FilePiece> sources;  // empty: the whole file at `path`
   std::int64_t file_size = 0;
 
   // The index, built once at open: packets in decode order; frames in presentation (pts) order.
@@ -103,7 +111,26 @@ struct MovieReader::Impl {
     av_packet_free(&pkt);
     av_buffer_unref(&storage);
     sws_freeContext(sws_yuv);
-    if (fd >= 0) ::close(fd);
+    for (int f : fds) ::close(f);
+  }
+
+  // pread over the movie's bytes (the concatenation of the pieces); one call may span pieces.
+  ssize_t pread_movie(std::uint8_t* buf, std::size_t n, std::int64_t pos) const {
+    std::size_t done = 0;
+    while (done < n) {
+      const std::int64_t at = pos + std::int64_t(done);
+      if (at >= file_size) break;
+      auto it = std::upper_bound(pieces.begin(), pieces.end(), at, [](std::int64_t v, const Piece& p) { return v < p.start; });
+      const Piece& p = *(it - 1);
+      const std::int64_t in = at - p.start;
+      const std::size_t want = std::size_t(std::min<std::int64_t>(std::int64_t(n - done), p.size - in));
+      const ssize_t got = ::pread(p.fd, buf + done, want, p.offset + in);
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0) return done ? ssize_t(done) : -1;
+      if (got == 0) break;
+      done += std::size_t(got);
+    }
+    return ssize_t(done);
   }
 
   int frame_of_pts(std::int64_t pts) const {
@@ -124,7 +151,7 @@ struct MovieReader::Impl {
     std::uint8_t h[16];
     while (pos < file_size) {
       if (file_size - pos < 8) return pos;
-      if (::pread(fd, h, 16, pos) < 8) return pos;
+      if (pread_movie(h, 16, pos) < 8) return pos;
       std::uint64_t size = (std::uint64_t(h[0]) << 24) | (std::uint64_t(h[1]) << 16) | (std::uint64_t(h[2]) << 8) | h[3];
       for (int i = 4; i < 8; ++i)
         if (h[i] < 0x20 || h[i] > 0x7e) return pos == 0 ? file_size : pos;  // not an MP4 box: not MP4
@@ -150,7 +177,7 @@ struct MovieReader::Impl {
     const std::int64_t left = m->view_size - m->view_pos;
     if (left <= 0) return AVERROR_EOF;
     for (;;) {
-      const ssize_t got = ::pread(m->fd, buf, std::size_t(std::min<std::int64_t>(n, left)), m->view_pos);
+      const ssize_t got = m->pread_movie(buf, std::size_t(std::min<std::int64_t>(n, left)), m->view_pos);
       if (got < 0 && errno == EINTR) continue;
       if (got < 0) return AVERROR(errno);
       if (got == 0) return AVERROR_EOF;
@@ -171,20 +198,55 @@ struct MovieReader::Impl {
     return m->view_pos;
   }
 
+  // Opens one file of the movie; returns its descriptor and size.
+  std::pair<int, std::int64_t> open_file(const std::string& file) {
+    // O_NONBLOCK: a FIFO in place of a movie must not block the open (it is refused just below).
+    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0) throw FileError(file, "cannot open the movie: " + errno_string(errno));
+    fds.push_back(fd);
+    struct stat sb {};
+    if (::fstat(fd, &sb) != 0) throw FileError(file, "cannot open the movie: " + errno_string(errno));
+    if (S_ISDIR(sb.st_mode)) throw FileError(file, "is a directory, not a movie");
+    if (!S_ISREG(sb.st_mode)) throw FileError(file, "is not a regular file (a FIFO, device or socket); refused");
+    return {fd, std::int64_t(sb.st_size)};
+  }
+
+  void open_pieces() {
+    if (sources.empty()) {
+      const auto [fd, size] = open_file(path);
+      pieces.push_back({fd, 0, size, 0});
+      file_size = size;
+      return;
+    }
+    std::vector<std::pair<std::string, std::pair<int, std::int64_t>>> opened;
+    for (const FilePiece& s : sources) {
+      auto it = std::find_if(opened.begin(), opened.end(), [&](const auto& o) { return o.first == s.path; });
+      if (it == opened.end()) {
+        opened.emplace_back(s.path, open_file(s.path));
+        it = opened.end() - 1;
+      }
+      const std::int64_t size = it->second.second;
+      if (s.size == 0) continue;
+      if (s.offset > std::uint64_t(size) || s.size > std::uint64_t(size) - s.offset)
+        throw FileError(s.path, "movie " + path + ": byte range " + std::to_string(s.offset) + "+" +
+                                    std::to_string(s.size) + " lies past the end of the file (" + std::to_string(size) +
+                                    " bytes)");
+      pieces.push_back({it->second.first, std::int64_t(s.offset), std::int64_t(s.size), file_size});
+      file_size += std::int64_t(s.size);
+    }
+  }
+
   // --- index ---
   void build_index() {
     // O_NONBLOCK: a FIFO in place of a movie must not block the open (it is refused just below).
-    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
-    if (fd < 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
-    struct stat sb {};
-    if (::fstat(fd, &sb) != 0) throw FileError(path, "cannot open the movie: " + errno_string(errno));
-    if (S_ISDIR(sb.st_mode)) throw FileError(path, "is a directory, not a movie");
-    if (!S_ISREG(sb.st_mode)) throw FileError(path, "is not a regular file (a FIFO, device or socket); refused");
-    file_size = sb.st_size;
+    open_pieces();
     if (file_size == 0) throw FileError(path, "not a readable movie (the file is empty)");
     view_size = readable_prefix();
     // Before FFmpeg sees the file: its sample tables must fit in it (see mp4_table_check.hpp).
-    check_mp4_sample_tables(fd, view_size, path);
+    const ReadAt read = [this](std::uint8_t* buf, std::size_t n, std::int64_t pos) {
+      return std::int64_t(pread_movie(buf, n, pos));
+    };
+    check_mp4_sample_tables(read, view_size, path);
 
     constexpr int kIoBuffer = 1 << 15;
     auto* io_buf = static_cast<std::uint8_t*>(av_malloc(kIoBuffer));
@@ -347,7 +409,7 @@ struct MovieReader::Impl {
       std::vector<std::uint8_t> bytes;
       for (std::size_t k = 0; k < packets.size() && k < 3 && !checksummed; ++k) {
         bytes.resize(std::size_t(packets[k].size));
-        if (::pread(fd, bytes.data(), bytes.size(), packets[k].pos) == ssize_t(bytes.size()))
+        if (pread_movie(bytes.data(), bytes.size(), packets[k].pos) == ssize_t(bytes.size()))
           checksummed = inspect_packet(bytes.data(), packets[k].size, nal_length_size).has_sei;
       }
     }
@@ -398,7 +460,7 @@ struct MovieReader::Impl {
     }
     std::int64_t done = 0;
     while (done < pi.size) {
-      const ssize_t n = ::pread(fd, storage->data + done, std::size_t(pi.size - done), pi.pos + done);
+      const ssize_t n = pread_movie(storage->data + done, std::size_t(pi.size - done), pi.pos + done);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) throw FileError(path, "cannot read frame data at byte " + std::to_string(pi.pos + done) + ": " +
                                             (n < 0 ? errno_string(errno) : "file shrank"));
@@ -535,6 +597,16 @@ MovieReader::MovieReader(const std::string& path, const FrameChecks& checks) : i
   impl_->build_index();
 }
 
+MovieReader::MovieReader(const std::vector<FilePiece>& pieces, const std::string& name, const FrameChecks& checks)
+    : impl_(std::make_unique<Impl>()) {
+  quiet_ffmpeg_logs();
+  if (pieces.empty()) throw FileError(name, "not a readable movie (no byte ranges)");
+  impl_->path = name;
+  impl_->sources = pieces;
+  impl_->checks = checks;
+  impl_->build_index();
+}
+
 MovieReader::~MovieReader() = default;
 
 void MovieReader::set_crop(int width, int height) {
@@ -572,7 +644,7 @@ std::vector<int> MovieReader::check_frames() {
     bytes.resize(std::size_t(pi.size));
     std::int64_t done = 0;
     while (done < pi.size) {
-      const ssize_t n = ::pread(m.fd, bytes.data() + done, std::size_t(pi.size - done), pi.pos + done);
+      const ssize_t n = m.pread_movie(bytes.data() + done, std::size_t(pi.size - done), pi.pos + done);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) throw FileError(m.path, "cannot read frame data at byte " + std::to_string(pi.pos + done));
       done += n;
@@ -604,7 +676,7 @@ void MovieReader::read_packet(int index, std::vector<std::uint8_t>& out) const {
   out.resize(std::size_t(pi.size));
   std::int64_t done = 0;
   while (done < pi.size) {
-    const ssize_t n = ::pread(m.fd, out.data() + done, std::size_t(pi.size - done), pi.pos + done);
+    const ssize_t n = m.pread_movie(out.data() + done, std::size_t(pi.size - done), pi.pos + done);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) throw FileError(m.path, "cannot read frame data at byte " + std::to_string(pi.pos + done) + ": " +
                                             (n < 0 ? errno_string(errno) : "file shrank"));

@@ -42,12 +42,23 @@ struct FrameChecks {
   bool parameter_sets = false;
 };
 
+/// One byte range of a file: a piece of a movie stored inside a larger file (a packed database).
+struct FilePiece {
+  std::string path;
+  std::uint64_t offset = 0, size = 0;
+};
+
 /// An open movie. Not thread-safe: use one reader per thread.
 class MovieReader {
  public:
   /// Opens the file and indexes its packets (no decoding). Throws FileError if the file is missing,
   /// not a movie, or holds no decodable video stream. A truncated movie opens with the frames it has.
   explicit MovieReader(const std::string& path, const FrameChecks& checks = {});
+  /// Opens the movie that is the concatenation of `pieces` (a fragmented MP4 cut into byte ranges:
+  /// init segment first, then its fragments in order), read through a virtual file over them; `name`
+  /// names it in messages (path()). Throws FileError as above, and when a range lies past the end of
+  /// its file. Everything else (index, checks, truncation) works as for a whole file.
+  MovieReader(const std::vector<FilePiece>& pieces, const std::string& name, const FrameChecks& checks = {});
   ~MovieReader();
   MovieReader(const MovieReader&) = delete;
   MovieReader& operator=(const MovieReader&) = delete;

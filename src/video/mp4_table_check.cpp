@@ -17,7 +17,7 @@ std::uint64_t be(const std::uint8_t* p, int n) {
 }
 
 struct Walker {
-  int fd;
+  const ReadAt& pread;
   std::int64_t size;
   const std::string& path;
   std::uint64_t samples = 0;  // declared by every trun / stsz / stz2 so far
@@ -25,7 +25,7 @@ struct Walker {
   bool read(std::int64_t pos, std::uint8_t* buf, int n) const {
     if (pos < 0 || pos + n > size) return false;
     for (int done = 0; done < n;) {
-      const ssize_t got = ::pread(fd, buf + done, std::size_t(n - done), pos + done);
+      const std::int64_t got = pread(buf + done, std::size_t(n - done), pos + done);
       if (got <= 0) return false;
       done += int(got);
     }
@@ -151,7 +151,14 @@ struct Walker {
 }  // namespace
 
 void check_mp4_sample_tables(int fd, std::int64_t size, const std::string& path) {
-  Walker w{fd, size, path};
+  const ReadAt read = [fd](std::uint8_t* buf, std::size_t n, std::int64_t pos) {
+    return std::int64_t(::pread(fd, buf, n, pos));
+  };
+  check_mp4_sample_tables(read, size, path);
+}
+
+void check_mp4_sample_tables(const ReadAt& read, std::int64_t size, const std::string& path) {
+  Walker w{read, size, path};
   w.walk(0, size, 0);
 }
 

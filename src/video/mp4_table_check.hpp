@@ -1,6 +1,7 @@
 #pragma once
 // Bounds what an MP4's sample tables may make FFmpeg allocate, checked before FFmpeg parses them.
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace panoptes::video {
@@ -13,5 +14,10 @@ namespace panoptes::video {
 /// stsc, stco, co64, elst, trun, stsz, sbgp, tfra) must fit in its box, even when the box itself is cut
 /// short by its parent. Files that are not MP4 pass through.
 void check_mp4_sample_tables(int fd, std::int64_t size, const std::string& path);
+
+/// Reads n bytes at pos into buf; returns the count read (< n at the end), negative on error.
+using ReadAt = std::function<std::int64_t(std::uint8_t* buf, std::size_t n, std::int64_t pos)>;
+/// The same walk over a movie given by a reader (e.g. a movie stored as byte ranges of a pack).
+void check_mp4_sample_tables(const ReadAt& read, std::int64_t size, const std::string& path);
 
 }  // namespace panoptes::video

@@ -169,8 +169,18 @@ class Database:
             yield self._db.frame(int(camera), int(task), f)
 
     def stream_path(self, camera, task):
-        """Path of the stream's MP4 movie."""
+        """Path of the stream's MP4 movie (files layout; a packed database has none: see packed_stream)."""
         return self._db.stream_path(int(camera), int(task))
+
+    @property
+    def packed(self):
+        """True when the movies live in packs (docs/formats.md, Packed layout)."""
+        return self._db.packed
+
+    def packed_stream(self, camera, task):
+        """A packed stream as byte ranges: a list of dicts (file, offset, size, first_frame, frames), the
+        init segment first; their bytes concatenated are a fragmented MP4 any player opens."""
+        return self._db.packed_stream(int(camera), int(task))
 
     def __repr__(self):
         w, h = self.image_size

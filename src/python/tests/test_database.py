@@ -136,3 +136,28 @@ def test_errors_are_exceptions_with_the_cli_messages(synth_db, tmp_path):
     with pytest.raises(panoptes.Error, match="no task named 'nope'"):
         db.frame(0, "nope", 0)
     assert issubclass(panoptes.FileError, panoptes.Error) and issubclass(panoptes.Error, RuntimeError)
+
+
+def test_packed_databases_read_like_files(tmp_path, synth_db):
+    """Issue 46: `panoptes pack` output reads frame for frame as its source, and a stream cut out of the
+    packs by its byte ranges alone is a movie of its own."""
+    packed = tmp_path / "packed"
+    subprocess.run([panoptes_binary(), "synth-db", str(tmp_path / "src"), "--cameras", "4", "--tasks", "3",
+                    "--frames", "5", "--size", "64x48", "--gop", "1"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([panoptes_binary(), "pack", str(tmp_path / "src"), str(packed)], check=True,
+                   stdout=subprocess.DEVNULL)
+    a, b = panoptes.open(tmp_path / "src"), panoptes.open(packed)
+    assert not a.packed and b.packed
+    for c, t, f in [(0, 0, 0), (3, 2, 4), (1, 1, 2)]:
+        np.testing.assert_array_equal(a.frame(c, t, f), b.frame(c, t, f))
+    pieces = b.packed_stream(2, 1)
+    assert pieces[0]["frames"] == 0 and sum(p["frames"] for p in pieces) == 5
+    cut = tmp_path / "cut.mp4"
+    with open(cut, "wb") as out:
+        for p in pieces:
+            with open(p["file"], "rb") as f:
+                f.seek(p["offset"])
+                out.write(f.read(p["size"]))
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-show_entries", "stream=nb_read_frames",
+                            "-of", "csv=p=0", str(cut)], capture_output=True, text=True, check=True)
+    assert probe.stdout.strip() == "5"
