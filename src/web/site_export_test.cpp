@@ -79,5 +79,23 @@ TEST(SiteExport, PackedDatabaseBecomesPacksAndAStreamIndex) {
   EXPECT_EQ(read_frame_stamp(copy.stream(2, 1)->read_rgba(2)), (FrameStamp{2, 1, 2}));
 }
 
+// --link: OUT/db is a link to the database, the stream index is written all the same.
+TEST(SiteExport, PackedDatabaseLinkedKeepsItsStreamIndex) {
+  store::testing::TempDir tmp{"site-export"};
+  const fs::path db = tmp.path / "db", site = tmp.path / "site", player = tmp.path / "player";
+  testing::write_packed_database(db, 2, 1, 2);
+  fs::create_directories(player);
+  std::ofstream(player / "index.html") << "<!doctype html>";
+  const SiteExport summary = export_site(db, site, player, DatabaseCopy::link, false);
+  EXPECT_EQ(summary.indexed, 2);
+  EXPECT_EQ(summary.bytes_copied, 0);
+  EXPECT_TRUE(fs::is_symlink(site / "db"));
+  const auto dbj = nlohmann::json::parse(testing::read_file(site / "api/database.json"));
+  EXPECT_EQ(dbj["stream_index"]["packs"], nlohmann::json::array({"db/packs/" + store::pack_file_name(0, 0)}));
+  const StreamIndexEntry e = read_stream_index_entry(site / "api/streams/0.bin", 1);
+  EXPECT_EQ(e.fragments.size(), 2u);
+  EXPECT_TRUE(fs::exists(site / "db/packs" / store::pack_file_name(0, 0)));
+}
+
 }  // namespace
 }  // namespace panoptes::web
