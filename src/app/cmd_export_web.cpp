@@ -37,7 +37,16 @@ void run(const Args& a) {
   if (summary.indexed < summary.streams)
     std::printf("note: %lld streams are missing or unreadable; the player shows a placeholder for them\n",
                 (long long)(summary.streams - summary.indexed));
-  std::printf("host it with any static web server, e.g.: cd %s && python3 -m http.server 8000\n", a.out.c_str());
+  if (summary.stream_index.is_null()) {
+    std::printf("host it with any static web server, e.g.: cd %s && python3 -m http.server 8000\n", a.out.c_str());
+  } else {
+    // The player reads a packed database by byte ranges of its packs; python3 -m http.server ignores
+    // Range and would send whole packs for every request.
+    std::printf("packed database: %zu stream index file(s) in api/streams, packs in db/packs; host it with a static "
+                "server or object store that honours HTTP Range requests (nginx, Apache, caddy, S3, a CDN; not "
+                "python3 -m http.server)\n",
+                summary.stream_index["shards"].size());
+  }
 }
 
 panoptes::app::CommandRegistration reg([](CLI::App& root) {

@@ -7,6 +7,7 @@
 #include <climits>
 #include <thread>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "core/stop_request.hpp"
 #include "core/memory.hpp"
 #include "video/writer_memory.hpp"
+#include "store/database.hpp"
 #include "store/synthetic.hpp"
 
 namespace cmd_synth_db {  // named, not anonymous: the unity build joins the command units
@@ -34,7 +36,38 @@ struct Args {
   std::string lattice, projection = "perspective";
   int shells = 1;
   std::string axes;  // "3x2x2": value counts of up to 4 parameter axes
+  std::string layout;  // "", "files" or "packed"
+  bool gop_given = false;
 };
+
+// The packed layout written as a simulation writes it (docs/formats.md, Packed layout): snapshot by
+// snapshot, every stream's frame then a checkpoint, so each pack holds one fragment per stream and
+// snapshot and a stream's fragments lie between the others' (what a packed database's readers meet).
+void write_packed(const Args& a, const panoptes::store::SyntheticOptions& o,
+                  const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  using namespace panoptes;
+  const store::Manifest m = store::synthetic_manifest(o);
+  store::WriterOptions w;
+  w.overwrite = o.overwrite;
+  w.overwrite_option = o.overwrite_option;
+  w.layout = store::LayoutChoice::packed;
+  store::DatabaseWriter writer = store::DatabaseWriter::create(a.out, m, w);
+  Image img(o.width, o.height, 4);
+  const std::int64_t streams = m.stream_count();
+  for (int f = 0; f < o.frames; ++f) {
+    for (int c = 0; c < m.camera_count(); ++c)
+      for (int t = 0; t < m.task_count(); ++t) {
+        store::draw_synthetic_frame(img, c, t, f);
+        writer.append(c, t, img);
+      }
+    writer.checkpoint();
+    if (progress) progress(streams * (f + 1) / o.frames, streams);
+    if (const int sig = stop_requested())
+      throw Interrupted(sig, a.out + ": stopped by " + signal_name(sig) + " after " + std::to_string(f + 1) + " of " +
+                                 std::to_string(o.frames) + " snapshots; the database is marked interrupted");
+  }
+  writer.finalize();
+}
 
 void run(const Args& a, const std::string& command_line) {
   using namespace panoptes;
@@ -69,7 +102,11 @@ void run(const Args& a, const std::string& command_line) {
   o.threads = a.threads;
   o.title = a.title;
   o.command_line = command_line;
-  o.video.gop = a.gop;
+  if (!a.layout.empty() && a.layout != "files" && a.layout != "packed")
+    throw Error("--layout \"" + a.layout + "\": expected files or packed");
+  const bool packed = a.layout == "packed";
+  // The packed writer encodes keyframes only: gop 1 unless asked otherwise (then the writer refuses).
+  o.video.gop = packed && !a.gop_given ? 1 : a.gop;
   if (a.crf >= 0) o.video.crf = a.crf;
   if (!a.preset.empty()) o.video.preset = a.preset;
   o.video.validate();
@@ -92,12 +129,17 @@ void run(const Args& a, const std::string& command_line) {
 
   const bool tty = ::isatty(STDERR_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
-  store::write_synthetic_database(a.out, o, [&](std::int64_t done, std::int64_t total) {
+  const auto progress = [&](std::int64_t done, std::int64_t total) {
     if (!tty) return;
     std::fprintf(stderr, "\rsynth-db: %lld / %lld streams (%d%%)", (long long)done, (long long)total,
                  int(total ? 100 * done / total : 100));
     std::fflush(stderr);
-  });
+  };
+  if (packed) {
+    write_packed(a, o, progress);
+  } else {
+    store::write_synthetic_database(a.out, o, progress);
+  }
   if (tty) std::fprintf(stderr, "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("wrote %s: %d cameras x %d tasks = %lld streams, %d frames of %dx%d each, in %.2f s (%.0f streams/s)\n",
@@ -141,16 +183,22 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--projection", args->projection, "Projection recorded in the manifest: perspective or equirectangular")
       ->check(CLI::IsMember({"perspective", "equirectangular"}))
       ->capture_default_str();
+  sub->add_option("--layout", args->layout,
+                  "files (one movie per stream) or packed (packs written snapshot by snapshot, as in situ; gop 1 "
+                  "unless --gop says otherwise); default: the writer's choice (docs/formats.md)")
+      ->check(CLI::IsMember({"files", "packed"}));
   sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
-  sub->callback([args] {
+  sub->callback([args, sub] {
     panoptes::install_stop_handlers();
+    args->gop_given = sub->get_option("--gop")->count() > 0;
     // The effective settings, so the provenance reproduces the database.
     const std::string command_line = "panoptes synth-db " + args->out + " --cameras " + std::to_string(args->cameras) + " --tasks " +
                    std::to_string(args->tasks) + " --frames " + std::to_string(args->frames) + " --size " + args->size +
                    (args->lattice.empty() ? "" : " --lattice " + args->lattice) +
                    (args->shells == 1 ? "" : " --shells " + std::to_string(args->shells)) +
                    (args->axes.empty() ? "" : " --axes " + args->axes) +
-                   (args->projection == "perspective" ? "" : " --projection " + args->projection);
+                   (args->projection == "perspective" ? "" : " --projection " + args->projection) +
+                   (args->layout.empty() ? "" : " --layout " + args->layout);
     run(*args, command_line);
   });
 });

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "player/legend.hpp"
 #include "player/value_readout.hpp"
 
@@ -30,6 +31,9 @@ nlohmann::json database_json(const store::Database& db, const DatabaseJsonOption
     frames = options.frames_backed;
   }
   j["frames"] = frames;
+  // Where the movies' bytes are (docs/web.md): "files" (the movie_pattern) or "packed" (per stream
+  // an index naming ranges of pack files).
+  j["layout"] = std::string(store::to_string(m.layout));
   j["fps"] = m.video.fps;
   // The rate the database asks its players to use (0: none; the movies' own rate then), as the desktop player does.
   j["playback_fps"] = m.playback_fps;
@@ -138,6 +142,38 @@ nlohmann::json fragment_index_json(const FragmentIndex& index) {
   nlohmann::json fragments = nlohmann::json::array();
   for (const auto& f : index.fragments) fragments.push_back({f.offset, f.size, f.first_frame, f.frames});
   return {{"file_size", index.file_size}, {"init_size", index.init_size}, {"fragments", std::move(fragments)}};
+}
+
+std::string database_file_url(const std::filesystem::path& db_dir, const std::filesystem::path& file) {
+  const std::filesystem::path relative = file.lexically_normal().lexically_relative(db_dir.lexically_normal());
+  if (relative.empty() || relative.begin()->string() == "..")
+    throw Error(file.string() + ": not inside the database directory " + db_dir.string());
+  return "db/" + relative.generic_string();
+}
+
+nlohmann::json packed_index_json(const store::PackedStream& stream, const std::filesystem::path& db_dir) {
+  using nlohmann::json;
+  json files = json::array(), fragments = json::array();
+  // Usually one pack (the camera's in its only segment); a resumed database adds one per segment.
+  std::map<std::filesystem::path, int> number;
+  const auto file_number = [&](const std::filesystem::path& p) {
+    const auto [it, added] = number.emplace(p, int(number.size()));
+    if (added) files.push_back(database_file_url(db_dir, p));
+    return it->second;
+  };
+  json init = json::array();
+  for (std::size_t k = 0; k < stream.pieces.size(); ++k) {
+    const auto& p = stream.pieces[k];
+    const int file = file_number(p.file);
+    if (k == 0) {
+      init = {file, p.offset, p.size};
+    } else {
+      fragments.push_back({p.offset, p.size, p.first_frame, p.frames, file});
+    }
+  }
+  json j = {{"files", std::move(files)}, {"init", std::move(init)}, {"fragments", std::move(fragments)}};
+  if (!stream.pieces.empty()) j["init_size"] = stream.pieces.front().size;
+  return j;
 }
 
 }  // namespace panoptes::web

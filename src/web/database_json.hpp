@@ -3,6 +3,8 @@
 // files, so schema 1 and 2 databases look the same to the browser).
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -47,5 +49,17 @@ inline nlohmann::json database_json(const store::Database& db, bool inline_camer
 /// The fragment index of one movie as JSON: {"file_size", "init_size", "fragments": [[offset, size,
 /// first_frame, frames], ...]}.
 nlohmann::json fragment_index_json(const FragmentIndex& index);
+
+/// The URL path of a file of the database relative to the player's base ("db/" + its path inside
+/// `db_dir`), as `panoptes serve` and export-web's db/ directory serve it. Throws Error when `file`
+/// is not inside `db_dir`.
+std::string database_file_url(const std::filesystem::path& db_dir, const std::filesystem::path& file);
+
+/// The index of one stream of a packed database as JSON (docs/web.md, "Packed databases"): the files
+/// that hold its bytes, where its init segment is and its fragments, each naming its file:
+/// {"files": ["db/packs/s0-r0.pack", ...], "init": [file, offset, size], "init_size": size,
+///  "fragments": [[offset, size, first_frame, frames, file], ...]}. The files layout's index
+/// (fragment_index_json) is the same without "files" and "init" (file 0 = the movie, init at 0).
+nlohmann::json packed_index_json(const store::PackedStream& stream, const std::filesystem::path& db_dir);
 
 }  // namespace panoptes::web

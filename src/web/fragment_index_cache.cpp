@@ -46,20 +46,43 @@ std::pair<std::shared_ptr<const std::string>, int> FragmentIndexCache::get(
   if (extra) extra(j);
   auto text = std::make_shared<const std::string>(j.dump());
   std::lock_guard lock(mutex_);
-  if (const auto it = by_path_.find(key); it != by_path_.end()) {
+  insert(Entry{key, size, mtime, text, index.frame_count()});
+  return {text, index.frame_count()};
+}
+
+void FragmentIndexCache::insert(Entry entry) {
+  if (const auto it = by_path_.find(entry.path); it != by_path_.end()) {
     bytes_ -= it->second->json->size();
     lru_.erase(it->second);
     by_path_.erase(it);
   }
-  lru_.push_front(Entry{key, size, mtime, text, index.frame_count()});
-  by_path_[key] = lru_.begin();
-  bytes_ += text->size();
+  bytes_ += entry.json->size();
+  lru_.push_front(std::move(entry));
+  by_path_[lru_.front().path] = lru_.begin();
   while (bytes_ > max_bytes_ && lru_.size() > 1) {
     bytes_ -= lru_.back().json->size();
     by_path_.erase(lru_.back().path);
     lru_.pop_back();
   }
-  return {text, index.frame_count()};
+}
+
+std::shared_ptr<const std::string> FragmentIndexCache::json_keyed(const std::string& key, std::uint64_t version,
+                                                                  const std::function<nlohmann::json()>& build) {
+  // A key no path can take ("" is never a movie's path), with the version where a file's size goes.
+  const std::string k = std::string(1, '\0') + key;
+  {
+    std::lock_guard lock(mutex_);
+    if (const auto it = by_path_.find(k); it != by_path_.end() && it->second->size == version) {
+      lru_.splice(lru_.begin(), lru_, it->second);
+      ++hits_;
+      return it->second->json;
+    }
+    ++misses_;
+  }
+  auto text = std::make_shared<const std::string>(build().dump());
+  std::lock_guard lock(mutex_);
+  insert(Entry{k, version, {}, text, 0});
+  return text;
 }
 
 std::uint64_t FragmentIndexCache::hits() const {

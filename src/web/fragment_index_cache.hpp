@@ -33,6 +33,12 @@ class FragmentIndexCache {
                                           const std::function<void(nlohmann::json&)>& extra = {});
   /// The frames in the complete fragments of `movie` (FragmentIndex::frame_count), from the same entry.
   int frame_count(const std::filesystem::path& movie);
+  /// An index that is no file's (a stream of a packed database): the JSON kept under `key` while
+  /// `version` is the one it was built for (serve: the opened manifest's generation, since a pack's
+  /// index names new fragments only with a new checkpoint), else build() and kept in the same LRU.
+  /// Throws what build throws (nothing is kept then).
+  std::shared_ptr<const std::string> json_keyed(const std::string& key, std::uint64_t version,
+                                                const std::function<nlohmann::json()>& build);
 
   /// Counters for tests and logs.
   std::uint64_t hits() const;
@@ -46,6 +52,7 @@ class FragmentIndexCache {
     std::shared_ptr<const std::string> json;
     int frames = 0;
   };
+  void insert(Entry entry);  // under mutex_: replaces the key's entry, evicts beyond max_bytes_
   std::pair<std::shared_ptr<const std::string>, int> get(const std::filesystem::path& movie,
                                                          const std::function<void(nlohmann::json&)>& extra);
   mutable std::mutex mutex_;

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <map>
 #include <regex>
+#include <stdexcept>
 #include <tuple>
 
 #include "core/error.hpp"
@@ -214,8 +215,14 @@ struct Server::Impl {
   std::chrono::steady_clock::time_point reopened{};
   static constexpr std::chrono::seconds kRunningRecheck{2};
 
-  std::shared_ptr<const store::Database> database(bool reopen) {
+  /// Counts the databases opened (reopen()): a packed stream's cached index is valid for one.
+  std::uint64_t db_generation = 0;
+
+  /// The database, reopened first when `reopen` and its manifest changed; `generation`, if given,
+  /// receives the count of the opened one.
+  std::shared_ptr<const store::Database> database(bool reopen, std::uint64_t* generation = nullptr) {
     std::lock_guard lock(db_mutex);
+    if (generation) *generation = db_generation;
     if (reopen) {
       std::error_code ec;
       const fs::path manifest = db_root.dir() / store::kManifestFileName;
@@ -231,6 +238,7 @@ struct Server::Impl {
         reopened = now;
         try {
           db = std::make_shared<const store::Database>(store::Database::open(db_root.dir()));
+          if (generation) *generation = ++db_generation;
           if (!ec) manifest_size = size, manifest_mtime = mtime;
         } catch (const Error& e) {
           log(std::string("reopen failed, keeping the previous manifest: ") + e.what());
@@ -280,8 +288,22 @@ struct Server::Impl {
   /// bytes (a frame takes at least one): then that movie's fragment index (cached; its work is bounded
   /// by the file's size) says how many it holds. -1 = not contradicted, or no movie to check against
   /// (a missing or unreadable first movie is that stream's damage, not a measure of the others).
-  std::int64_t frames_backed(const store::Database& d) {
+  std::int64_t frames_backed(const store::Database& d, std::uint64_t generation) {
     if (d.camera_count() == 0 || d.task_count() == 0 || d.frame_count() == 0) return -1;
+    if (d.packed()) {
+      // The first stream's fragments as its pack index names them, once per opened manifest.
+      std::lock_guard lock(backed_mutex);
+      if (backed_generation != generation) {
+        backed_generation = generation;
+        try {
+          backed_frames = d.packed_stream(0, 0).frames();
+          backed_frames = backed_frames < d.frame_count() && backed_frames > 0 ? backed_frames : -1;
+        } catch (const Error&) {
+          backed_frames = -1;  // that stream's damage, not a measure of the others
+        }
+      }
+      return backed_frames;
+    }
     const auto movie = db_root.resolve(d.manifest().stream_relative_path(0, 0));
     if (!movie) return -1;
     std::error_code ec;
@@ -291,6 +313,40 @@ struct Server::Impl {
       return indexes.frame_count(*movie);
     } catch (const Error&) {
       return -1;
+    }
+  }
+
+  std::mutex backed_mutex;
+  std::uint64_t backed_generation = ~std::uint64_t(0);
+  std::int64_t backed_frames = -1;
+
+  /// GET /api/index/C/T.json of a packed database: the stream's ranges of its packs (web/database_json.hpp,
+  /// packed_index_json), built once per opened manifest: a request for a stream seen before reads no
+  /// file (the packs' index headers are read once per opened database, by store::Database).
+  void packed_index(const store::Database& d, std::uint64_t generation, int camera, int task,
+                    const httplib::Request& req, httplib::Response& res) {
+    const std::string which = "stream camera " + std::to_string(camera) + ", task " + std::to_string(task);
+    try {
+      const auto text = indexes.json_keyed(std::to_string(camera) + "/" + std::to_string(task), generation, [&] {
+        const store::PackedStream ps = d.packed_stream(camera, task);
+        if (ps.pieces.size() < 2) throw std::out_of_range("no pack indexes a fragment of " + which);
+        nlohmann::json j = packed_index_json(ps, d.dir());
+        try {
+          const std::vector<int> damaged = d.damaged_frames(camera, task);
+          if (!damaged.empty()) j["damaged_frames"] = damaged;
+        } catch (const Error&) {
+          // Truncated or unreadable here: the browser finds out by itself.
+        }
+        return j;
+      });
+      res.set_header("Cache-Control", "no-cache");
+      res.set_content(*text, "application/json");
+    } catch (const std::out_of_range& e) {
+      log(request_line(req) + " 404 " + e.what());
+      send_error(res, 404, e.what());
+    } catch (const Error& e) {
+      log(request_line(req) + " 422 " + which + ": " + e.what());
+      send_error(res, 422, which + ": " + e.what());
     }
   }
 
@@ -318,8 +374,9 @@ struct Server::Impl {
           return send_error(res, 400, "times_from=" + escape_for_log(from, 32) + ": expected a frame number");
         o.times_from = std::stoull(from);
       }
-      const auto d = database(true);
-      o.frames_backed = frames_backed(*d);
+      std::uint64_t generation = 0;
+      const auto d = database(true, &generation);
+      o.frames_backed = frames_backed(*d, generation);
       res.set_content(*cached_database_json(d, o), "application/json");
     });
     // The players' key table as data (docs/web.md), with this database's view mode.
@@ -329,10 +386,12 @@ struct Server::Impl {
       res.set_content(player::keys_json(&d->manifest()).dump(), "application/json");
     });
     http.Get(R"(/api/index/(\d{1,9})/(\d{1,9})\.json)", [this](const httplib::Request& req, httplib::Response& res) {
-      const auto d = database(false);
+      std::uint64_t generation = 0;
+      const auto d = database(false, &generation);
       const int camera = std::stoi(req.matches[1]), task = std::stoi(req.matches[2]);
       if (camera >= d->camera_count() || task >= d->task_count())
         return send_error(res, 404, "no stream (" + std::to_string(camera) + ", " + std::to_string(task) + ")");
+      if (d->packed()) return packed_index(*d, generation, camera, task, req, res);
       const std::string relative = d->manifest().stream_relative_path(camera, task);
       std::string why;
       const auto file = db_root.resolve(relative, &why);

@@ -3,8 +3,11 @@
 //
 //   GET /                          the player (index.html and its files from the player directory)
 //   GET /api/database.json         the database as JSON (web/database_json.hpp), re-read per request
-//   GET /api/index/C/T.json        fragment index of the movie of camera C, task T
-//   GET /db/PATH                   a file of the database, with byte ranges (Range: bytes=a-b → 206)
+//   GET /api/index/C/T.json        fragment index of the movie of camera C, task T; for a packed
+//                                  database the ranges of its packs (files, init, fragments with
+//                                  their file), built once per opened manifest and then cached
+//   GET /db/PATH                   a file of the database, with byte ranges (Range: bytes=a-b → 206):
+//                                  a packed database's streams are read straight from db/packs/*.pack
 //
 // Nothing outside the database and the player directory can be reached (web/safe_path.hpp); with a
 // token, every request must carry it (?token=T once, which sets a cookie, or Authorization: Bearer T).

@@ -13,6 +13,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/frame_stamp.hpp"
+#include "store/database.hpp"
+#include "video/movie_reader.hpp"
 #include "store/manifest.hpp"
 #include "store/synthetic.hpp"
 #include "store/test_support.hpp"
@@ -143,6 +146,69 @@ TEST(Server, DatabaseJsonIsBuiltOncePerManifest) {
   ASSERT_TRUE(res);
   EXPECT_NE(res->body.find("renamed "), std::string::npos);
   EXPECT_EQ(builds(), 3);
+}
+
+// A packed database (issue 46): the index names the pack and the ranges of the stream in it, and the
+// bytes come straight from the pack by Range requests; init + fragments is a movie with its stamps.
+TEST(Server, PackedDatabaseIndexNamesPackRangesServedByteForByte) {
+  Fixture f;  // for the player directory
+  const fs::path db = f.tmp.path / "packed";
+  testing::write_packed_database(db, 3, 2, 4);
+  auto o = options(f);
+  o.database = db;
+  Running r(o);
+  httplib::Client c("127.0.0.1", r.server.port());
+  auto res = c.Get("/api/database.json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(nlohmann::json::parse(res->body)["layout"], "packed");
+  EXPECT_EQ(nlohmann::json::parse(res->body)["frames"], 4);
+
+  const store::Database reference = store::Database::open(db);
+  for (int camera = 0; camera < 3; ++camera) {
+    res = c.Get("/api/index/" + std::to_string(camera) + "/1.json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << res->body;
+    const auto index = nlohmann::json::parse(res->body);
+    ASSERT_EQ(index["files"].size(), 1u);
+    const std::string pack = index["files"][0];
+    EXPECT_EQ(pack, "db/packs/" + store::pack_file_name(0, 0));
+    const store::PackedStream ps = reference.packed_stream(camera, 1);
+    ASSERT_EQ(index["fragments"].size(), ps.pieces.size() - 1);
+    EXPECT_EQ(index["init"], nlohmann::json::array({0, ps.pieces[0].offset, ps.pieces[0].size}));
+    EXPECT_EQ(index["init_size"], ps.pieces[0].size);
+    std::string movie;
+    const auto get = [&](std::uint64_t offset, std::uint64_t size) {
+      auto part = c.Get("/" + pack, {{"Range", "bytes=" + std::to_string(offset) + "-" + std::to_string(offset + size - 1)}});
+      EXPECT_TRUE(part);
+      EXPECT_EQ(part->status, 206);
+      EXPECT_EQ(part->body, testing::read_range(ps.pieces[0].file, offset, size));
+      return part->body;
+    };
+    movie += get(ps.pieces[0].offset, ps.pieces[0].size);
+    for (std::size_t k = 0; k < ps.pieces.size() - 1; ++k) {
+      const auto& fr = index["fragments"][k];
+      const auto& piece = ps.pieces[k + 1];
+      EXPECT_EQ(fr, nlohmann::json::array({piece.offset, piece.size, int(k), 1, 0}));
+      // Other streams' fragments lie between this stream's: the player fetches them one run each.
+      if (k > 0) {
+        EXPECT_GT(piece.offset, ps.pieces[k].offset + ps.pieces[k].size);
+      }
+      movie += get(fr[0], fr[1]);
+    }
+    // What a browser assembles plays, with this stream's stamps.
+    const fs::path cut = f.tmp.path / ("cut" + std::to_string(camera) + ".mp4");
+    std::ofstream(cut, std::ios::binary) << movie;
+    video::MovieReader reader(cut.string(), reference.frame_checks(camera, 1));
+    ASSERT_EQ(reader.frame_count(), 4);
+    EXPECT_TRUE(reader.check_frames().empty());
+    EXPECT_EQ(read_frame_stamp(reader.read_rgba(3)), (FrameStamp{std::uint32_t(camera), 1, 3}));
+  }
+  // Asked again, the same index (from the cache).
+  const auto again = c.Get("/api/index/2/1.json");
+  ASSERT_TRUE(again);
+  EXPECT_EQ(nlohmann::json::parse(again->body)["fragments"].size(), 4u);
+  // Out of range: 404, as for a files database.
+  EXPECT_EQ(c.Get("/api/index/3/0.json")->status, 404);
 }
 
 TEST(Server, NoPathOutsideTheDatabaseCanBeReached) {

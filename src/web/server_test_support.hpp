@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "store/database.hpp"
 #include "store/manifest.hpp"
 #include "store/synthetic.hpp"
 #include "store/test_support.hpp"
@@ -58,6 +59,33 @@ struct Fixture {
     fs::create_symlink(db / "movies" / "c0" / "t0.mp4", db / "movies" / "inside.mp4");
   }
 };
+
+/// A stamped synthetic database in the packed layout, written as a simulation writes it: snapshot by
+/// snapshot with a checkpoint each, so a stream's fragments lie between the other streams' in its pack.
+inline void write_packed_database(const fs::path& dir, int cameras, int tasks, int frames, int width = 64, int height = 48) {
+  store::SyntheticOptions o;
+  o.cameras = cameras;
+  o.tasks = tasks;
+  o.frames = frames;
+  o.width = width;
+  o.height = height;
+  o.video.gop = 1;
+  const store::Manifest m = store::synthetic_manifest(o);
+  store::WriterOptions w;
+  w.layout = store::LayoutChoice::packed;
+  store::DatabaseWriter writer = store::DatabaseWriter::create(dir, m, w);
+  for (int f = 0; f < frames; ++f) {
+    for (int c = 0; c < cameras; ++c)
+      for (int t = 0; t < tasks; ++t) writer.append(c, t, store::synthetic_frame(c, t, f, width, height));
+    writer.checkpoint();
+  }
+  writer.finalize();
+}
+
+/// The bytes [offset, offset + size) of a file.
+inline std::string read_range(const fs::path& p, std::uint64_t offset, std::uint64_t size) {
+  return read_file(p).substr(std::size_t(offset), std::size_t(size));
+}
 
 /// A server on a free port, running in a thread for the test's lifetime.
 struct Running {

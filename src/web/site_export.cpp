@@ -14,6 +14,7 @@
 #include <cstring>
 #include <fstream>
 #include <random>
+#include <map>
 #include <set>
 
 #include "core/error.hpp"
@@ -23,6 +24,7 @@
 #include "web/database_json.hpp"
 #include "web/mp4_fragments.hpp"
 #include "web/safe_path.hpp"
+#include "web/stream_index.hpp"
 
 namespace panoptes::web {
 
@@ -98,12 +100,26 @@ class Staging {
     return std::int64_t(fs::file_size(to));
   }
 
+  /// A hard link to `from` when it is on the same file system (no bytes copied: packs are large and
+  /// never rewritten once a manifest names them), else a copy. Returns the bytes copied (0 if linked).
+  std::int64_t link_or_copy_in(const fs::path& from, const std::string& relative) {
+    const fs::path to = dir_ / relative;
+    fs::create_directories(to.parent_path());
+    if (::link(from.c_str(), to.c_str()) == 0) {
+      files_.push_back(relative);
+      return 0;
+    }
+    return copy_in(from, relative);
+  }
+
   void link(const fs::path& target, const std::string& relative) {
     fs::create_directory_symlink(target, dir_ / relative);
     files_.push_back(relative);
   }
 
   const std::vector<std::string>& files() const { return files_; }
+  /// A file written into the staging directory by other means.
+  void add_file(const std::string& relative) { files_.push_back(relative); }
 
  private:
   fs::path dir_;
@@ -214,6 +230,111 @@ void move_in(const Staging& staging, int out_fd, const fs::path& out) {
   }
 }
 
+// A database of movie files: per stream its fragment index as JSON (what serve computes per
+// request) and, when copying, the movie.
+void export_files(const store::Database& db, const SafeRoot& root, Staging& staging, DatabaseCopy mode,
+                  SiteExport& summary, const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  std::int64_t done = 0;
+  for (int c = 0; c < db.camera_count(); ++c) {
+    for (int t = 0; t < db.task_count(); ++t, ++done) {
+      if (progress && done % 64 == 0) progress(done, summary.streams);
+      const std::string relative = db.manifest().stream_relative_path(c, t);
+      const auto movie = root.resolve(relative);
+      if (!movie) continue;  // missing or unsafe: the player shows its placeholder
+      FragmentIndex index;
+      try {
+        index = index_fragments(*movie);
+      } catch (const Error&) {
+        continue;  // unreadable: same
+      }
+      nlohmann::json index_json = fragment_index_json(index);
+      // Frames that fail the manifest's frame checks (checksum, identity, index, timestamp): the
+      // browser decodes by itself, so the index says which ones to show as damaged.
+      try {
+        const std::vector<int> damaged = db.damaged_frames(c, t);
+        if (!damaged.empty()) index_json["damaged_frames"] = damaged;
+      } catch (const Error&) {
+        // Truncated or not decodable here: the browser finds out by itself, as before.
+      }
+      staging.write_text("api/index/" + std::to_string(c) + "/" + std::to_string(t) + ".json", index_json.dump());
+      ++summary.indexed;
+      if (mode == DatabaseCopy::copy) summary.bytes_copied += staging.copy_in(*movie, "db/" + relative);
+    }
+  }
+}
+
+// A packed database: its packs (hard-linked or copied, with their indexes, so OUT/db stays a
+// database) and the stream index shards (web/stream_index.hpp) instead of a JSON file per stream.
+void export_packed(const store::Database& db, const SafeRoot& root, Staging& staging, DatabaseCopy mode,
+                   SiteExport& summary, const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  // Packs are numbered in the manifest's order (segments, then ranks): known before any stream is read.
+  std::map<std::string, std::uint32_t> number;  // pack file name -> position in the list
+  nlohmann::json packs = nlohmann::json::array();
+  for (const store::PackSegment& seg : db.manifest().packs) {
+    for (int r = 0; r < seg.ranks; ++r) {
+      const std::string name = store::pack_file_name(seg.segment, r);
+      const std::string relative = std::string(store::kPackDirectory) + "/" + name;
+      const auto pack = root.resolve(relative);
+      if (!pack) continue;  // a rank that owned no camera wrote none
+      number.emplace(name, std::uint32_t(packs.size()));
+      packs.push_back("db/" + relative);
+      if (mode == DatabaseCopy::copy) {
+        summary.bytes_copied += staging.link_or_copy_in(*pack, "db/" + relative);
+        const std::string index = std::string(store::kPackDirectory) + "/" + store::pack_index_name(seg.segment, r);
+        if (const auto idx = root.resolve(index)) summary.bytes_copied += staging.link_or_copy_in(*idx, "db/" + index);
+      }
+    }
+  }
+  const int frames = db.frame_count(), tasks = db.task_count();
+  const std::int64_t total = db.stream_count();
+  nlohmann::json shards = nlohmann::json::array();
+  for (std::int64_t first = 0; first < total; first += kStreamsPerShard) {
+    const std::int64_t count = std::min(kStreamsPerShard, total - first);
+    const std::string relative = "api/streams/" + std::to_string(first / kStreamsPerShard) + ".bin";
+    fs::create_directories((staging.dir() / relative).parent_path());
+    StreamIndexWriter writer(staging.dir() / relative, first, count, total, frames, int(packs.size()));
+    for (std::int64_t s = first; s < first + count; ++s) {
+      if (progress && s % 64 == 0) progress(s, total);
+      const int c = int(s / tasks), t = int(s % tasks);
+      StreamIndexEntry e;
+      try {
+        const store::PackedStream ps = db.packed_stream(c, t);
+        const auto range = [&](const store::PackedStream::Piece& p) {
+          const auto it = number.find(p.file.filename().string());
+          if (it == number.end()) throw Error(p.file.string() + ": a pack the manifest does not list");
+          return StreamIndexEntry::Range{it->second, p.offset, std::uint32_t(p.size), std::uint32_t(p.frames)};
+        };
+        for (std::size_t k = 1; k < ps.pieces.size() && ps.pieces[k].first_frame < frames; ++k)
+          e.fragments.push_back(range(ps.pieces[k]));
+        if (!e.fragments.empty()) e.init = range(ps.pieces.front());
+      } catch (const Error&) {
+        e.fragments.clear();  // a damaged index: the player shows its placeholder, as for a missing movie
+      }
+      if (!e.fragments.empty()) {
+        ++summary.indexed;
+        // Frames that fail the manifest's frame checks: the browser decodes by itself, so the index
+        // says which ones to show as damaged (as api/index/C/T.json does for a files database).
+        try {
+          for (const int f : db.damaged_frames(c, t)) e.damaged.push_back(std::uint32_t(f));
+        } catch (const Error&) {
+          // Truncated or not decodable here: the browser finds out by itself.
+        }
+      }
+      writer.add(e);
+    }
+    writer.finish();
+    staging.add_file(relative);
+    shards.push_back(relative);
+  }
+  summary.stream_index = {{"format", "panoptes stream index"},
+                          {"version", kStreamIndexVersion},
+                          {"packs", std::move(packs)},
+                          {"shards", std::move(shards)},
+                          {"streams_per_shard", kStreamsPerShard},
+                          {"header_bytes", kStreamIndexHeaderBytes},
+                          {"entry_bytes", stream_entry_bytes(frames)}};
+}
+
 }  // namespace
 
 SiteExport export_site(const fs::path& database, const fs::path& out_arg, const fs::path& player_dir,
@@ -255,7 +376,6 @@ SiteExport export_site(const fs::path& database, const fs::path& out_arg, const 
     if (!entry.is_regular_file()) continue;
     staging.copy_in(entry.path(), entry.path().lexically_relative(player_dir).generic_string());
   }
-  staging.write_text("api/database.json", database_json(db).dump());
   staging.write_text("api/keys.json", player::keys_json(&db.manifest()).dump());
 
   SiteExport summary;
@@ -267,33 +387,15 @@ SiteExport export_site(const fs::path& database, const fs::path& out_arg, const 
     const std::string table = store::referenced_camera_table(root.dir() / store::kManifestFileName);
     if (!table.empty()) summary.bytes_copied += staging.copy_in(root.dir() / table, "db/" + table);
   }
-  std::int64_t done = 0;
-  for (int c = 0; c < db.camera_count(); ++c) {
-    for (int t = 0; t < db.task_count(); ++t, ++done) {
-      if (progress && done % 64 == 0) progress(done, summary.streams);
-      const std::string relative = db.manifest().stream_relative_path(c, t);
-      const auto movie = root.resolve(relative);
-      if (!movie) continue;  // missing or unsafe: the player shows its placeholder
-      FragmentIndex index;
-      try {
-        index = index_fragments(*movie);
-      } catch (const Error&) {
-        continue;  // unreadable: same
-      }
-      nlohmann::json index_json = fragment_index_json(index);
-      // Frames that fail the manifest's frame checks (checksum, identity, index, timestamp): the
-      // browser decodes by itself, so the index says which ones to show as damaged.
-      try {
-        const std::vector<int> damaged = db.damaged_frames(c, t);
-        if (!damaged.empty()) index_json["damaged_frames"] = damaged;
-      } catch (const Error&) {
-        // Truncated or not decodable here: the browser finds out by itself, as before.
-      }
-      staging.write_text("api/index/" + std::to_string(c) + "/" + std::to_string(t) + ".json", index_json.dump());
-      ++summary.indexed;
-      if (mode == DatabaseCopy::copy) summary.bytes_copied += staging.copy_in(*movie, "db/" + relative);
-    }
+  if (db.packed()) {
+    export_packed(db, root, staging, mode, summary, progress);
+  } else {
+    export_files(db, root, staging, mode, summary, progress);
   }
+  // After the streams: a packed site's database.json names the stream index written for them.
+  nlohmann::json dbj = database_json(db);
+  if (!summary.stream_index.is_null()) dbj["stream_index"] = summary.stream_index;
+  staging.write_text("api/database.json", dbj.dump());
   std::string listing;
   for (const auto& f : staging.files()) listing += f + "\n";
   {

@@ -1,6 +1,8 @@
-// Movie access for the web player: per stream a fragment index (api/index/C/T.json), the init
-// segment and single fragments fetched with byte ranges, demuxed by mp4box.js and decoded by a
-// WebCodecs VideoDecoder. Decoded frames go to a bounded LRU cache of VideoFrames.
+// Movie access for the web player: per stream a fragment index (api/index/C/T.json, or for a static
+// site of a packed database an entry of its binary stream index), the init segment and fragments
+// fetched with byte ranges (of the stream's movie file, or of the packs that hold it), demuxed by
+// mp4box.js or fragmentSamples and decoded by a WebCodecs VideoDecoder. Decoded frames go to a
+// bounded LRU cache of VideoFrames.
 import { createFile, DataStream, Endianness, MP4BoxBuffer } from "./vendor/mp4box/mp4box.all.mjs";
 
 const MAX_FRAGMENTS_PER_STREAM = 256;
@@ -34,6 +36,53 @@ async function fetchBytes(url, range) {
   // A static server without range support answers 200 with the whole file: cut the range out.
   if (range && res.status === 200 && buf.byteLength > range[1] - range[0]) buf = buf.slice(range[0], range[1]);
   return buf;
+}
+
+// Init segments by file and range: every stream of a pack shares the pack's init segment, so a packed
+// database fetches it once per pack, not once per stream.
+const initSegments = new Map();
+function initSegment(url, offset, size) {
+  const key = `${url} ${offset} ${size}`;
+  if (!initSegments.has(key))
+    initSegments.set(key, fetchBytes(url, [offset, offset + size]).catch((e) => { initSegments.delete(key); throw e; }));
+  return initSegments.get(key);
+}
+
+/// The index of stream `stream` read from a static site's binary stream index (database.json
+/// `stream_index`, written by export-web for a packed database; docs/web.md, "A static site from a
+/// packed database"): one Range request for its fixed-size entry (and one more for its damaged-frame
+/// list when it has one). Returns what api/index/C/T.json holds for a packed database.
+export async function readStreamIndexEntry(base, si, stream, streams) {
+  const shard = Math.floor(stream / si.streams_per_shard), slot = stream % si.streams_per_shard;
+  if (shard >= si.shards.length) throw Object.assign(new Error(`stream ${stream}: no shard ${shard}`), { kind: "missing" });
+  const url = base + si.shards[shard], at = si.header_bytes + slot * si.entry_bytes;
+  const buf = await fetchBytes(url, [at, at + si.entry_bytes]);
+  const v = new DataView(buf);
+  const bad = (why) => { throw new Error(`${url}: entry of stream ${stream} (bytes ${at}+${si.entry_bytes}): ${why}`); };
+  if (buf.byteLength !== si.entry_bytes) bad(`${buf.byteLength} bytes`);
+  if (v.getUint32(0, true) !== stream) bad(`names stream ${v.getUint32(0, true)}`);
+  const n = v.getUint32(4, true);
+  if (n === 0) throw Object.assign(new Error("missing (no fragment indexed)"), { kind: "missing" });
+  if (32 + 16 * n > si.entry_bytes) bad(`${n} fragments do not fit`);
+  const fragments = [];
+  for (let k = 0, frame = 0; k < n; k++) {
+    const p = 32 + 16 * k, where = v.getBigUint64(p, true), frames = v.getUint32(p + 12, true);
+    const pack = Number(where >> 48n);
+    if (pack >= si.packs.length || frames === 0) bad(`fragment ${k}: pack ${pack}, ${frames} frames`);
+    fragments.push([Number(where & 0xffffffffffffn), v.getUint32(p + 8, true), frame, frames, pack]);
+    frame += frames;
+  }
+  const index = { files: si.packs, init: [v.getUint32(8, true), Number(v.getBigUint64(16, true)), v.getUint32(12, true)], fragments };
+  index.init_size = index.init[2];
+  const damaged = v.getUint32(24, true);
+  if (damaged > 0) {
+    // The shard's damaged-frame list follows its entries.
+    const inShard = Math.min(si.streams_per_shard, streams - shard * si.streams_per_shard);
+    const from = si.header_bytes + inShard * si.entry_bytes + 4 * v.getUint32(28, true);
+    const list = new DataView(await fetchBytes(url, [from, from + 4 * damaged]));
+    index.damaged_frames = Array.from({ length: damaged }, (_, k) => list.getUint32(4 * k, true));
+  }
+  return index;
 }
 
 /// Runs mp4box.js over an init segment followed by one fragment (a valid fragmented MP4 by itself:
@@ -171,8 +220,17 @@ export class Stream {
   constructor(base, db, camera, task) {
     this.camera = camera;
     this.task = task;
-    this.url = base + "db/" + db.movie_pattern.replaceAll("{camera}", camera).replaceAll("{task}", task);
+    this.base = base;
+    // A packed database keeps every stream in ranges of pack files its index names (docs/web.md);
+    // `url` then only names the stream in messages.
+    this.packed = db.layout === "packed";
+    this.url = this.packed ? `${base}db/packs (camera ${camera}, task ${task})`
+      : base + "db/" + db.movie_pattern.replaceAll("{camera}", camera).replaceAll("{task}", task);
     this.indexUrl = `${base}api/index/${camera}/${task}.json`;
+    // A static site of a packed database has no JSON per stream but a binary stream index.
+    this.streamIndex = db.stream_index || null;
+    this.streamNumber = camera * db.tasks.length + task;
+    this.streamCount = db.cameras.count * db.tasks.length;
     this.status = "new";  // new | ok | missing | unreadable
     this.message = "";
     this.opening = null;
@@ -194,20 +252,33 @@ export class Stream {
       // The init segment's size is in the index, but waiting for it costs a round trip: ask for the
       // first INIT_GUESS bytes at the same time (an init segment is ~800 bytes) and only fetch
       // again when it is larger.
-      const head = fetchBytes(this.url, [0, INIT_GUESS]).catch((e) => e);
-      const res = await fetch(this.indexUrl, { cache: "no-store" });
-      if (res.status === 404) throw Object.assign(new Error("missing"), { kind: "missing" });
-      if (!res.ok) throw Object.assign(new Error(`unreadable (HTTP ${res.status})`), { kind: "unreadable" });
-      const text = await res.text();
-      traffic.bytes += text.length;
-      traffic.requests++;
-      this.index = JSON.parse(text);
+      // A packed stream's init segment is shared by its pack (initSegment): no guess.
+      const head = this.packed ? null : fetchBytes(this.url, [0, INIT_GUESS]).catch((e) => e);
+      if (this.streamIndex) {
+        this.index = await readStreamIndexEntry(this.base, this.streamIndex, this.streamNumber, this.streamCount);
+      } else {
+        const res = await fetch(this.indexUrl, { cache: "no-store" });
+        if (res.status === 404) throw Object.assign(new Error("missing"), { kind: "missing" });
+        if (!res.ok) throw Object.assign(new Error(`unreadable (HTTP ${res.status})`), { kind: "unreadable" });
+        const text = await res.text();
+        traffic.bytes += text.length;
+        traffic.requests++;
+        this.index = JSON.parse(text);
+      }
+      // The files holding the bytes: the movie, or the packs the index names (fragment field 4).
+      this.files = Array.isArray(this.index.files) ? this.index.files.map((u) => this.base + u) : [this.url];
       // Frames that fail their database's frame checks (checksum, identity, position): the server
       // and export-web name them; the player shows a placeholder instead of a frame that lies.
       this.damaged = new Set(Array.isArray(this.index.damaged_frames) ? this.index.damaged_frames : []);
       mark("index");
-      const n = this.index.init_size, guess = await head;
-      this.init = !(guess instanceof Error) && guess.byteLength >= n ? guess.slice(0, n) : await fetchBytes(this.url, [0, n]);
+      if (this.index.init) {
+        const [file, offset, size] = this.index.init;
+        if (!this.files[file]) throw new Error(`the index names init file ${file} of ${this.files.length}`);
+        this.init = (await initSegment(this.files[file], offset, size)).slice(0);
+      } else {
+        const n = this.index.init_size, guess = await head;
+        this.init = !(guess instanceof Error) && guess.byteLength >= n ? guess.slice(0, n) : await fetchBytes(this.url, [0, n]);
+      }
       mark("init");
       const { file, info } = await demux(this.init, null);
       const track = info.videoTracks[0];
@@ -274,24 +345,20 @@ export class Stream {
     if (!this.samples.has(n)) await this.fetching.get(n);
   }
 
-  /// Fragments [a, b): contiguous in the file, so one range; init + those fragments is itself a valid
-  /// fragmented MP4 for mp4box.js (offsets are relative to each moof).
+  /// Fragments [a, b), with one range request per maximal run of them that lies back to back in one
+  /// file (a movie file's fragments are one run; a pack's hold other streams' fragments between
+  /// them). Init + a run is itself a valid fragmented MP4 for mp4box.js (offsets are relative to
+  /// each moof).
   async _fetch(a, b) {
-    const f = this.index.fragments;
+    const f = this.index.fragments, file = (k) => f[k][4] ?? 0;
+    const runs = [];
+    for (let k = a; k < b; k++) {
+      const last = runs[runs.length - 1];
+      if (last && file(k) === file(k - 1) && f[k][0] === f[k - 1][0] + f[k - 1][1]) last[1] = k + 1;
+      else runs.push([k, k + 1]);
+    }
     try {
-      const bytes = await fetchBytes(this.url, [f[a][0], f[b - 1][0] + f[b - 1][1]]);
-      mark("fragments fetched");
-      const td = performance.now();
-      const samples = ownDemux ? fragmentSamples(bytes, `${this.url} fragments ${a}..${b - 1}`)
-        : (await demux(this.init, bytes)).samples.map((x) => ({ data: x.data, key: x.is_sync }));
-      traffic.demuxMs += performance.now() - td;
-      if (samples.length !== f[b - 1][2] + f[b - 1][3] - f[a][2])
-        throw new Error(`${samples.length} samples, the index says ${f[b - 1][2] + f[b - 1][3] - f[a][2]}`);
-      let i = 0;
-      for (let k = a; k < b; k++) {
-        this.samples.set(k, samples.slice(i, i + f[k][3]));
-        i += f[k][3];
-      }
+      await Promise.all(runs.map(([ra, rb]) => this._fetchRun(ra, rb)));
       // Bounded memory: the oldest fetched fragments go first.
       for (const k of this.samples.keys()) {
         if (this.samples.size <= MAX_FRAGMENTS_PER_STREAM) break;
@@ -300,6 +367,25 @@ export class Stream {
     } catch (e) {
       this.status = "unreadable";
       this.message = `${this.url}: fragments ${a}..${b - 1}: ${e.message || e}`;
+    }
+  }
+
+  /// Fragments [a, b), back to back in one file: one range request.
+  async _fetchRun(a, b) {
+    const f = this.index.fragments, url = this.files[f[a][4] ?? 0];
+    if (!url) throw new Error(`fragment ${a} names file ${f[a][4]} of ${this.files.length}`);
+    const bytes = await fetchBytes(url, [f[a][0], f[b - 1][0] + f[b - 1][1]]);
+    mark("fragments fetched");
+    const td = performance.now();
+    const samples = ownDemux ? fragmentSamples(bytes, `${url} fragments ${a}..${b - 1}`)
+      : (await demux(this.init, bytes)).samples.map((x) => ({ data: x.data, key: x.is_sync }));
+    traffic.demuxMs += performance.now() - td;
+    if (samples.length !== f[b - 1][2] + f[b - 1][3] - f[a][2])
+      throw new Error(`${samples.length} samples, the index says ${f[b - 1][2] + f[b - 1][3] - f[a][2]}`);
+    let i = 0;
+    for (let k = a; k < b; k++) {
+      this.samples.set(k, samples.slice(i, i + f[k][3]));
+      i += f[k][3];
     }
   }
 
