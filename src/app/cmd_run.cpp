@@ -87,7 +87,8 @@ void check_run_resources(const seismic::SolverConfig& solver, const insitu::Sess
     for (const auto& t : cfg.tasks)
       tasks += std::int64_t(std::max<std::size_t>(
           1, std::max({t.isovalues.size(), t.slice_positions.size(), t.windows.size()})));
-    insitu::check_open_streams(cameras, int(std::min<std::int64_t>(tasks, INT_MAX)), ranks);
+    insitu::check_open_streams(cameras, int(std::min<std::int64_t>(tasks, INT_MAX)), ranks,
+                               insitu::packed_layout(cfg, cameras * std::min<std::int64_t>(tasks, INT_MAX)));
     if (!force) {
       MemoryEstimate e = seismic::estimate_solver_memory(solver, ranks);
       const double slab = double(g.nx) * g.ny * (std::ceil(double(g.nz) / ranks) + 4);

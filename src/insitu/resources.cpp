@@ -8,6 +8,7 @@
 #include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 #include "insitu/task_plan.hpp"
+#include "store/database.hpp"
 #include "video/writer_memory.hpp"
 
 namespace panoptes::insitu {
@@ -47,7 +48,14 @@ MemoryEstimate estimate_session_memory(const SessionConfig& cfg, double block_po
   // send buffers and the received ones, plus the composite; full frames at worst.
   e.add("partial images", (3.0 * ranks + 1) * tasks * px * 20);
   e.add("finished frames", tasks * px * 3 + std::max(encode_threads, 1) * video::live_encoder_bytes(px));
-  e.add("open movie writers", owned * tasks * video::open_writer_bytes(px, cfg.video.gop));
+  if (packed_layout(cfg, (long long)(double(cameras) * tasks))) {
+    // docs/formats.md, "Packed layout": a 96-byte record and ~13 bytes of heap per idle stream, and the
+    // compressed frames of the snapshot until its flush (23 kB per 920x896 frame at crf 23, ~0.03 B per
+    // pixel: counted twice over for sharper pictures).
+    e.add("packed stream records and pending frames", owned * tasks * (110.0 + 0.06 * px));
+  } else {
+    e.add("open movie writers", owned * tasks * video::open_writer_bytes(px, cfg.video.gop));
+  }
   e.add("rig and manifest", double(cameras) * kBytesPerCamera);
   return e;
 }
@@ -74,8 +82,15 @@ long long rig_camera_count(const SessionConfig& cfg, const render::GridGeometry&
   return camera::read_rig_file(spec.path, domain).size();
 }
 
-long long check_open_streams(long long cameras, int tasks, int ranks) {
+bool packed_layout(const SessionConfig& cfg, long long streams) {
+  const store::LayoutChoice choice = store::parse_layout_choice(cfg.layout);
+  return choice == store::LayoutChoice::packed ||
+         (choice == store::LayoutChoice::automatic && cfg.video.gop == 1 && streams >= store::kPackedAutoStreams);
+}
+
+long long check_open_streams(long long cameras, int tasks, int ranks, bool packed) {
   const long long streams = checked_product(cameras, tasks, "cameras x tasks (movies)", INT_MAX);
+  if (packed) return 2;
   const long long per_rank = (streams + std::max(ranks, 1) - 1) / std::max(ranks, 1);
   const long long limit = open_file_limit();
   // Keep room for the manifest, the lock, MPI and the C library.

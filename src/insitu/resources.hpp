@@ -12,6 +12,8 @@ namespace panoptes::insitu {
 /// (`block_points` points, ghosts included), partial images in flight (camera rounds of `ranks`,
 /// every task, full frames at worst), finished frames, the open writers of the streams it owns and
 /// the rig / manifest / navigation graph of `cameras` cameras. `encode_threads` frames encode at once.
+/// Open writers: a muxer per stream in the files layout, a ~110-byte record plus the stream's
+/// compressed frames of one snapshot in the packed layout (packed_layout()).
 MemoryEstimate estimate_session_memory(const SessionConfig& config, double block_points, long long cameras,
                                        int ranks, int encode_threads);
 
@@ -25,9 +27,14 @@ MemoryEstimate estimate_grid_stage_memory(double source_points, double cover_poi
 /// The number of cameras config.rig gives: computed for built-in rigs, read for file rigs (bounded).
 long long rig_camera_count(const SessionConfig& config, const render::GridGeometry& grid);
 
-/// Movies open at once on one rank (its share of cameras × tasks), or throws Error naming the count
-/// and the open-file limit (ulimit -n) when they cannot all be open; also refuses a cameras × tasks
-/// count beyond an int.
-long long check_open_streams(long long cameras, int tasks, int ranks);
+/// Whether a new database of `streams` streams gets the packed layout under `config` ([output] layout
+/// = "packed", or "auto" with gop 1 and at least store::kPackedAutoStreams streams: what
+/// store::DatabaseWriter decides).
+bool packed_layout(const SessionConfig& config, long long streams);
+
+/// Files one rank holds open for its movies: with `packed`, its pack and index (2); else one per movie
+/// of its share of cameras × tasks, and then throws Error naming the count and the open-file limit
+/// (ulimit -n) when they cannot all be open. Refuses a cameras × tasks count beyond an int.
+long long check_open_streams(long long cameras, int tasks, int ranks, bool packed = false);
 
 }  // namespace panoptes::insitu

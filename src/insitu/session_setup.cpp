@@ -152,7 +152,7 @@ void Session::Impl::check_resources() {
   std::string refusal;
   try {
     const long long cameras = rig_camera_count(cfg, grid);
-    check_open_streams(cameras, int(plan.size()), size);
+    check_open_streams(cameras, int(plan.size()), size, packed_layout(cfg, cameras * (long long)plan.size()));
     if (cfg.check_memory) {
       const double points = me().has_brick ? double(me().required.size()) : 0.0;
       int sharing = 1;
