@@ -49,9 +49,16 @@ struct SweepPlan {
   bool one_colour = false;                    // every task's colour is colour[0]
   // Volume windows: rows, bin mapping, and the hull [vis_lo, vis_hi] of values (|v| for an
   // absolute-value map) that reach a bin of non-zero opacity (empty: vis_lo > vis_hi).
-  std::vector<std::vector<march::VolRow>> rows;
+  // Each window's LUT rows, shared between windows whose rows are the same (one transfer function
+  // over windows of one width: a window sweep's usual case): 1,000 tables of 16 KB each missed the
+  // caches on every sample, one table stays in L1.
+  std::vector<std::vector<march::VolRow>> tables;
+  std::vector<const march::VolRow*> rows;
+  std::vector<int> table_of;
   std::vector<float> lo, sc, last, vis_lo, vis_hi;
   std::vector<char> absv;
+  bool same_abs = false;    // every window maps v, or every window |v|
+  std::vector<int> by_vis;  // windows in increasing vis_lo (same_abs), else in task order
 };
 
 SweepPlan compile_sweep(std::span<const PreparedField> fields, std::span<const TaskSpec> tasks,
@@ -75,7 +82,16 @@ SweepPlan compile_sweep(std::span<const PreparedField> fields, std::span<const T
   }
   for (const TaskSpec& t : tasks) {
     const TransferLut lut(t.tf, t.window.resolve(t.reference), opt.sample_distance);
-    P.rows.push_back(march::vol_rows(lut));
+    std::vector<march::VolRow> r = march::vol_rows(lut);
+    std::size_t u = 0;
+    const std::size_t first = P.tables.size() > 16 ? P.tables.size() - 16 : 0;  // the recent ones suffice
+    for (u = first; u < P.tables.size(); ++u)
+      if (P.tables[u].size() == r.size() &&
+          std::memcmp(P.tables[u].data(), r.data(), r.size() * sizeof(march::VolRow)) == 0)
+        break;
+    if (u == P.tables.size()) P.tables.push_back(std::move(r));
+    P.rows.push_back(nullptr);  // pointed into tables once they stop moving (below)
+    P.table_of.push_back(int(u));
     P.lo.push_back(lut.lo()), P.sc.push_back(lut.scale()), P.last.push_back(float(lut.bins() - 1));
     P.absv.push_back(lut.absolute_value());
     // Bins b with non-zero opacity hold the values v with b ≤ (v − lo)·sc < b + 1 (clamped at both
@@ -90,6 +106,13 @@ SweepPlan compile_sweep(std::span<const PreparedField> fields, std::span<const T
     }
     P.vis_lo.push_back(vl), P.vis_hi.push_back(vh);
   }
+  for (std::size_t i = 0; i < P.rows.size(); ++i) P.rows[i] = P.tables[std::size_t(P.table_of[i])].data();
+  P.same_abs = std::all_of(P.absv.begin(), P.absv.end(), [&](char a) { return a == P.absv[0]; });
+  P.by_vis.resize(tasks.size());
+  std::iota(P.by_vis.begin(), P.by_vis.end(), 0);
+  if (P.same_abs)
+    std::stable_sort(P.by_vis.begin(), P.by_vis.end(),
+                     [&](int a, int b) { return P.vis_lo[std::size_t(a)] < P.vis_lo[std::size_t(b)]; });
   return P;
 }
 
@@ -470,8 +493,7 @@ std::uint64_t volume_ray(const SweepPlan& SP, const Ray& r, VolumeScratch& sc, s
     const float tr_stop = 1.0f - S.termination;
     const march::RayPos P{float(r.O[0] + t0 * r.D[0]), float(r.O[1] + t0 * r.D[1]), float(r.O[2] + t0 * r.D[2]),
                           float(dt * r.D[0]),          float(dt * r.D[1]),          float(dt * r.D[2])};
-    sc.live.resize(std::size_t(K));
-    std::iota(sc.live.begin(), sc.live.end(), 0);
+    sc.live = SP.by_vis;
     alignas(32) float v[kBlock];
     alignas(32) int bins[4][kBlock];
     for (std::int64_t k0 = 0; k0 <= kg_last && !sc.live.empty(); k0 += kBlock) {
@@ -483,14 +505,23 @@ std::uint64_t volume_ray(const SweepPlan& SP, const Ray& r, VolumeScratch& sc, s
         bmin = std::min(bmin, v[l]), bmax = std::max(bmax, v[l]), amin = std::min(amin, std::fabs(v[l])),
         amax = std::max(amax, std::fabs(v[l]));
       const bool finite = std::isfinite(bmin) && std::isfinite(bmax);
-      // Windows that see something in this block, four at a time (composite_group()).
-      int ids[4], g = 0;
-      std::size_t keep = 0;
+      // Windows that see something in this block, four at a time (composite_group()). With one
+      // value mapping (all |v| or all v) the live windows stay sorted by the low end of their visible
+      // range, so those that cannot see the block's largest value are not looked at.
+      std::size_t end = sc.live.size();
+      if (SP.same_abs && finite) {
+        const float top = SP.absv[0] ? amax : bmax;
+        end = std::size_t(std::partition_point(sc.live.begin(), sc.live.end(),
+                                               [&](int w) { return SP.vis_lo[std::size_t(w)] <= top; }) -
+                          sc.live.begin());
+      }
+      int ids[4], at[4], g = 0;
+      bool died = false;
       auto flush = [&]() {
         const march::VolRow* luts[4];
         float* as[4];
         int stops[4];
-        for (int q = 0; q < g; ++q) luts[q] = SP.rows[std::size_t(ids[q])].data(), as[q] = sc.acc[std::size_t(ids[q])].data();
+        for (int q = 0; q < g; ++q) luts[q] = SP.rows[std::size_t(ids[q])], as[q] = sc.acc[std::size_t(ids[q])].data();
         switch (g) {
           case 1: march::composite_group<1>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
           case 2: march::composite_group<2>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
@@ -498,23 +529,21 @@ std::uint64_t volume_ray(const SweepPlan& SP, const Ray& r, VolumeScratch& sc, s
           default: march::composite_group<4>(luts, bins, as, stops, n, k0, k_partial, partial, tr_stop); break;
         }
         for (int q = 0; q < g; ++q)
-          if (stops[q] < 0) sc.live[keep++] = ids[q];  // still live
+          if (stops[q] >= 0) sc.live[std::size_t(at[q])] = -1, died = true;  // opaque: leaves the ray
         g = 0;
       };
-      for (std::size_t i = 0; i < sc.live.size(); ++i) {
+      for (std::size_t i = 0; i < end; ++i) {
         const int w = sc.live[i];
         const float lo = SP.absv[std::size_t(w)] ? amin : bmin, hi = SP.absv[std::size_t(w)] ? amax : bmax;
-        if (finite && (hi < SP.vis_lo[std::size_t(w)] || lo > SP.vis_hi[std::size_t(w)])) {
-          sc.live[keep++] = w;  // every sample of the block is transparent for it: exact no-ops
-          continue;
-        }
+        if (finite && (hi < SP.vis_lo[std::size_t(w)] || lo > SP.vis_hi[std::size_t(w)]))
+          continue;  // every sample of the block is transparent for it: exact no-ops
         march::lut_bin_block<kRowShift>(v, SP.lo[std::size_t(w)], SP.sc[std::size_t(w)], SP.last[std::size_t(w)],
                                         SP.absv[std::size_t(w)] != 0, bins[g]);
-        ids[g++] = w;
+        ids[g] = w, at[g++] = int(i);
         if (g == 4) flush();
       }
       if (g) flush();
-      sc.live.resize(keep);
+      if (died) sc.live.erase(std::remove(sc.live.begin(), sc.live.end(), -1), sc.live.end());  // keeps the order
     }
   }
   for (int t = 0; t < K; ++t) {
