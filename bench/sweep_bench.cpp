@@ -21,6 +21,7 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,7 +36,9 @@
 #include "camera/rig_spec.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "core/memory.hpp"
 #include "insitu/config.hpp"
+#include "insitu/resources.hpp"
 #include "insitu/session.hpp"
 #include "render/renderer.hpp"
 #include "render/sweep.hpp"
@@ -187,6 +190,124 @@ void BM_SweepGrouped(benchmark::State& state) {
 }
 BENCHMARK(BM_SweepGrouped)->ArgName("windows")->Arg(0)->Arg(1)->Iterations(1)->UseManualTime()->Unit(benchmark::kMillisecond);
 
+std::int64_t resident_bytes() {
+  long pages = 0, resident = 0;
+  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(f);
+  }
+  return std::int64_t(resident) * ::sysconf(_SC_PAGESIZE);
+}
+
+constexpr int kSessionCameras = 8, kSessionWidth = 460, kSessionHeight = 448;
+
+insitu::SessionConfig session_config(bool iso, const std::string& dir) {
+  insitu::SessionConfig cfg;
+  cfg.output_dir = dir;
+  cfg.mode = insitu::OutputMode::overwrite;
+  cfg.keep_interrupted = false;
+  cfg.rig = "fibonacci:" + std::to_string(kSessionCameras);
+  cfg.width = kSessionWidth, cfg.height = kSessionHeight;
+  cfg.video.gop = 1;
+  insitu::TaskConfig t;
+  t.fields = {"p"};
+  if (iso) {
+    t.kind = TaskKind::isosurface;
+    t.name = "iso";
+    t.iso_relative = true;
+    for (int j = 0; j < kParams; ++j) t.isovalues.push_back(-0.9 + 1.8 * j / (kParams - 1));
+  } else {
+    t.kind = TaskKind::volume;
+    t.name = "p";
+    t.windows.clear();
+    for (int j = 0; j < kParams; ++j) t.windows.push_back({window_lo(j), window_lo(j) + 0.25, true});
+  }
+  cfg.tasks = {t};
+  cfg.validate();
+  return cfg;
+}
+
+// The child: one snapshot of the sweep through a Session; prints "base_rss cpu_s frames estimate".
+int session_child(bool iso, const std::string& dir) {
+  const DenseWaveScene waves = dense_wave_scene(kGrid);
+  const std::int64_t base = resident_bytes();
+  const double c0 = cpu_seconds();
+  insitu::SessionConfig cfg = session_config(iso, dir);
+  const MemoryEstimate e = insitu::estimate_session_memory(cfg, double(kGrid.dims[0]) * kGrid.dims[1] * kGrid.dims[2], kSessionCameras, 1,
+                                                           omp_get_max_threads());
+  std::fprintf(stderr, "estimate: %s\n", e.describe().c_str());
+  insitu::Session session(cfg, kGrid, insitu::LocalBlock::whole(kGrid));
+  session.snapshot(0.0, {insitu::FieldInput{"p", waves.p.data(), insitu::ScalarType::f32, {}}});
+  session.finalize();
+  const insitu::SessionStats st = session.stats();
+  std::printf("%lld %.6f %lld %.0f %.6f %.6f\n", (long long)base, cpu_seconds() - c0, (long long)st.frames_encoded,
+              e.total(), st.time.render, st.time.encode);
+  return 0;
+}
+
+// 1,000 parameters x 8 cameras x 460x448 through the Session in a child process (its peak RSS is its own).
+void BM_SessionSweep(benchmark::State& state) {
+  const bool iso = state.range(0) == 0;
+  for (auto _ : state) {
+    const std::string dir = (std::filesystem::temp_directory_path() / ("panoptes_sweep_bench_" + std::to_string(::getpid()))).string();
+    char self[4096];
+    const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0) throw Error("sweep_bench: cannot find its own executable");
+    self[n] = 0;
+    const std::string out = dir + ".out";
+    std::string arg = std::string("--session-child=") + (iso ? "iso" : "window") + ":" + dir;
+    char* argv[] = {self, arg.data(), nullptr};
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    if (posix_spawn(&pid, self, &fa, nullptr, argv, environ) != 0) throw Error("sweep_bench: cannot start the child");
+    posix_spawn_file_actions_destroy(&fa);
+    int status = 0;
+    rusage ru{};
+    ::wait4(pid, &status, 0, &ru);
+    long long base = 0, frames = 0;
+    double cpu = 0, estimate = 0, render_s = 0, encode_s = 0;
+    FILE* f = std::fopen(out.c_str(), "r");
+    const bool ok = f && std::fscanf(f, "%lld %lf %lld %lf %lf %lf", &base, &cpu, &frames, &estimate, &render_s, &encode_s) == 6;
+    if (f) std::fclose(f);
+    std::filesystem::remove_all(dir);
+    std::filesystem::remove(out);
+    if (!ok || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      state.SkipWithError("the session child failed (see its stderr)");
+      return;
+    }
+    const double peak = double(ru.ru_maxrss) * 1024.0;
+    const double streams = double(kSessionCameras) * kParams;
+    state.counters["peak_rss_GB"] = peak / 1e9;
+    state.counters["scene_rss_GB"] = double(base) / 1e9;
+    state.counters["estimate_GB"] = estimate / 1e9;
+    state.counters["bytes_per_stream"] = (peak - double(base)) / streams;
+    state.counters["session_cpu_s"] = cpu;
+    state.counters["render_s"] = render_s;
+    state.counters["finish_encode_s"] = encode_s;
+    state.counters["frames"] = double(frames);
+    state.SetIterationTime(cpu);
+  }
+}
+BENCHMARK(BM_SessionSweep)->ArgName("windows")->Arg(0)->Arg(1)->Iterations(1)->UseManualTime()->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::strncmp(argv[i], "--session-child=", 16) == 0) {
+      const std::string a = argv[i] + 16;
+      const std::size_t colon = a.find(':');
+      try {
+        return session_child(a.substr(0, colon) == "iso", a.substr(colon + 1));
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "sweep_bench session child: %s\n", e.what());
+        return 1;
+      }
+    }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
