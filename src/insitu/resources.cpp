@@ -45,12 +45,13 @@ MemoryEstimate estimate_session_memory(const SessionConfig& cfg, double block_po
         if (std::find(marched.begin(), marched.end(), f) == marched.end()) marched.push_back(f);
   if (!marched.empty()) e.add("corner copies", double(marched.size()) * block_points * 16);
   if (sweep_rendering(cfg, ranks)) {
-    // render_sweep(): one camera's 8-bit frames (4 bytes per pixel and task, a pixel's tasks padded
-    // to 64 bytes), and per encoding thread one partial image (20 B/px), one frame (4 B/px) and an
+    // render_sweep(): one camera's frames (4 bytes per pixel and task, isosurfaces 2; a pixel's tasks
+    // padded to 64 bytes), and per encoding thread one partial image (20 B/px), one frame (4 B/px) and an
     // encoder; an isosurface sweep also keeps the field's staggered differences (12 B per point).
-    e.add("sweep frames", px * std::ceil(4.0 * tasks / 64) * 64);
+    const bool iso = cfg.tasks[0].kind == render::TaskKind::isosurface;
+    e.add("sweep frames", px * std::ceil((iso ? 2.0 : 4.0) * tasks / 64) * 64);
     e.add("finished frames", std::max(encode_threads, 1) * (px * 24 + video::live_encoder_bytes(px)));
-    if (cfg.tasks[0].kind == render::TaskKind::isosurface) e.add("sweep gradients", block_points * 12);
+    if (iso) e.add("sweep gradients", block_points * 12);
   } else {
     // Partial images (premultiplied RGBA + depth floats) of one camera round: rendered ones, their
     // send buffers and the received ones, plus the composite; full frames at worst.

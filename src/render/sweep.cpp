@@ -46,7 +46,6 @@ struct SweepPlan {
   std::vector<int> order;
   std::vector<float> sorted;
   std::vector<std::array<float, 3>> colour;  // per task
-  bool one_colour = false;                    // every task's colour is colour[0]
   // Volume windows: rows, bin mapping, and the hull [vis_lo, vis_hi] of values (|v| for an
   // absolute-value map) that reach a bin of non-zero opacity (empty: vis_lo > vis_hi).
   // Each window's LUT rows, shared between windows whose rows are the same (one transfer function
@@ -77,7 +76,6 @@ SweepPlan compile_sweep(std::span<const PreparedField> fields, std::span<const T
                      [&](int a, int b) { return tasks[std::size_t(a)].isovalue < tasks[std::size_t(b)].isovalue; });
     for (int i : P.order) P.sorted.push_back(tasks[std::size_t(i)].isovalue);
     for (const TaskSpec& t : tasks) P.colour.push_back({t.surface_colour.r, t.surface_colour.g, t.surface_colour.b});
-    P.one_colour = std::all_of(P.colour.begin(), P.colour.end(), [&](const auto& c) { return c == P.colour[0]; });
     return P;
   }
   for (const TaskSpec& t : tasks) {
@@ -280,39 +278,27 @@ struct IsoScratch {
         gx(std::size_t(K) + 8), gy(std::size_t(K) + 8), gz(std::size_t(K) + 8) {}
 };
 
-// shade_hit()'s headlight for hits 0 … nh − 1 of a block from their gradients: diffuse
-// 0.15 + 0.85·|n·l|, specular 0.25·|n·l|^32, two-sided (a zero gradient faces the camera); each
-// written opaque to its slot px + 4·j.
-void shade_hits(const SweepPlan& SP, const IsoScratch& sc, int nh, const float dir[3], std::uint8_t* px) {
+// |n·l| of hits 0 … nh − 1 of a block from their gradients (a zero gradient faces the camera), written
+// as SweepFrames' 2-byte code 1 + |n·l|·65534 to slot px + 2·j.
+void shade_hits(const IsoScratch& sc, int nh, const float dir[3], std::uint8_t* px) {
   int h = 0;
 #ifdef PANOPTES_RENDER_AVX2
-  if (SP.one_colour) {
-    const __m256 dx = _mm256_set1_ps(dir[0]), dy = _mm256_set1_ps(dir[1]), dz = _mm256_set1_ps(dir[2]);
-    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), k255 = _mm256_set1_ps(255.0f);
-    const __m256 half = _mm256_set1_ps(0.5f);
-    const __m256 cr = _mm256_set1_ps(SP.colour[0][0]), cg = _mm256_set1_ps(SP.colour[0][1]),
-                 cb = _mm256_set1_ps(SP.colour[0][2]);
-    for (; h + 8 <= nh; h += 8) {
-      const __m256 gx = _mm256_loadu_ps(&sc.gx[std::size_t(h)]), gy = _mm256_loadu_ps(&sc.gy[std::size_t(h)]),
-                   gz = _mm256_loadu_ps(&sc.gz[std::size_t(h)]);
-      const __m256 nn = _mm256_fmadd_ps(gx, gx, _mm256_fmadd_ps(gy, gy, _mm256_mul_ps(gz, gz)));
-      const __m256 d = _mm256_fmadd_ps(gx, dx, _mm256_fmadd_ps(gy, dy, _mm256_mul_ps(gz, dz)));
-      __m256 ndl = _mm256_min_ps(one, _mm256_div_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), d), _mm256_sqrt_ps(nn)));
-      ndl = _mm256_blendv_ps(one, ndl, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
-      __m256 p32 = ndl;
-      for (int i = 0; i < 5; ++i) p32 = _mm256_mul_ps(p32, p32);
-      const __m256 diffuse = _mm256_fmadd_ps(_mm256_set1_ps(0.85f), ndl, _mm256_set1_ps(0.15f));
-      const __m256 spec = _mm256_mul_ps(_mm256_set1_ps(0.25f), p32);
-      auto byte = [&](__m256 c) {  // sweep_byte()
-        const __m256 v = _mm256_mul_ps(_mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(c, diffuse, spec), zero), one), k255);
-        return _mm256_cvttps_epi32(_mm256_add_ps(v, half));
-      };
-      const __m256i rgba = _mm256_or_si256(
-          _mm256_or_si256(byte(cr), _mm256_slli_epi32(byte(cg), 8)),
-          _mm256_or_si256(_mm256_slli_epi32(byte(cb), 16), _mm256_set1_epi32(int(0xff000000u))));
-      alignas(32) std::uint32_t out[8];
-      _mm256_store_si256(reinterpret_cast<__m256i*>(out), rgba);
-      for (int q = 0; q < 8; ++q) std::memcpy(px + 4 * std::size_t(sc.hj[std::size_t(h + q)]), &out[q], 4);
+  const __m256 dx = _mm256_set1_ps(dir[0]), dy = _mm256_set1_ps(dir[1]), dz = _mm256_set1_ps(dir[2]);
+  const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  for (; h + 8 <= nh; h += 8) {
+    const __m256 gx = _mm256_loadu_ps(&sc.gx[std::size_t(h)]), gy = _mm256_loadu_ps(&sc.gy[std::size_t(h)]),
+                 gz = _mm256_loadu_ps(&sc.gz[std::size_t(h)]);
+    const __m256 nn = _mm256_fmadd_ps(gx, gx, _mm256_fmadd_ps(gy, gy, _mm256_mul_ps(gz, gz)));
+    const __m256 d = _mm256_fmadd_ps(gx, dx, _mm256_fmadd_ps(gy, dy, _mm256_mul_ps(gz, dz)));
+    __m256 ndl = _mm256_min_ps(one, _mm256_div_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), d), _mm256_sqrt_ps(nn)));
+    ndl = _mm256_blendv_ps(one, ndl, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
+    const __m256i code = _mm256_add_epi32(
+        _mm256_cvttps_epi32(_mm256_fmadd_ps(ndl, _mm256_set1_ps(65534.0f), _mm256_set1_ps(0.5f))), _mm256_set1_epi32(1));
+    alignas(32) std::uint32_t out[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(out), code);
+    for (int q = 0; q < 8; ++q) {
+      const std::uint16_t c = std::uint16_t(out[q]);
+      std::memcpy(px + 2 * std::size_t(sc.hj[std::size_t(h + q)]), &c, 2);
     }
   }
 #endif
@@ -320,14 +306,8 @@ void shade_hits(const SweepPlan& SP, const IsoScratch& sc, int nh, const float d
     const float gx = sc.gx[std::size_t(h)], gy = sc.gy[std::size_t(h)], gz = sc.gz[std::size_t(h)];
     const float nn = gx * gx + gy * gy + gz * gz;
     const float ndl = nn > 0 ? std::min(1.0f, std::fabs(gx * dir[0] + gy * dir[1] + gz * dir[2]) / std::sqrt(nn)) : 1.0f;
-    float p32 = ndl;
-    for (int i = 0; i < 5; ++i) p32 *= p32;
-    const float diffuse = 0.15f + 0.85f * ndl, spec = 0.25f * p32;
-    const int j = sc.hj[std::size_t(h)];
-    const float* col = SP.colour[std::size_t(SP.one_colour ? 0 : SP.order[std::size_t(j)])].data();
-    std::uint8_t* o = px + 4 * std::size_t(j);
-    o[0] = sweep_byte(col[0] * diffuse + spec), o[1] = sweep_byte(col[1] * diffuse + spec),
-    o[2] = sweep_byte(col[2] * diffuse + spec), o[3] = 255;
+    const std::uint16_t c = std::uint16_t(int(ndl * 65534.0f + 0.5f) + 1);
+    std::memcpy(px + 2 * std::size_t(sc.hj[std::size_t(h)]), &c, 2);
   }
 }
 
@@ -353,7 +333,7 @@ inline bool any_unhit(const std::vector<std::uint64_t>& hit, int j0, int j1) {
   return false;
 }
 
-// One isosurface-sweep ray: writes slot j's pixel (px + 4·j) for every sorted isovalue j it hits.
+// One isosurface-sweep ray: writes slot j's code (px + 2·j) for every sorted isovalue j it hits.
 // Returns the samples interpolated.
 //
 // A hit is found and placed as render_brick() places one: the first segment (samples k − 1, k)
@@ -467,7 +447,7 @@ std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const Is
       sc.gy[std::size_t(h)] = c[1][0] + s * (c[1][1] + s * (c[1][2] + s * c[1][3]));
       sc.gz[std::size_t(h)] = c[2][0] + s * (c[2][1] + s * (c[2][2] + s * c[2][3]));
     }
-    shade_hits(SP, sc, nh, dir, px);
+    shade_hits(sc, nh, dir, px);
     vb[0] = vb[n], ib[0] = ib[n];
     for (int a = 0; a < 3; ++a) g[a][0] = g[a][8], g[a][1] = g[a][9], g[a][2] = g[a][10];
     g_valid = true;
@@ -584,9 +564,9 @@ inline bool slab(const double O[3], const double D[3], const double lo[3], const
 
 }  // namespace
 
-void SweepFrames::resize(int w, int h, int tasks) {
-  width = w, height = h, count = tasks;
-  stride = (4 * std::size_t(tasks) + 63) / 64 * 64;
+void SweepFrames::resize(int w, int h, int tasks, int bytes) {
+  width = w, height = h, count = tasks, task_bytes = bytes;
+  stride = (std::size_t(bytes) * std::size_t(tasks) + 63) / 64 * 64;
   const std::size_t need = std::size_t(w) * std::size_t(h) * stride + 64;
   if (storage_.size() != need) {
     const bool grew = need > storage_.capacity();
@@ -609,8 +589,28 @@ void SweepFrames::to_partial(int t, PartialImage& out) const {
     throw Error("sweep frames: task " + std::to_string(t) + " of " + std::to_string(count));
   out.resize(width, height, {0, 0, width, height});
   const std::size_t n = std::size_t(width) * std::size_t(height);
-  const std::uint8_t* p = data() + 4 * std::size_t(slot[std::size_t(t)]);
+  const std::uint8_t* p = data() + std::size_t(task_bytes) * std::size_t(slot[std::size_t(t)]);
   constexpr float inv = 1.0f / 255.0f;
+  if (task_bytes == 2) {
+    const std::array<float, 3>& col = colour[std::size_t(t)];
+    for (std::size_t i = 0; i < n; ++i, p += stride) {
+      float* o = out.rgba.data() + 4 * i;
+      std::uint16_t code;
+      std::memcpy(&code, p, 2);
+      if (!code) {
+        o[0] = o[1] = o[2] = o[3] = 0, out.depth[i] = PartialImage::kNoDepth;
+        continue;
+      }
+      // shade_hit()'s headlight: diffuse 0.15 + 0.85·|n·l|, specular 0.25·|n·l|^32.
+      const float ndl = float(code - 1) * (1.0f / 65534.0f);
+      float p32 = ndl;
+      for (int k = 0; k < 5; ++k) p32 *= p32;
+      const float diffuse = 0.15f + 0.85f * ndl, spec = 0.25f * p32;
+      for (int k = 0; k < 3; ++k) o[k] = std::min(1.0f, col[std::size_t(k)] * diffuse + spec);
+      o[3] = 1, out.depth[i] = 0;
+    }
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i, p += stride) {
     float* o = out.rgba.data() + 4 * i;
     o[0] = p[0] * inv, o[1] = p[1] * inv, o[2] = p[2] * inv, o[3] = p[3] * inv;
@@ -651,7 +651,8 @@ RenderStats render_sweep(const camera::Camera& cam, std::span<const PreparedFiel
   for (TaskSpec& t : local) t.field = 0;
   const SweepPlan SP = compile_sweep(one, local, opt);
   const int W = cam.width(), H = cam.height(), K = SP.K;
-  out.resize(W, H, K);
+  out.resize(W, H, K, SP.iso ? 2 : 4);
+  out.colour = SP.iso ? SP.colour : std::vector<std::array<float, 3>>{};
   // Isosurfaces are stored in the order of their isovalues (a segment's hits are then adjacent).
   out.slot.resize(std::size_t(K));
   for (int j = 0; j < K; ++j) out.slot[std::size_t(SP.iso ? SP.order[std::size_t(j)] : j)] = j;

@@ -4,6 +4,7 @@
 // kMaxTasksPerMarch tasks per march and keeps 20 bytes per pixel per task; a 1,000-value sweep there
 // is 16 marches and 4 GB of partial images per 460x448 camera. Here the cost of a ray grows with the
 // surfaces it hits, not with the number of isovalues, and a frame takes 4 bytes per pixel.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -14,28 +15,34 @@
 
 namespace panoptes::render {
 
-/// The frames of one camera for every task of a sweep: premultiplied RGBA8 per pixel and task,
-/// stored pixel-major (a pixel's `stride` bytes hold its tasks' RGBA, slot after slot) because a ray
-/// writes all its tasks' values at once; task t is stored in slot[t] (isosurfaces in the order of
-/// their isovalues). The stride is a multiple of 64 bytes and pixels start on 64-byte boundaries, so
-/// a ray's pixel is written by streaming stores that bypass the caches.
+/// The frames of one camera for every task of a sweep, stored pixel-major (a pixel's `stride` bytes
+/// hold its tasks' values, slot after slot) because a ray writes all its tasks' values at once; task t
+/// is stored in slot[t] (isosurfaces in the order of their isovalues). A volume task's value is its
+/// premultiplied RGBA8 (4 bytes); an isosurface's is 2 bytes: 0 where the ray misses it, else
+/// 1 + |n·l|·65534 (its colour, in `colour`, and |n·l| give the headlight shading, so half the bytes of
+/// RGBA8). The stride is a multiple of 64 bytes and pixels start on 64-byte boundaries, so a ray's
+/// pixel is written by streaming stores that bypass the caches.
 struct SweepFrames {
   int width = 0, height = 0, count = 0;
-  std::size_t stride = 0;  ///< bytes per pixel (4·count rounded up to 64)
+  int task_bytes = 4;      ///< bytes per task and pixel: 4 (volume, RGBA8) or 2 (isosurface)
+  std::size_t stride = 0;  ///< bytes per pixel (task_bytes·count rounded up to 64)
   std::vector<int> slot;
+  std::vector<std::array<float, 3>> colour;  ///< isosurfaces: each task's surface colour
 
-  /// Premultiplied RGBA8 of task t at pixel (x, y).
-  const std::uint8_t* at(int x, int y, int t) const {
-    return pixel(x, y) + 4 * std::size_t(slot[std::size_t(t)]);
+  /// Whether task t shows something at pixel (x, y).
+  bool shows(int x, int y, int t) const {
+    const std::uint8_t* v = pixel(x, y) + std::size_t(task_bytes) * std::size_t(slot[std::size_t(t)]);
+    return task_bytes == 2 ? (v[0] | v[1]) != 0 : v[3] != 0;
   }
   const std::uint8_t* pixel(int x, int y) const { return data() + (std::size_t(y) * std::size_t(width) + std::size_t(x)) * stride; }
   std::uint8_t* pixel(int x, int y) { return data() + (std::size_t(y) * std::size_t(width) + std::size_t(x)) * stride; }
-  /// Resizes for a w×h image of `tasks` tasks (capacity reused; contents unspecified).
-  void resize(int w, int h, int tasks);
+  /// Resizes for a w×h image of `tasks` tasks of `bytes` bytes each (capacity reused; contents unspecified).
+  void resize(int w, int h, int tasks, int bytes);
   /// Bytes held (what a session keeps per camera being rendered).
   std::size_t bytes() const { return storage_.capacity(); }
-  /// Task t's frame as a full-image partial (what finish_image() takes): colour and alpha back to
-  /// floats (k/255), depth 0 where the task shows something, +∞ elsewhere. Reuses `out`'s buffers.
+  /// Task t's frame as a full-image partial (what finish_image() takes): colour and alpha as floats
+  /// (k/255, or the isosurface's shading), depth 0 where the task shows something, +∞ elsewhere.
+  /// Reuses `out`'s buffers.
   void to_partial(int t, PartialImage& out) const;
 
  private:
