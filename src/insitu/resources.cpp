@@ -8,6 +8,7 @@
 #include "camera/volume_rigs.hpp"
 #include "core/error.hpp"
 #include "insitu/task_plan.hpp"
+#include "render/renderer.hpp"
 #include "store/database.hpp"
 #include "video/writer_memory.hpp"
 
@@ -44,10 +45,20 @@ MemoryEstimate estimate_session_memory(const SessionConfig& cfg, double block_po
       for (const auto& f : t.fields)
         if (std::find(marched.begin(), marched.end(), f) == marched.end()) marched.push_back(f);
   if (!marched.empty()) e.add("corner copies", double(marched.size()) * block_points * 16);
-  // Partial images (premultiplied RGBA + depth floats) of one camera round: rendered ones, their
-  // send buffers and the received ones, plus the composite; full frames at worst.
-  e.add("partial images", (3.0 * ranks + 1) * tasks * px * 20);
-  e.add("finished frames", tasks * px * 3 + std::max(encode_threads, 1) * video::live_encoder_bytes(px));
+  if (sweep_rendering(cfg, ranks)) {
+    // render_sweep(): one camera's frames (4 bytes per pixel and task, isosurfaces 2; a pixel's tasks
+    // padded to 64 bytes), and per encoding thread one partial image (20 B/px), one frame (4 B/px) and an
+    // encoder; an isosurface sweep also keeps the field's staggered differences (12 B per point).
+    const bool iso = cfg.tasks[0].kind == render::TaskKind::isosurface;
+    e.add("sweep frames", px * std::ceil((iso ? 2.0 : 4.0) * tasks / 64) * 64);
+    e.add("finished frames", std::max(encode_threads, 1) * (px * 24 + video::live_encoder_bytes(px)));
+    if (iso) e.add("sweep gradients", block_points * 12);
+  } else {
+    // Partial images (premultiplied RGBA + depth floats) of one camera round: rendered ones, their
+    // send buffers and the received ones, plus the composite; full frames at worst.
+    e.add("partial images", (3.0 * ranks + 1) * tasks * px * 20);
+    e.add("finished frames", tasks * px * 3 + std::max(encode_threads, 1) * video::live_encoder_bytes(px));
+  }
   if (packed_layout(cfg, (long long)(double(cameras) * tasks))) {
     // docs/formats.md, "Packed layout": a 96-byte record and ~13 bytes of heap per idle stream, and the
     // compressed frames of the snapshot until its flush (23 kB per 920x896 frame at crf 23, ~0.03 B per
@@ -70,6 +81,16 @@ MemoryEstimate estimate_grid_stage_memory(double source_points, double cover_poi
   e.add("grid stage: resampled fields", slab * 4 * std::max(fields, 1));
   e.add("grid stage: gathered source points", source_share * 4 * 3);
   return e;
+}
+
+bool sweep_rendering(const SessionConfig& cfg, int ranks) {
+  if (ranks != 1 || cfg.tasks.size() != 1) return false;
+  const TaskConfig& t = cfg.tasks[0];
+  const std::size_t K = planned_task_count(t);
+  if (K < 2) return false;
+  if (t.kind == render::TaskKind::isosurface)
+    return !cfg.render.iso_antialias || K > std::size_t(render::kMaxTasksPerMarch);
+  return t.kind == render::TaskKind::volume && t.fields.size() == 1;
 }
 
 long long rig_camera_count(const SessionConfig& cfg, const render::GridGeometry& grid) {

@@ -24,6 +24,15 @@ MemoryEstimate estimate_session_memory(const SessionConfig& config, double block
 /// an 8x200x400 shell peaked at 2.5 GB against an estimate of 348 MB, issue 44).
 MemoryEstimate estimate_grid_stage_memory(double source_points, double cover_points, int ranks, int fields);
 
+/// Whether a session of `config` on `ranks` ranks renders its tasks as one sweep (render::render_sweep():
+/// one march per ray for every value, 8-bit frames, finished and encoded task by task): one rank, and
+/// the tasks are one [[task]] with several isovalues, or one single-field volume [[task]] with several
+/// windows. An isosurface sweep of at most render::kMaxTasksPerMarch values with [render]
+/// iso_antialias keeps the general path (render_sweep() does not anti-alias); a longer one takes the
+/// sweep path without anti-aliasing (the general path needed 20 bytes per pixel and value per camera:
+/// 1,000 values at 460x448 refused 16.5 GB, issue 45).
+bool sweep_rendering(const SessionConfig& config, int ranks);
+
 /// The number of cameras config.rig gives: computed for built-in rigs, read for file rigs (bounded).
 long long rig_camera_count(const SessionConfig& config, const render::GridGeometry& grid);
 

@@ -200,7 +200,59 @@ const char* unpack(const char* in, const char* end, int width, int height, rende
 
 }  // namespace
 
+// One rank rendering one sweep: per camera render_sweep() into 8-bit frames, then each task's frame
+// finished and encoded from them, tasks in parallel (appends to different streams may run
+// concurrently). The session holds one camera's sweep frames (4 bytes per pixel and task) and per
+// thread one partial image and one frame, whatever the number of tasks.
+void Session::Impl::render_sweep_snapshot(int frame) {
+  const int C = rig.size();
+  const int K = int(plan.size());
+  const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
+  render::OutlineStyle outline;
+  outline.enabled = cfg.outline || (cfg.compass && cfg.projection == "equirectangular");
+  outline.box = cfg.outline;
+  outline.compass = cfg.compass;
+  outline.sky = camera::SkyFrame::of(cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis));
+  store::DatabaseWriter& w = *writer;
+  for (int c = 0; c < C; ++c) {
+    auto t0 = Clock::now();
+    const camera::Camera& cam = cameras[std::size_t(c)];
+    render::render_sweep(cam, prepared, specs, sweep_frames, cfg.render);
+    time.render += since(t0);
+    if (!deferred_failure.empty()) continue;  // a failed append: this rank encodes no more
+    t0 = Clock::now();
+    std::exception_ptr error;
+#pragma omp parallel
+    {
+      render::PartialImage part;
+      Image image;
+#pragma omp for schedule(dynamic)
+      for (int t = 0; t < K; ++t) {
+        try {
+          sweep_frames.to_partial(t, part);
+          render::finish_image_into(part, cam, grid, image, bg, outline);
+          if (observer) {
+#pragma omp critical(panoptes_sweep_observer)
+            observer(c, t, frame, image);
+          }
+          w.append(c, t, image);
+        } catch (...) {
+#pragma omp critical(panoptes_encode_error)
+          if (!error) error = std::current_exception();
+        }
+      }
+    }
+    if (error) {
+      deferred_failure = "encoding on rank " + std::to_string(rank) + " failed: " + exception_message(error);
+      continue;
+    }
+    frames_encoded += K;
+    time.encode += since(t0);
+  }
+}
+
 void Session::Impl::render_snapshot(int frame) {
+  if (sweep && render::is_sweep(specs)) return render_sweep_snapshot(frame);
   const int C = rig.size();
   const int K = int(plan.size());
 #ifdef PANOPTES_HAVE_MPI

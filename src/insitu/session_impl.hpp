@@ -39,6 +39,7 @@
 #include "insitu/resources.hpp"
 #include "insitu/task_plan.hpp"
 #include "render/renderer.hpp"
+#include "render/sweep.hpp"
 #include "store/database.hpp"
 #include "core/version.hpp"
 
@@ -114,6 +115,11 @@ struct Session::Impl {
   std::vector<std::vector<Image>> batch;
   std::vector<int> batch_camera;
   int batch_n = 0;
+  // One rank, one sweep (sweep_rendering()): each camera's frames come from render::render_sweep()
+  // in 8 bits, and are finished and encoded task by task from there, so the session holds one
+  // camera's sweep frames and a partial and a frame per thread instead of K of each per camera.
+  bool sweep = false;
+  render::SweepFrames sweep_frames;
   std::int64_t frames_encoded = 0;
   Timings time;
   // The in-situ overhead: CPU time of the process (all threads) inside the session's calls on this
@@ -164,6 +170,7 @@ struct Session::Impl {
   void render_snapshot_banded(int frame);
 #endif
   void encode_batch();
+  void render_sweep_snapshot(int frame);
   void checkpoint(double time);
 };
 

@@ -142,8 +142,14 @@ void Session::Impl::init() {
   received.assign(std::size_t(size), std::vector<render::PartialImage>(plan.size()));
   composited.resize(plan.size());
   parts.resize(plan.size());
-  batch.assign(kEncodeBatch, std::vector<Image>(plan.size()));
   batch_camera.assign(kEncodeBatch, 0);
+  // A whole-domain brick on one rank rendering one sweep: render_sweep(), frames task by task.
+  sweep = sweep_rendering(cfg, size) && me().has_brick && me().brick == render::Brick::whole(grid);
+  if (!sweep) {
+    batch.assign(kEncodeBatch, std::vector<Image>(plan.size()));
+  } else {
+    partials.clear(), received.clear(), composited.clear(), parts.clear();
+  }
 }
 
 // Refuses, before the rig, the writers and the buffers exist, a session this rank cannot hold.

@@ -195,6 +195,53 @@ TEST(InsituSession, ExpandsSweepsIntoTasks) {
   fs::remove_all(dir);
 }
 
+// Issue 45: one rank rendering one sweep takes render_sweep() (sweep_rendering()), and its frames are
+// those of the general path, which the same sweep beside a second task takes.
+TEST(InsituSession, ASweepRendersAsTheGeneralPathDoes) {
+  const std::string sweep_task = R"(
+[image]
+width = 48
+height = 40
+[rig]
+spec = "fibonacci:3"
+[render]
+iso_antialias = false
+[[task]]
+name = "iso"
+type = "isosurface"
+field = "f"
+isovalues = [0.6, -0.2, 0.1, 0.35]
+relative = true
+)";
+  const std::string other_task = "[[task]]\nname = \"v\"\nfield = \"f\"\n";
+  const auto f = field(0.5);
+  auto run = [&](const std::string& text, const fs::path& dir, bool expect_sweep) {
+    auto cfg = insitu::parse_session_config_text(text, "sweep");
+    cfg.output_dir = dir.string();
+    cfg.mode = insitu::OutputMode::overwrite;
+    EXPECT_EQ(insitu::sweep_rendering(cfg, 1), expect_sweep);
+    std::vector<Image> frames(12);  // [camera][isovalue]
+    {
+      insitu::Session s(cfg, grid(), insitu::LocalBlock::whole(grid()));
+      s.set_frame_observer([&](int camera, int task, int, const Image& image) {
+        if (task < 4) frames[std::size_t(camera * 4 + task)] = image;
+      });
+      s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
+      s.finalize();
+      EXPECT_EQ(s.stats().frames_encoded, 3 * std::int64_t(cfg.tasks.size() == 1 ? 4 : 5));
+    }
+    fs::remove_all(dir);
+    return frames;
+  };
+  const fs::path base = fs::temp_directory_path() / ("insitu_sweep_" + std::to_string(::getpid()));
+  const std::vector<Image> swept = run(sweep_task, base.string() + "a", true);
+  const std::vector<Image> general = run(sweep_task + other_task, base.string() + "b", false);
+  for (std::size_t i = 0; i < swept.size(); ++i) {
+    ASSERT_EQ(swept[i].pixels.size(), general[i].pixels.size()) << "camera " << i / 4 << ", isovalue " << i % 4;
+    EXPECT_GE(std::min(99.0, psnr(swept[i], general[i])), 45.0) << "camera " << i / 4 << ", isovalue " << i % 4;
+  }
+}
+
 TEST(InsituSession, MissingFieldIsAnError) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_missing_" + std::to_string(::getpid()));
   insitu::Session s(small_config(dir), grid(), insitu::LocalBlock::whole(grid()));
