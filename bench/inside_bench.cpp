@@ -141,20 +141,23 @@ void BM_DenseInside(benchmark::State& state) {
   render(full, out_full, full_images);  // first touch of both paths' buffers, outside the timing
   render(fast, out_fast, images);
   RenderStats st_fast;
+  // Per iteration one full march (3-4 CPU-s) and kFast frames of the fast path, so that the fast
+  // path's figure, a fraction of a second per frame, is not one frame's noise on the shared machine.
+  constexpr int kFast = 4;
   double cpu_fast = 0, cpu_full = 0;
   for (auto _ : state) {
     double c0 = process_cpu_seconds();
     render(full, out_full, full_images);
     cpu_full += process_cpu_seconds() - c0;
     c0 = process_cpu_seconds();
-    st_fast = render(fast, out_fast, images);
+    for (int r = 0; r < kFast; ++r) st_fast = render(fast, out_fast, images);
     cpu_fast += process_cpu_seconds() - c0;
     benchmark::DoNotOptimize(images.data());
   }
   const double frames = double(state.iterations());
-  state.counters["frames_core_s"] = frames / cpu_fast;  // target >= 2
+  state.counters["frames_core_s"] = kFast * frames / cpu_fast;  // target >= 2
   state.counters["full_frames_core_s"] = frames / cpu_full;
-  state.counters["speedup"] = cpu_full / cpu_fast;
+  state.counters["speedup"] = cpu_full / (cpu_fast / kFast);
   double worst = std::numeric_limits<double>::infinity();
   for (std::size_t t = 0; t < images.size(); ++t) worst = std::min(worst, psnr(images[t], full_images[t]));
   state.counters["psnr_db"] = std::min(worst, 999.0);  // target >= 45
