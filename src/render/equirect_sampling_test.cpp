@@ -136,7 +136,7 @@ TEST(EquirectSampling, FramesFromInsideMatchTheFullMarchWithin45dB) {
     const Comparison r = compare_with_full_march(cams[ci], grid, fields, tasks);
     std::printf("camera %zu: worst %.2f dB, %.1f %% of the pixels marched\n", ci, r.worst_db, 100 * r.marched);
     EXPECT_GE(r.worst_db, 45.0);
-    EXPECT_LT(r.marched, 0.75);  // measured 45 % and 65 % (the bench's 1920x960 frame: 14 %)
+    EXPECT_LT(r.marched, 0.75);  // measured 45 % and 65 % at a tolerance of 4/255, 23 % and 46 % at 10/255 (the bench's 1920x960 frame: 14 %)
   }
 }
 
@@ -152,5 +152,5 @@ TEST(EquirectSampling, DenseScenesAreRefinedNotBlurred) {
   const Comparison r = compare_with_full_march(cam, grid, fields, paper_tasks(views));
   std::printf("dense: worst %.2f dB, %.1f %% of the pixels marched\n", r.worst_db, 100 * r.marched);
   EXPECT_GE(r.worst_db, 45.0);
-  EXPECT_GT(r.marched, 0.8);  // measured 94.5 %; without refinement 26 %
+  EXPECT_GT(r.marched, 0.6);  // measured 94.5 % at a tolerance of 4/255 (64 dB), 71 % at 10/255 (58 dB); without refinement 26 %
 }

@@ -35,7 +35,7 @@ struct RenderOptions {
   /// Equirectangular cameras: adaptive sampling on the sphere (render/equirect_sampling.hpp) whatever
   /// `adaptive` says — 64×32-pixel tiles (`tile` does not apply), a coarse lattice of rows about
   /// `equirect_lattice_deg` apart whose columns widen by 1/cos(latitude) toward the poles, refined where
-  /// corners differ by more than `adaptive_tolerance`. A 360° frame from inside the volume marches
+  /// corners differ by more than `equirect_tolerance`. A 360° frame from inside the volume marches
   /// every pixel through the domain; this cuts its cost ~8× within 45 dB of the full march (issue 32,
   /// docs/rendering-journal.md). Like any adaptive sampling it can miss a feature smaller than the
   /// lattice that lies between its rays. Bricks of a decomposition then composite as adaptive images
@@ -44,6 +44,11 @@ struct RenderOptions {
   /// Row spacing of the equirectangular coarse lattice in degrees (the columns' at the equator): the
   /// largest power of two of pixels not above it, at least 2 (1920 px wide: 8 px; 768: 2 px).
   double equirect_lattice_deg = 1.5;
+  /// Largest corner range interpolated in equirectangular frames (what `adaptive_tolerance` is for
+  /// perspective ones). 10/255, not 4/255: from inside a dense field (issue 45, inside_bench's
+  /// BM_DenseInside) 4/255 refined a third of the pixels down to single ones and kept the frame at
+  /// 59 dB of the full march; 10/255 marches 15 % at 50 dB, ~2.3x cheaper (docs/rendering.md, Round 12).
+  float equirect_tolerance = 10.0f / 255;
   /// Isosurface anti-aliasing (render/iso_edges.hpp): rays that graze or nearly miss a surface
   /// give it partial coverage (box filter of one pixel), so silhouettes are not stair-stepped.
   /// Off in the library (images stay those of the reference renderer); the product's
