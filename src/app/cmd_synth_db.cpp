@@ -29,14 +29,13 @@ struct Args {
   int cameras = 8, tasks = 2, frames = 10;
   std::string size = "64x64";
   bool overwrite = false;
-  std::string layout = "auto";
   int gop = 10, crf = -1, threads = 0;
   std::string preset, title = "synthetic database";
   bool force = false;
   std::string lattice, projection = "perspective";
   int shells = 1;
   std::string axes;  // "3x2x2": value counts of up to 4 parameter axes
-  std::string layout;  // "", "files" or "packed"
+  std::string layout;  // "" (the writer's choice: auto), "auto", "files" or "packed"
   bool gop_given = false;
 };
 
@@ -81,7 +80,7 @@ void run(const Args& a, const std::string& command_line) {
   o.height = (*size)[1];
   o.overwrite = a.overwrite;
   o.overwrite_option = "--overwrite";
-  o.layout = a.layout;
+  o.layout = a.layout.empty() ? "auto" : a.layout;
   if (!a.lattice.empty()) {
     const auto l = parse_dims_text(a.lattice, 3, 4);
     if (!l || (*l)[0] < 1 || (*l)[1] < 1 || (*l)[2] < 1)
@@ -102,8 +101,8 @@ void run(const Args& a, const std::string& command_line) {
   o.threads = a.threads;
   o.title = a.title;
   o.command_line = command_line;
-  if (!a.layout.empty() && a.layout != "files" && a.layout != "packed")
-    throw Error("--layout \"" + a.layout + "\": expected files or packed");
+  if (!a.layout.empty() && a.layout != "auto" && a.layout != "files" && a.layout != "packed")
+    throw Error("--layout \"" + a.layout + "\": expected auto, files or packed");
   const bool packed = a.layout == "packed";
   // The packed writer encodes keyframes only: gop 1 unless asked otherwise (then the writer refuses).
   o.video.gop = packed && !a.gop_given ? 1 : a.gop;
@@ -160,10 +159,6 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_option("--frames", args->frames, "Frames per movie")->check(CLI::Range(1, 1 << 20))->capture_default_str();
   sub->add_option("--size", args->size, "Frame size WIDTHxHEIGHT (at least 40x32 for the stamp)")->capture_default_str();
   sub->add_flag("--overwrite", args->overwrite, "Replace an existing database in OUT");
-  sub->add_option("--layout", args->layout,
-                  "Movie layout: auto (packed from 1024 streams at gop 1), files (one MP4 per stream) or packed (one "
-                  "pack file + index; needs --gop 1)")
-      ->check(CLI::IsMember({"auto", "files", "packed"}))->capture_default_str();
   // Not the video default (1): an intra-only writer opens an x264 encoder per frame, which for tiny
   // frames costs 2.6x the CPU of one encoder per movie (measured: 10 vs 3.8 ms per 64x64 10-frame stream).
   sub->add_option("--gop", args->gop, "Keyframe interval in frames")->check(CLI::Range(1, 100000))->capture_default_str();
@@ -184,9 +179,10 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
       ->check(CLI::IsMember({"perspective", "equirectangular"}))
       ->capture_default_str();
   sub->add_option("--layout", args->layout,
-                  "files (one movie per stream) or packed (packs written snapshot by snapshot, as in situ; gop 1 "
-                  "unless --gop says otherwise); default: the writer's choice (docs/formats.md)")
-      ->check(CLI::IsMember({"files", "packed"}));
+                  "auto (packed from 1024 streams at gop 1, the default), files (one movie per stream) or packed "
+                  "(packs written snapshot by snapshot, as in situ; gop 1 unless --gop says otherwise); "
+                  "docs/formats.md")
+      ->check(CLI::IsMember({"auto", "files", "packed"}));
   sub->add_flag("--force", args->force, "Start even when the estimated memory exceeds what is available");
   sub->callback([args, sub] {
     panoptes::install_stop_handlers();
