@@ -22,6 +22,14 @@ MemoryEstimate estimate_session_memory(const SessionConfig& config, double block
 /// an 8x200x400 shell peaked at 2.5 GB against an estimate of 348 MB, issue 44).
 MemoryEstimate estimate_grid_stage_memory(double source_points, double cover_points, int ranks, int fields);
 
+/// The split config.parallel asks for on `ranks` ranks, RenderSplit::automatic decided: cameras when
+/// there are several ranks, at least as many cameras as ranks and the whole grid's fields (float32
+/// copy, macro-cells, and the march's corner copy of each volume-rendered field) take at most
+/// kReplicateBytes per rank; else bricks. One rank always renders the whole grid (bricks = cameras).
+/// Depends only on what every rank agrees on, so every rank decides alike.
+RenderSplit choose_render_split(const SessionConfig& config, const render::GridGeometry& grid, long long cameras,
+                                int ranks);
+
 /// The number of cameras config.rig gives: computed for built-in rigs, read for file rigs (bounded).
 long long rig_camera_count(const SessionConfig& config, const render::GridGeometry& grid);
 
