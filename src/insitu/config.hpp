@@ -156,10 +156,7 @@ struct SessionConfig {
   std::vector<TaskConfig> tasks;
   ScheduleConfig schedule;
   video::VideoSettings video;
-  /// The product anti-aliases isosurfaces (iso_edges.hpp) and samples adaptively in image space as
-  /// `panoptes render` does (adaptive_sampling.hpp; >= 45 dB of every pixel marched, docs/rendering.md
-  /// Round 4): on the issue-45 in-situ setting it saved 10-20 % of Panoptes' CPU.
-  render::RenderOptions render{.adaptive = true, .iso_antialias = true};
+  render::RenderOptions render{.iso_antialias = true};  ///< the product anti-aliases isosurfaces (iso_edges.hpp)
   std::array<float, 3> background{0, 0, 0};
   bool outline = true;
   bool compass = true;                ///< 360° frames: horizon, ticks and N/E/S/W (render::OutlineStyle)
