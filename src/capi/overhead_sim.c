@@ -6,9 +6,9 @@
  * steps), and the code waits for its neighbours sleeping, not in MPI's busy wait: on a loaded machine
  * the ranks drift apart and a spinning wait turned the drift into 10-20 % of the code's CPU time, a
  * different amount in every run, which the comparison of two runs cannot tell from overhead.
- * ALPHA (default 0.1) is the diffusion number: insitu_overhead_bench takes a small one so that the
- * field keeps its structure over a long run (at 0.1 a 128x128x64 grid is a near-uniform fog after
- * ~1000 steps, the costliest scene for a ray caster: one snapshot then took ~19 CPU-s, 40x the first).
+ * ALPHA (default 0.1) is the diffusion number: insitu_overhead_bench takes a smaller one for its long
+ * run, so that its snapshots see the field of a 5,000-step run at 0.1 (the march's cost follows how far
+ * the blob has spread).
  *   overhead_sim CONFIG on|off NX NY NZ STEPS HALO_EVERY [ALPHA]                                     */
 #include <mpi.h>
 #include <stdio.h>
