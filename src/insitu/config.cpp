@@ -54,6 +54,21 @@ OutputMode parse_output_mode(const std::string& text) {
   throw Error("[output] mode = \"" + text + "\": expected \"create\", \"overwrite\" or \"resume\"");
 }
 
+const char* to_string(RenderSplit split) {
+  switch (split) {
+    case RenderSplit::automatic: return "auto";
+    case RenderSplit::cameras: return "cameras";
+    case RenderSplit::bricks: return "bricks";
+  }
+  return "auto";
+}
+
+RenderSplit parse_render_split(const std::string& text) {
+  for (RenderSplit m : {RenderSplit::automatic, RenderSplit::cameras, RenderSplit::bricks})
+    if (text == to_string(m)) return m;
+  throw Error("[resources] parallel = \"" + text + "\": expected \"auto\", \"cameras\" or \"bricks\"");
+}
+
 const char* to_string(ReferenceMode mode) {
   switch (mode) {
     case ReferenceMode::snapshot: return "snapshot";
@@ -266,9 +281,15 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.render.iso_antialias = boolean(c, *r, "iso_antialias", "render.", true);
   }
   if (const auto* r = table(c, root, "resources")) {
-    only_keys(c, *r, "resources", {"check_memory", "mpi_timeout"});
+    only_keys(c, *r, "resources", {"check_memory", "mpi_timeout", "parallel"});
     s.check_memory = boolean(c, *r, "check_memory", "resources.", true);
     s.mpi_timeout = num(c, *r, "mpi_timeout", "resources.", s.mpi_timeout);
+    const std::string split = str(c, *r, "parallel", "resources.", to_string(s.parallel));
+    try {
+      s.parallel = parse_render_split(split);
+    } catch (const Error&) {
+      c.fail("resources.parallel", "\"" + split + "\"; expected \"auto\", \"cameras\" or \"bricks\"");
+    }
   }
   if (const auto* t = root.get("task")) {
     const auto* a = t->as_array();
@@ -368,7 +389,11 @@ const char* config_keys_help() {
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has
             available: MemAvailable or the cgroup limit; false = panoptes run --force);
             mpi_timeout = 120 (seconds a rank waits in a Panoptes call for the other ranks before every
-            waiting rank reports them missing: no job hangs inside Panoptes)
+            waiting rank reports them missing: no job hangs inside Panoptes);
+            parallel = "auto" (how ranks share the rendering: "cameras" = every rank gathers the whole
+            grid's fields and renders its own cameras alone, no compositing; "bricks" = every rank
+            renders its brick for every camera, composited sort-last; "auto" = cameras when the whole
+            grid's fields take at most 256 MiB per rank and there are as many cameras as ranks)
 )") + task_tables_help();
   return text.c_str();
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "camera/rig_spec.hpp"
 #include "camera/volume_rigs.hpp"
@@ -91,6 +93,24 @@ bool sweep_rendering(const SessionConfig& cfg, int ranks) {
   if (t.kind == render::TaskKind::isosurface)
     return !cfg.render.iso_antialias || K > std::size_t(render::kMaxTasksPerMarch);
   return t.kind == render::TaskKind::volume && t.fields.size() == 1;
+RenderSplit choose_render_split(const SessionConfig& cfg, const render::GridGeometry& grid, long long cameras,
+                                int ranks) {
+  if (ranks <= 1) return RenderSplit::bricks;
+  if (cfg.parallel != RenderSplit::automatic) return cfg.parallel;
+  // Fewer cameras than ranks would leave ranks idle while the others march whole rays.
+  if (cameras < ranks) return RenderSplit::bricks;
+  const double points = double(grid.dims[0]) * grid.dims[1] * grid.dims[2];
+  // The same per-point bytes as estimate_session_memory(): 4 + 1 per field, 16 per marched field.
+  std::vector<std::string> fields, marched;
+  for (const TaskConfig& t : cfg.tasks)
+    for (const auto& f : t.fields) {
+      if (std::find(fields.begin(), fields.end(), f) == fields.end()) fields.push_back(f);
+      if (t.kind != render::TaskKind::isosurface && t.kind != render::TaskKind::slice &&
+          std::find(marched.begin(), marched.end(), f) == marched.end())
+        marched.push_back(f);
+    }
+  const double bytes = points * (5.0 * double(fields.size()) + 16.0 * double(marched.size()));
+  return bytes <= kReplicateBytes ? RenderSplit::cameras : RenderSplit::bricks;
 }
 
 long long rig_camera_count(const SessionConfig& cfg, const render::GridGeometry& grid) {

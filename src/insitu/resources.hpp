@@ -32,6 +32,13 @@ MemoryEstimate estimate_grid_stage_memory(double source_points, double cover_poi
 /// sweep path without anti-aliasing (the general path needed 20 bytes per pixel and value per camera:
 /// 1,000 values at 460x448 refused 16.5 GB, issue 45).
 bool sweep_rendering(const SessionConfig& config, int ranks);
+/// The split config.parallel asks for on `ranks` ranks, RenderSplit::automatic decided: cameras when
+/// there are several ranks, at least as many cameras as ranks and the whole grid's fields (float32
+/// copy, macro-cells, and the march's corner copy of each volume-rendered field) take at most
+/// kReplicateBytes per rank; else bricks. One rank always renders the whole grid (bricks = cameras).
+/// Depends only on what every rank agrees on, so every rank decides alike.
+RenderSplit choose_render_split(const SessionConfig& config, const render::GridGeometry& grid, long long cameras,
+                                int ranks);
 
 /// The number of cameras config.rig gives: computed for built-in rigs, read for file rigs (bounded).
 long long rig_camera_count(const SessionConfig& config, const render::GridGeometry& grid);

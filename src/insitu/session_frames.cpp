@@ -200,6 +200,18 @@ const char* unpack(const char* in, const char* end, int width, int height, rende
 
 }  // namespace
 
+namespace {
+render::OutlineStyle outline_style(const SessionConfig& cfg) {
+  render::OutlineStyle outline;
+  // In a 360° frame the box edges are arcs, and the horizon and compass show where to turn (issue 32).
+  outline.enabled = cfg.outline || (cfg.compass && cfg.projection == "equirectangular");
+  outline.box = cfg.outline;
+  outline.compass = cfg.compass;
+  outline.sky = camera::SkyFrame::of(cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis));
+  return outline;
+}
+}  // namespace
+
 // One rank rendering one sweep: per camera render_sweep() into 8-bit frames, then each task's frame
 // finished and encoded from them, tasks in parallel (appends to different streams may run
 // concurrently). The session holds one camera's sweep frames (4 bytes per pixel and task) and per
@@ -208,11 +220,7 @@ void Session::Impl::render_sweep_snapshot(int frame) {
   const int C = rig.size();
   const int K = int(plan.size());
   const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
-  render::OutlineStyle outline;
-  outline.enabled = cfg.outline || (cfg.compass && cfg.projection == "equirectangular");
-  outline.box = cfg.outline;
-  outline.compass = cfg.compass;
-  outline.sky = camera::SkyFrame::of(cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis));
+  const render::OutlineStyle outline = outline_style(cfg);
   store::DatabaseWriter& w = *writer;
   for (int c = 0; c < C; ++c) {
     auto t0 = Clock::now();
@@ -251,21 +259,64 @@ void Session::Impl::render_sweep_snapshot(int frame) {
   }
 }
 
+
+void Session::Impl::finish_camera(int camera, int frame) {
+  const int K = int(plan.size());
+  const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
+  const render::OutlineStyle outline = outline_style(cfg);
+  const camera::Camera& cam = cameras[std::size_t(camera)];
+  // One task at a time: composite() and finish_image() are parallel over pixels, which keeps
+  // both cores busy for any K (a loop over K = 3 tasks on 2 threads left one idle a third of the time).
+  std::vector<Image>& images = batch[std::size_t(batch_n)];
+  for (int t = 0; t < K; ++t) {
+    const std::vector<const render::PartialImage*>& p = parts[std::size_t(t)];
+    Image& out = images[std::size_t(t)];
+    if (p.empty()) {
+      empty_partial.reset(cfg.width, cfg.height, {0, 0, 0, 0});
+      render::finish_image_into(empty_partial, cam, grid, out, bg, outline);
+    } else if (p.size() == 1) {
+      render::finish_image_into(*p[0], cam, grid, out, bg, outline);
+    } else {
+      render::composite_into(specs[std::size_t(t)].kind, p, composited[std::size_t(t)]);  // the kind's blend
+      render::finish_image_into(composited[std::size_t(t)], cam, grid, out, bg, outline);
+    }
+  }
+  if (observer)
+    for (int t = 0; t < K; ++t) observer(camera, t, frame, images[std::size_t(t)]);
+  batch_camera[std::size_t(batch_n)] = camera;
+  ++batch_n;
+}
+
+// RenderSplit::cameras: this rank holds the whole grid and renders its own cameras through it; the
+// frames are those one rank rendering everything makes, and no rank waits for another's partials.
+void Session::Impl::render_own_cameras(int frame) {
+  const int K = int(plan.size());
+  const bool brick = me().has_brick;
+  for (int c : owned) {
+    for (auto& p : parts) p.clear();
+    if (brick) {
+      const auto t0 = Clock::now();
+      render::render_brick(cameras[std::size_t(c)], prepared, specs, partials[0], cfg.render);
+      time.render += since(t0);
+      for (int t = 0; t < K; ++t) parts[std::size_t(t)].push_back(&partials[0][std::size_t(t)]);
+    }
+    const auto t0 = Clock::now();
+    finish_camera(c, frame);
+    time.composite += since(t0);
+    if (batch_n == int(batch.size())) encode_batch();
+  }
+  encode_batch();
+}
+
 void Session::Impl::render_snapshot(int frame) {
   if (sweep && render::is_sweep(specs)) return render_sweep_snapshot(frame);
+  if (split == RenderSplit::cameras) return render_own_cameras(frame);
   const int C = rig.size();
   const int K = int(plan.size());
 #ifdef PANOPTES_HAVE_MPI
   if (size > C) return render_snapshot_banded(frame);
 #endif
   const bool brick = me().has_brick;
-  const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
-  render::OutlineStyle outline;
-  // In a 360° frame the box edges are arcs, and the horizon and compass show where to turn (issue 32).
-  outline.enabled = cfg.outline || (cfg.compass && cfg.projection == "equirectangular");
-  outline.box = cfg.outline;
-  outline.compass = cfg.compass;
-  outline.sky = camera::SkyFrame::of(cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis));
   for (int r0 = 0; r0 < C; r0 += size) {
     // Render every camera of this round, sending each partial set to its owner at once.
 #ifdef PANOPTES_HAVE_MPI
@@ -315,28 +366,9 @@ void Session::Impl::render_snapshot(int frame) {
         }
 #endif
       }
-      const camera::Camera& cam = cameras[std::size_t(mine)];
-      // One task at a time: composite() and finish_image() are parallel over pixels, which keeps
-      // both cores busy for any K (a loop over K = 3 tasks on 2 threads left one idle a third of the time).
-      std::vector<Image>& images = batch[std::size_t(batch_n)];
-      for (int t = 0; t < K; ++t) {
-        const std::vector<const render::PartialImage*>& p = parts[std::size_t(t)];
-        Image& out = images[std::size_t(t)];
-        if (p.empty()) {
-          empty_partial.reset(cfg.width, cfg.height, {0, 0, 0, 0});
-          render::finish_image_into(empty_partial, cam, grid, out, bg, outline);
-        } else if (p.size() == 1) {
-          render::finish_image_into(*p[0], cam, grid, out, bg, outline);
-        } else {
-          render::composite_into(specs[std::size_t(t)].kind, p, composited[std::size_t(t)]);  // the kind's blend
-          render::finish_image_into(composited[std::size_t(t)], cam, grid, out, bg, outline);
-        }
-      }
+      finish_camera(mine, frame);
       time.composite += since(t0);
-      if (observer)
-        for (int t = 0; t < K; ++t) observer(mine, t, frame, images[std::size_t(t)]);
-      batch_camera[std::size_t(batch_n)] = mine;
-      if (++batch_n == int(batch.size())) encode_batch();
+      if (batch_n == int(batch.size())) encode_batch();
     }
 #ifdef PANOPTES_HAVE_MPI
     if (!sends.empty()) {
@@ -364,11 +396,7 @@ void Session::Impl::render_snapshot_banded(int frame) {
   const auto band_y0 = [&](int j) { return int(std::int64_t(H) * j / T); };
   const auto band_owner = [&](int c, int j) { return int((std::int64_t(c) * T + j) % size); };
   const render::Rgb bg{cfg.background[0], cfg.background[1], cfg.background[2]};
-  render::OutlineStyle outline;
-  outline.enabled = cfg.outline || (cfg.compass && cfg.projection == "equirectangular");
-  outline.box = cfg.outline;
-  outline.compass = cfg.compass;
-  outline.sky = camera::SkyFrame::of(cfg.up_axis.empty() ? camera::UpAxis::z_up : camera::parse_up_axis(cfg.up_axis));
+  const render::OutlineStyle outline = outline_style(cfg);
   std::vector<MPI_Request> sends;
   std::vector<int> count_to(std::size_t(size), 0);
   int messages = 0;

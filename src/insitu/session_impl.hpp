@@ -80,6 +80,7 @@ struct Session::Impl {
   std::vector<camera::Camera> cameras;
   std::optional<store::DatabaseWriter> writer;
   std::vector<int> owned;
+  RenderSplit split = RenderSplit::bricks;  // how the ranks share the rendering (choose_render_split())
   int snapshots = 0;
   double next_time = 0;
   // The time of the last snapshot written (this run's or, after a resume, the database's): snapshot
@@ -169,6 +170,10 @@ struct Session::Impl {
 #ifdef PANOPTES_HAVE_MPI
   void render_snapshot_banded(int frame);
 #endif
+  void render_own_cameras(int frame);  // RenderSplit::cameras
+  // Finishes camera `camera`'s images from parts[] (each task's partials), hands them to the observer
+  // and queues them for encoding (the caller encodes a full batch).
+  void finish_camera(int camera, int frame);
   void encode_batch();
   void render_sweep_snapshot(int frame);
   void checkpoint(double time);

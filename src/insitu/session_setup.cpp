@@ -21,7 +21,8 @@ std::array<double, kShapeValues> Session::Impl::shape() const {
     v[std::size_t(3 + a)] = grid.origin[a];
     v[std::size_t(6 + a)] = grid.spacing[a];
   }
-  std::string text = cfg.output_dir + '\n' + cfg.rig + '\n' + std::to_string(cfg.width) + 'x' + std::to_string(cfg.height) +
+  // [resources] parallel too: ranks that split the rendering differently would wait for each other.
+  std::string text = cfg.output_dir + '\n' + to_string(cfg.parallel) + '\n' + cfg.rig + '\n' + std::to_string(cfg.width) + 'x' + std::to_string(cfg.height) +
                      '\n' + to_string(cfg.mode) + '\n' + cfg.projection;
   for (const TaskConfig& t : cfg.tasks) {
     text += '\n' + t.name + ':' + render::to_string(t.kind);
@@ -73,6 +74,26 @@ void Session::Impl::init() {
     throw Error("the local blocks of the " + std::to_string(size) + " ranks do not partition the grid's " +
                 std::to_string(total) + " points (they own " + std::to_string(points) + (overlap ? ", overlapping" : "") +
                 "): each point must be owned by exactly one rank");
+  // Cameras split: every rank's brick becomes the whole grid, so the exchange below fetches every
+  // point each rank does not own and render_snapshot() renders whole rays with nothing to composite.
+  // (A rig that cannot be read counts no cameras here; check_resources() refuses it on every rank.)
+  long long rig_cameras = 0;
+  try {
+    rig_cameras = rig_camera_count(cfg, grid);
+  } catch (const std::exception&) {
+  }
+  split = choose_render_split(cfg, grid, rig_cameras, size);
+  if (split == RenderSplit::cameras) {
+    const BlockInfo whole = halo::block_info(grid, LocalBlock::whole(grid));
+    for (BlockInfo& b : blocks) {
+      b.brick = whole.brick;
+      b.has_brick = whole.has_brick;
+      b.required = whole.required;
+    }
+  }
+  if (rank == 0 && size > 1)
+    log::info("session: " + std::to_string(size) + " ranks split the rendering by " +
+              (split == RenderSplit::cameras ? "cameras (each gathers the whole grid's fields)" : "bricks (sort-last)"));
   exchange.blocks = &blocks;
   exchange.rank = rank;
   exchange.size = size;
@@ -136,7 +157,7 @@ void Session::Impl::init() {
       for (std::size_t f = 0; f < references.size(); ++f) references[f].update(out.references[f]);
   }
   stage("database created");
-  const int slots = size;
+  const int slots = split == RenderSplit::cameras ? 1 : size;
   partials.assign(std::size_t(slots), std::vector<render::PartialImage>(plan.size()));
   send_buf.resize(std::size_t(slots));
   received.assign(std::size_t(size), std::vector<render::PartialImage>(plan.size()));
@@ -191,6 +212,7 @@ store::Manifest Session::Impl::make_manifest() const {
   man.provenance.version = panoptes::kVersion;
   man.provenance.command_line = cfg.command_line;
   man.provenance.extra["mpi_ranks"] = std::to_string(size);
+  if (size > 1) man.provenance.extra["mpi_split"] = to_string(split);
   man.provenance.extra[kScheduleNote] = schedule_text(cfg.schedule);
   man.domain.dims = {grid.dims[0], grid.dims[1], grid.dims[2]};
   man.domain.origin = grid.origin;

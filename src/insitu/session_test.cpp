@@ -113,6 +113,24 @@ TEST(InsituResources, RigFileMustBeARegularFile) {
   }
 }
 
+TEST(InsituResources, RanksSplitByCamerasWhenTheWholeGridIsSmall) {
+  auto c = insitu::parse_session_config_text(std::string(kTask), "t");  // one volume field: 21 B per point
+  EXPECT_EQ(c.parallel, insitu::RenderSplit::automatic);
+  const render::GridGeometry small{{128, 128, 64}, {0, 0, 0}, {1, 1, 1}};    // 22 MB
+  const render::GridGeometry big{{512, 512, 512}, {0, 0, 0}, {1, 1, 1}};     // 2.8 GB
+  EXPECT_EQ(insitu::choose_render_split(c, small, 26, 2), insitu::RenderSplit::cameras);
+  EXPECT_EQ(insitu::choose_render_split(c, big, 26, 2), insitu::RenderSplit::bricks);
+  EXPECT_EQ(insitu::choose_render_split(c, small, 3, 4), insitu::RenderSplit::bricks);  // ranks would idle
+  EXPECT_EQ(insitu::choose_render_split(c, small, 26, 1), insitu::RenderSplit::bricks);  // one rank: the whole grid
+  c = insitu::parse_session_config_text(std::string(kTask) + "[resources]\nparallel = \"cameras\"\n", "t");
+  EXPECT_EQ(insitu::choose_render_split(c, big, 26, 2), insitu::RenderSplit::cameras);   // asked for
+  c = insitu::parse_session_config_text(std::string(kTask) + "[resources]\nparallel = \"bricks\"\n", "t");
+  EXPECT_EQ(insitu::choose_render_split(c, small, 26, 2), insitu::RenderSplit::bricks);
+  EXPECT_NE(error_of(std::string(kTask) + "[resources]\nparallel = \"rays\"\n")
+                .find("resources.parallel: \"rays\"; expected \"auto\", \"cameras\" or \"bricks\""),
+            std::string::npos);
+}
+
 TEST(InsituResources, HugeImagesAndRigsDoNotFitAndSmallOnesDo) {
   auto c = insitu::parse_session_config_text(std::string(kTask), "t");
   const double points = 64.0 * 64 * 64;
