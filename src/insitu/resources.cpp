@@ -93,6 +93,8 @@ bool sweep_rendering(const SessionConfig& cfg, int ranks) {
   if (t.kind == render::TaskKind::isosurface)
     return !cfg.render.iso_antialias || K > std::size_t(render::kMaxTasksPerMarch);
   return t.kind == render::TaskKind::volume && t.fields.size() == 1;
+}
+
 RenderSplit choose_render_split(const SessionConfig& cfg, const render::GridGeometry& grid, long long cameras,
                                 int ranks) {
   if (ranks <= 1) return RenderSplit::bricks;
