@@ -38,17 +38,25 @@ TEST(ParallelFor, CallsEveryIndexOnceOnSeveralThreads) {
 }
 
 TEST(ParallelFor, RethrowsTheFirstErrorAndStartsNoFurtherIndex) {
+  // Each index takes 1 ms, so without the stop the other threads would need ~7 s for the rest: the
+  // thread that throws at index 10 would have to be kept off a core that long for this to fail by load
+  // (with trivial bodies the others finished all 100,000 indices while it waited: a flaky test).
   std::atomic<std::int64_t> started{0};
   try {
-    parallel_for(100000, 4, [&](std::int64_t i) {
+    parallel_for(20000, 4, [&](std::int64_t i) {
       ++started;
       if (i == 10) throw std::runtime_error("index 10");
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     });
     FAIL() << "no exception";
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(), "index 10");
   }
-  EXPECT_LT(started.load(), 100000);
+  const std::int64_t at_return = started.load();
+  EXPECT_LT(at_return, 20000);
+  // Nothing is still running or starts after the call returned.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(started.load(), at_return);
 }
 
 TEST(ParallelFor, WatchRunsOnTheCallerWhileOthersWork) {

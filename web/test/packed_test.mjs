@@ -79,8 +79,11 @@ async function expectShown(page, camera, task, frame, what) {
     throw new Error(`${what}: expected (${camera}, ${task}, ${frame}) on screen, shows ${JSON.stringify(s)}`);
   }
   const { shown, stamp } = await page.evaluate(() => ({ shown: window.panoptes.shown(), stamp: window.panoptes.readStamp() }));
-  assert.equal(shown.status, "ok", `${what}: status`);
-  assert.deepEqual(stamp, { camera: shown.camera, task: shown.task, frame: shown.frame }, `${what}: stamp in the canvas pixels`);
+  // Frame 2 of stream (1, 0) is the one damaged on purpose: playback may land on it after a switch.
+  const damaged = shown.camera === 1 && shown.task === 0 && shown.frame === 2;
+  assert.equal(shown.status, damaged ? "damaged" : "ok", `${what}: status of ${JSON.stringify(shown)}`);
+  if (!damaged)
+    assert.deepEqual(stamp, { camera: shown.camera, task: shown.task, frame: shown.frame }, `${what}: stamp in the canvas pixels`);
   return shown;
 }
 
