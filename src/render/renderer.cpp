@@ -1,3 +1,4 @@
+#include "render/ray_box.hpp"
 #include "render/renderer.hpp"
 
 // The renderer's pixel loop: the brick's screen footprint, tiles over OpenMP threads, each pixel's
@@ -29,27 +30,6 @@ namespace {
 
 using march::MarchKind;
 using march::MarchTask;
-
-// Ray–box intersection in index space; returns false when the ray misses. `axis` receives the axis
-// of the plane where the ray enters (-1 when t0 stays −∞); that plane is lo[axis] when
-// D[axis] > 0, else hi[axis], and t0 is exactly (plane − O[axis]) / D[axis].
-inline bool slab(const double O[3], const double D[3], const double lo[3], const double hi[3], double& t0, double& t1,
-                 int& axis) {
-  t0 = -INFINITY;
-  t1 = INFINITY;
-  axis = -1;
-  for (int a = 0; a < 3; ++a) {
-    if (D[a] == 0) {
-      if (O[a] < lo[a] || O[a] > hi[a]) return false;
-      continue;
-    }
-    double ta = (lo[a] - O[a]) / D[a], tb = (hi[a] - O[a]) / D[a];
-    if (ta > tb) std::swap(ta, tb);
-    if (t0 < ta) t0 = ta, axis = a;  // the value of std::max(t0, ta)
-    t1 = std::min(t1, tb);
-  }
-  return t1 >= t0;
-}
 
 }  // namespace
 
@@ -190,12 +170,12 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
     double tg0;
     int ag, ab;
-    if (!slab(r.O, r.D, glo, ghi, tg0, r.tg1, ag)) return false;
+    if (!ray_box(r.O, r.D, glo, ghi, tg0, r.tg1, ag)) return false;
     r.t0 = std::max(tg0, 0.0);
     if (r.tg1 <= r.t0) return false;
     if (whole_domain) {  // the brick's slab test would repeat the domain's, bit for bit
       r.tb0 = tg0, r.tb1 = r.tg1, ab = ag;
-    } else if (!slab(r.O, r.D, blo, bhi, r.tb0, r.tb1, ab)) {
+    } else if (!ray_box(r.O, r.D, blo, bhi, r.tb0, r.tb1, ab)) {
       return false;
     }
     r.face = 0;

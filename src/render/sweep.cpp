@@ -1,3 +1,4 @@
+#include "render/ray_box.hpp"
 #include "render/sweep.hpp"
 
 // Sections: the sweep's tasks compiled (SweepPlan), the isosurface ray (iso_ray), the volume ray
@@ -544,24 +545,6 @@ inline void stream_pixel(const std::uint8_t* from, std::uint8_t* to, std::size_t
 #endif
 }
 
-// Ray–box intersection in index space (renderer.cpp's slab()).
-inline bool slab(const double O[3], const double D[3], const double lo[3], const double hi[3], double& t0,
-                 double& t1) {
-  t0 = -INFINITY;
-  t1 = INFINITY;
-  for (int a = 0; a < 3; ++a) {
-    if (D[a] == 0) {
-      if (O[a] < lo[a] || O[a] > hi[a]) return false;
-      continue;
-    }
-    double ta = (lo[a] - O[a]) / D[a], tb = (hi[a] - O[a]) / D[a];
-    if (ta > tb) std::swap(ta, tb);
-    if (t0 < ta) t0 = ta;
-    t1 = std::min(t1, tb);
-  }
-  return t1 >= t0;
-}
-
 }  // namespace
 
 void SweepFrames::resize(int w, int h, int tasks, int bytes) {
@@ -690,7 +673,8 @@ RenderStats render_sweep(const camera::Camera& cam, std::span<const PreparedFiel
           r.dir = rays.direction(x, y);
           for (int a = 0; a < 3; ++a) r.O[a] = O_index[a], r.D[a] = r.dir[a] / grid.spacing[a];
           double tg0;
-          bool in = slab(r.O, r.D, glo, ghi, tg0, r.tg1);
+          int entry_axis = -1;
+          bool in = ray_box(r.O, r.D, glo, ghi, tg0, r.tg1, entry_axis);
           r.t0 = std::max(tg0, 0.0);
           in = in && r.tg1 > r.t0;
           if (in) {
