@@ -32,7 +32,9 @@ TEST(ParallelFor, CallsEveryIndexOnceOnSeveralThreads) {
     });
     for (const auto& c : calls) ASSERT_EQ(c.load(), 1) << threads << " threads";
     EXPECT_LE(int(ids.size()), parallel_threads(1000, threads));
-    if (threads == 1) EXPECT_EQ(*ids.begin(), std::this_thread::get_id());  // the caller works
+    if (threads == 1) {
+      EXPECT_EQ(*ids.begin(), std::this_thread::get_id());  // the caller works
+    }
   }
   parallel_for(0, 4, [](std::int64_t) { FAIL() << "no index in an empty range"; });
 }

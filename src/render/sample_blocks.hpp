@@ -82,6 +82,7 @@ constexpr int kBlock = 8;
 // (returns whether it did; the caller computes it otherwise).
 inline bool interp_block(const FieldAcc& f, const RayPos& P, std::int64_t k0, int n, bool safe, float* v,
                          float* range = nullptr) {
+  (void)range;  // only the gather path (AVX2) writes it
 #ifdef PANOPTES_RENDER_AVX2
   if (f.gather32) {
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);

@@ -1,0 +1,74 @@
+// The web player on a large exported packed site (issue 46, million_bench): a static server that
+// honours byte ranges (as object stores do) serves the export-web site; headless Chromium opens it and
+// shows N random streams of a synth-db database (stamped frames): each must appear with status ok and
+// its (camera, task, frame) stamp read back from the canvas pixels. Prints a Markdown row: site files,
+// open ms, median and worst ms from select() to the stream's frame on screen, requests and bytes per
+// stream.
+//   node big_site_check.mjs SITE_DIR CHROMIUM NODE_MODULES [N]
+import { createRequire } from "node:module";
+import fs from "node:fs";
+import http from "node:http";
+import path from "node:path";
+
+const [siteDir, chromium, nodeModules, nArg] = process.argv.slice(2);
+const N = Number(nArg || 20);
+const require = createRequire(nodeModules + "/");
+const puppeteer = require("puppeteer-core");
+
+const types = { ".html": "text/html", ".js": "text/javascript", ".mjs": "text/javascript", ".css": "text/css", ".json": "application/json" };
+let requests = 0, bytes = 0;
+const server = http.createServer((req, res) => {
+  const rel = path.normalize(decodeURIComponent(new URL(req.url, "http://x").pathname)).replace(/^(\.\.[/\\])+/, "").replace(/^\/+/, "");
+  const file = path.join(siteDir, rel === "" || rel.endsWith("/") ? rel + "index.html" : rel);
+  fs.stat(file, (err, st) => {
+    requests++;
+    if (err || !st.isFile()) { res.writeHead(404); return res.end(); }
+    const type = types[path.extname(file)] || "application/octet-stream";
+    const m = /^bytes=(\d+)-(\d+)$/.exec(req.headers.range || "");
+    if (!m) {
+      bytes += st.size;
+      res.writeHead(200, { "Content-Type": type, "Content-Length": st.size, "Accept-Ranges": "bytes" });
+      return fs.createReadStream(file).pipe(res);
+    }
+    const a = Number(m[1]), b = Math.min(Number(m[2]), st.size - 1);
+    bytes += b - a + 1;
+    res.writeHead(206, { "Content-Type": type, "Content-Length": b - a + 1, "Content-Range": `bytes ${a}-${b}/${st.size}` });
+    fs.createReadStream(file, { start: a, end: b }).pipe(res);
+  });
+});
+await new Promise((r) => server.listen(0, "127.0.0.1", r));
+const url = `http://127.0.0.1:${server.address().port}/?play=0`;
+const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox", "--disable-dev-shm-usage"] });
+let failures = 0;
+try {
+  const page = await browser.newPage();
+  const t0 = Date.now();
+  await page.goto(url);
+  await page.waitForFunction(() => window.panoptes && window.panoptes.shown() && window.panoptes.camerasLoaded(), { timeout: 120000 });
+  const openMs = Date.now() - t0;
+  const db = JSON.parse(fs.readFileSync(path.join(siteDir, "api/database.json"), "utf8"));
+  const C = db.cameras.count, T = db.tasks.length;
+  let seed = 46;
+  const rnd = (n) => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed % n; };
+  const ms = [];
+  const r0 = requests, b0 = bytes;
+  for (let i = 0; i < N; i++) {
+    const c = rnd(C), t = rnd(T);
+    const s = Date.now();
+    await page.evaluate((c, t) => window.panoptes.select(c, t), c, t);
+    await page.waitForFunction((c, t) => { const s = window.panoptes.shown(); return s && s.camera === c && s.task === t && s.status !== "loading"; }, { timeout: 30000 }, c, t);
+    ms.push(Date.now() - s);
+    const { shown, stamp } = await page.evaluate(() => ({ shown: window.panoptes.shown(), stamp: window.panoptes.readStamp() }));
+    if (shown.status !== "ok" || !stamp || stamp.camera !== c || stamp.task !== t || stamp.frame !== shown.frame) {
+      failures++;
+      console.error(`stream (${c}, ${t}): shows ${JSON.stringify(shown)}, stamp ${JSON.stringify(stamp)}`);
+    }
+  }
+  ms.sort((a, b) => a - b);
+  const files = fs.readdirSync(siteDir, { recursive: true }).filter((f) => fs.statSync(path.join(siteDir, f)).isFile()).length;
+  console.log(`| ${C} x ${T} | ${files} | ${openMs} | ${ms[Math.floor(ms.length / 2)]} / ${ms[ms.length - 1]} | ${((requests - r0) / N).toFixed(1)} / ${((bytes - b0) / N / 1024).toFixed(1)} kB | ${N - failures} of ${N} |`);
+} finally {
+  await browser.close();
+  server.close();
+}
+process.exit(failures ? 1 : 0);
