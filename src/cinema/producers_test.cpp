@@ -95,10 +95,18 @@ void check_navigation(const store::Manifest& m) {
     const Vec3 fwd = normalize(c.look_at - c.position), up = orthogonal(c.up, fwd), right = cross(fwd, up);
     const auto& n = m.graph.neighbours[std::size_t(c.id)];
     auto towards = [&](int j, const Vec3& axis) { return dot(m.cameras[std::size_t(j)].position - c.position, axis); };
-    if (n.right >= 0) EXPECT_GT(towards(n.right, right), 0) << "camera " << c.id;
-    if (n.left >= 0) EXPECT_LT(towards(n.left, right), 0) << "camera " << c.id;
-    if (n.up >= 0) EXPECT_GT(towards(n.up, up), 0) << "camera " << c.id;
-    if (n.down >= 0) EXPECT_LT(towards(n.down, up), 0) << "camera " << c.id;
+    if (n.right >= 0) {
+      EXPECT_GT(towards(n.right, right), 0) << "camera " << c.id;
+    }
+    if (n.left >= 0) {
+      EXPECT_LT(towards(n.left, right), 0) << "camera " << c.id;
+    }
+    if (n.up >= 0) {
+      EXPECT_GT(towards(n.up, up), 0) << "camera " << c.id;
+    }
+    if (n.down >= 0) {
+      EXPECT_LT(towards(n.down, up), 0) << "camera " << c.id;
+    }
     if (n.right >= 0 && std::abs(c.labels.lat_deg) < 75 && std::abs(m.cameras[std::size_t(n.right)].labels.lat_deg) < 75) {
       double dlon = m.cameras[std::size_t(n.right)].labels.lon_deg - c.labels.lon_deg;
       dlon = std::remainder(dlon, 360.0);

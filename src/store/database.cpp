@@ -1060,7 +1060,7 @@ StreamReport Database::validate_streams(int threads, bool decode_all,
     });
   auto check = [&](std::int64_t i) {
     const int camera = int(i / tasks), task = int(i % tasks);
-    StreamProblem problem{camera, task, StreamProblem::Kind::missing, {}};
+    StreamProblem problem{camera, task, StreamProblem::Kind::missing, {}, {}};
     std::int64_t file_bytes = -1;
     try {
       if (packed()) {

@@ -34,8 +34,8 @@ extern "C" {
 namespace panoptes::video {
 
 // --- limits ---
-namespace {
-
+// Named, not anonymous: MovieReader::Impl (declared in the header) holds a vector of them.
+namespace movie_reader_detail {
 struct PacketInfo {
   std::int64_t pos = 0;  // byte offset of the sample in the file
   int size = 0;
@@ -43,6 +43,10 @@ struct PacketInfo {
   std::int64_t dts = 0;
   bool key = false;
 };
+}  // namespace movie_reader_detail
+using movie_reader_detail::PacketInfo;
+
+namespace {
 
 std::string errno_string(int e) { return std::strerror(e); }
 
