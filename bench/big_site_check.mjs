@@ -8,8 +8,8 @@
 // (--no-stamp: frames without stamps, e.g. an in-situ database: each stream must show with status ok)
 import { createRequire } from "node:module";
 import fs from "node:fs";
-import http from "node:http";
 import path from "node:path";
+import { serveStatic } from "../web/test/static_server.mjs";
 
 const [siteDir, chromium, nodeModules, nArg, stampArg] = process.argv.slice(2);
 const stamped = stampArg !== "--no-stamp";
@@ -17,29 +17,9 @@ const N = Number(nArg || 20);
 const require = createRequire(nodeModules + "/");
 const puppeteer = require("puppeteer-core");
 
-const types = { ".html": "text/html", ".js": "text/javascript", ".mjs": "text/javascript", ".css": "text/css", ".json": "application/json" };
-let requests = 0, bytes = 0;
-const server = http.createServer((req, res) => {
-  const rel = path.normalize(decodeURIComponent(new URL(req.url, "http://x").pathname)).replace(/^(\.\.[/\\])+/, "").replace(/^\/+/, "");
-  const file = path.join(siteDir, rel === "" || rel.endsWith("/") ? rel + "index.html" : rel);
-  fs.stat(file, (err, st) => {
-    requests++;
-    if (err || !st.isFile()) { res.writeHead(404); return res.end(); }
-    const type = types[path.extname(file)] || "application/octet-stream";
-    const m = /^bytes=(\d+)-(\d+)$/.exec(req.headers.range || "");
-    if (!m) {
-      bytes += st.size;
-      res.writeHead(200, { "Content-Type": type, "Content-Length": st.size, "Accept-Ranges": "bytes" });
-      return fs.createReadStream(file).pipe(res);
-    }
-    const a = Number(m[1]), b = Math.min(Number(m[2]), st.size - 1);
-    bytes += b - a + 1;
-    res.writeHead(206, { "Content-Type": type, "Content-Length": b - a + 1, "Content-Range": `bytes ${a}-${b}/${st.size}` });
-    fs.createReadStream(file, { start: a, end: b }).pipe(res);
-  });
-});
-await new Promise((r) => server.listen(0, "127.0.0.1", r));
-const url = `http://127.0.0.1:${server.address().port}/?play=0`;
+const server = await serveStatic(siteDir, { ranges: true });
+const url = server.url + "?play=0";
+const count = () => ({ n: server.requests.length, bytes: server.requests.reduce((t, r) => t + (r.bytes || 0), 0) });
 const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox", "--disable-dev-shm-usage"] });
 let failures = 0;
 try {
@@ -53,7 +33,7 @@ try {
   let seed = 46;
   const rnd = (n) => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed % n; };
   const ms = [];
-  const r0 = requests, b0 = bytes;
+  const before = count();
   for (let i = 0; i < N; i++) {
     const c = rnd(C), t = rnd(T);
     const s = Date.now();
@@ -68,7 +48,7 @@ try {
   }
   ms.sort((a, b) => a - b);
   const files = fs.readdirSync(siteDir, { recursive: true }).filter((f) => fs.statSync(path.join(siteDir, f)).isFile()).length;
-  console.log(`| ${C} x ${T} | ${files} | ${openMs} | ${ms[Math.floor(ms.length / 2)]} / ${ms[ms.length - 1]} | ${((requests - r0) / N).toFixed(1)} / ${((bytes - b0) / N / 1024).toFixed(1)} kB | ${N - failures} of ${N} |`);
+  console.log(`| ${C} x ${T} | ${files} | ${openMs} | ${ms[Math.floor(ms.length / 2)]} / ${ms[ms.length - 1]} | ${((count().n - before.n) / N).toFixed(1)} / ${((count().bytes - before.bytes) / N / 1024).toFixed(1)} kB | ${N - failures} of ${N} |`);
 } finally {
   await browser.close();
   server.close();

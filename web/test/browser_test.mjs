@@ -3,8 +3,8 @@
 import { createRequire } from "node:module";
 import assert from "node:assert/strict";
 import fs from "node:fs";
-import http from "node:http";
 import path from "node:path";
+import { serveStatic } from "./static_server.mjs";
 
 const [serveArg, siteDir, chromium, nodeModules, liveUrl, liveDir] = process.argv.slice(2);
 const serveBase = serveArg.replace(/\?.*/, "");  // the URL printed by serve, without ?token=
@@ -14,18 +14,8 @@ const require = createRequire(nodeModules + "/");
 const puppeteer = require("puppeteer-core");
 
 // The exported site behind the plainest static server: whole files only (200, no Range support).
-const types = { ".html": "text/html", ".js": "text/javascript", ".mjs": "text/javascript", ".css": "text/css", ".json": "application/json" };
-const staticServer = http.createServer((req, res) => {
-  const file = path.join(siteDir, path.normalize(decodeURIComponent(new URL(req.url, "http://x").pathname)).replace(/^(\.\.[/\\])+/, ""));
-  const name = file.endsWith("/") ? file + "index.html" : file;
-  fs.readFile(name, (err, data) => {
-    if (err) { res.writeHead(404); return res.end(); }
-    res.writeHead(200, { "Content-Type": types[path.extname(name)] || "application/octet-stream" });
-    res.end(data);
-  });
-});
-await new Promise((r) => staticServer.listen(0, "127.0.0.1", r));
-const staticUrl = `http://127.0.0.1:${staticServer.address().port}/`;
+const staticServer = await serveStatic(siteDir, { ranges: false });
+const staticUrl = staticServer.url;
 
 const browser = await puppeteer.launch({
   executablePath: chromium,

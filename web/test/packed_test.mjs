@@ -4,38 +4,16 @@
 import { createRequire } from "node:module";
 import assert from "node:assert/strict";
 import fs from "node:fs";
-import http from "node:http";
 import path from "node:path";
+import { serveStatic } from "./static_server.mjs";
 
 const [serveUrl, siteDir, chromium, nodeModules] = process.argv.slice(2);
 const require = createRequire(nodeModules + "/");
 const puppeteer = require("puppeteer-core");
 
-// A static file server as object stores and CDNs behave: whole files (200) or one byte range
-// (Range: bytes=a-b, 206), nothing else; every request logged.
-const types = { ".html": "text/html", ".js": "text/javascript", ".mjs": "text/javascript", ".css": "text/css", ".json": "application/json" };
-const requests = [];
-const staticServer = http.createServer((req, res) => {
-  const rel = path.normalize(decodeURIComponent(new URL(req.url, "http://x").pathname)).replace(/^(\.\.[/\\])+/, "").replace(/^\/+/, "");
-  const file = path.join(siteDir, rel === "" || rel.endsWith("/") ? rel + "index.html" : rel);
-  fs.stat(file, (err, st) => {
-    if (err || !st.isFile()) { requests.push({ path: rel, status: 404 }); res.writeHead(404); return res.end(); }
-    const type = types[path.extname(file)] || "application/octet-stream";
-    const m = /^bytes=(\d+)-(\d+)$/.exec(req.headers.range || "");
-    if (!m) {
-      requests.push({ path: rel, status: 200 });
-      res.writeHead(200, { "Content-Type": type, "Content-Length": st.size, "Accept-Ranges": "bytes" });
-      return fs.createReadStream(file).pipe(res);
-    }
-    const a = Number(m[1]), b = Math.min(Number(m[2]), st.size - 1);
-    if (a > b) { requests.push({ path: rel, status: 416 }); res.writeHead(416); return res.end(); }
-    requests.push({ path: rel, status: 206, bytes: b - a + 1 });
-    res.writeHead(206, { "Content-Type": type, "Content-Length": b - a + 1, "Content-Range": `bytes ${a}-${b}/${st.size}` });
-    fs.createReadStream(file, { start: a, end: b }).pipe(res);
-  });
-});
-await new Promise((r) => staticServer.listen(0, "127.0.0.1", r));
-const staticUrl = `http://127.0.0.1:${staticServer.address().port}/`;
+// The exported site as object stores and CDNs serve it: whole files or one byte range, every request logged.
+const staticServer = await serveStatic(siteDir, { ranges: true });
+const { requests } = staticServer, staticUrl = staticServer.url;
 
 const browser = await puppeteer.launch({
   executablePath: chromium,
