@@ -4,6 +4,7 @@
 //   session_setup.cpp   the start: the grid stage, the rig, the task plan, resources, the database
 //   session_frames.cpp  one snapshot: fields in, references, images rendered, composited, encoded,
 //                       and the checkpoint
+//   session_bands.cpp   compositing in bands of rows when ranks outnumber cameras
 
 #include "insitu/session.hpp"
 
@@ -44,6 +45,9 @@
 #include "core/version.hpp"
 
 namespace panoptes::insitu {
+
+/// The outline and compass of the session's frames, as the configuration asks.
+render::OutlineStyle outline_style(const SessionConfig& config);
 
 struct Session::Impl {
   using Clock = std::chrono::steady_clock;
