@@ -231,7 +231,8 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance", "equirect_adaptive", "iso_antialias", "field", "share_scale"});
+                                      "adaptive_tolerance", "equirect_adaptive", "equirect_tolerance", "iso_antialias", "field",
+                                      "share_scale"});
     const std::string ref = str(c, *r, "reference", "render.", "running");
     if (ref == "fixed") c.fail("render.reference", "\"fixed\" needs a value per field: [render.field.NAME] reference = \"fixed\", value = V");
     try {
@@ -278,6 +279,11 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
     if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");
     s.render.adaptive_tolerance = float(tol / 255);
+    // 360° frames have their own: from inside a dense field 4/255 refined a third of the pixels to single
+    // ones for 59 dB, 10/255 marches 15 % at 50 dB (docs/rendering.md, Round 12).
+    const double eq_tol = num(c, *r, "equirect_tolerance", "render.", double(s.render.equirect_tolerance) * 255);
+    if (!(eq_tol >= 0 && eq_tol <= 255)) c.fail("render.equirect_tolerance", "expected 0..255 (units of 1/255)");
+    s.render.equirect_tolerance = float(eq_tol / 255);
     s.render.iso_antialias = boolean(c, *r, "iso_antialias", "render.", true);
   }
   if (const auto* r = table(c, root, "resources")) {
@@ -383,7 +389,8 @@ const char* config_keys_help() {
             adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
             corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
-            apart whose columns widen toward the poles, whatever adaptive says; false = every pixel)
+            apart whose columns widen toward the poles, whatever adaptive says; false = every pixel);
+            equirect_tolerance = 10 (360° frames: the largest corner range interpolated, units of 1/255)
             iso_antialias = true (isosurface silhouettes get partial coverage from rays that graze or
             nearly miss them: no stair steps; false = every pixel hit or missed, as before)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has

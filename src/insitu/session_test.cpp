@@ -91,6 +91,16 @@ TEST(InsituConfig, IntegersAreRangeCheckedBeforeNarrowing) {
                    .check_memory);
 }
 
+// Issue 45: 360° frames have their own adaptive tolerance (10/255 by default), in 1/255 in the file.
+TEST(InsituConfig, EquirectToleranceIsItsOwnKey) {
+  EXPECT_FLOAT_EQ(insitu::parse_session_config_text(std::string(kTask), "t").render.equirect_tolerance, 10.0f / 255);
+  const auto c = insitu::parse_session_config_text(std::string(kTask) + "[render]\nequirect_tolerance = 4\n", "t");
+  EXPECT_FLOAT_EQ(c.render.equirect_tolerance, 4.0f / 255);
+  EXPECT_FLOAT_EQ(c.render.adaptive_tolerance, 4.0f / 255);
+  EXPECT_NE(error_of(std::string(kTask) + "[render]\nequirect_tolerance = 300\n").find("render.equirect_tolerance"),
+            std::string::npos);
+}
+
 TEST(InsituConfig, RigSpecsAreBounded) {
   // More cameras over all shells than the limit (each shell alone is allowed).
   EXPECT_NE(error_of(std::string(kTask) + "[rig]\nspec = \"fibonacci:5000000@2,3,4\"\n").find("is more than the limit"),
