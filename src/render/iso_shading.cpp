@@ -104,8 +104,9 @@ namespace {
 // highlight (above kHighlightFrom, where 0.25·|n·l|^32 bends) is the surface looked at: between them
 // the diffuse term is linear in n, so a box filter leaves the centre's shading unless the normal
 // bends sharply within the pixel (a crease: one speckle of issue 41's scene, camera 115, stays). It
-// saves two thirds of the filter's cost (+17 % of an isosurface frame for every hit, +6 % so).
-constexpr double kRimBelow = 0.3, kHighlightFrom = 0.85;
+// saves most of the filter's cost (BM_Isosurfaces from outside: +12 … +22 % of an anti-aliased
+// isosurface frame when every hit is looked at, +4 … +10 % so; docs/rendering.md).
+constexpr double kRimBelow = 0.3, kHighlightFrom = 0.92;
 // Filtered where the footprint corners' mean departs from the centre by more than this (three times
 // a box filter's departure for a quadratic change: ~2.7 levels).
 constexpr float kBends = 8.0f / 255;
