@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "camera/rig_spec.hpp"
 #include "core/image.hpp"
+#include "core/png.hpp"
 #include "render/iso_edges.hpp"
 #include "render/render_test_util.hpp"
 #include "render/synthetic_fields.hpp"
@@ -213,7 +215,7 @@ Frame downsample(const Frame& big, int S) {
 // than 30 levels outside the range the reference takes over the pixel and its 8 neighbours in some
 // channel. An edge pixel whose coverage is somewhat off stays within that range; a ray that sees
 // through the surface to the black background or to a sheet behind it does not.
-int speckles(const Frame& img, const Frame& ref) {
+int speckles(const Frame& img, const Frame& ref, const char* tag = nullptr) {
   int n = 0;
   for (int y = 0; y < img.img.height; ++y)
     for (int x = 0; x < img.img.width; ++x) {
@@ -228,6 +230,9 @@ int speckles(const Frame& img, const Frame& ref) {
           }
         const int v = img.img.at(x, y)[c];
         off = v < lo - 30 || v > hi + 30;
+        // PANOPTES_ISO_SPECKLES=1 lists the speckles and the pixels within 10 levels of being one.
+        if (tag && (v < lo - 20 || v > hi + 20) && std::getenv("PANOPTES_ISO_SPECKLES"))
+          std::printf("%s %s (%d, %d) channel %d: %d, reference %d..%d\n", off ? "speckle" : "near", tag, x, y, c, v, lo, hi);
       }
       n += off;
     }
@@ -284,10 +289,12 @@ TEST(IsoEdges, SliverStateCrossesBricks) {
 // (sample distance 0.125 voxel). Outside (every 5th camera of the 130-camera rig) and inside (360°
 // frames from three points in the domain). The bend of the surface itself decides, and an exit adds
 // nothing only when its entry came before it on the ray, in this brick or one in front (the sliver
-// state, PartialImage::slivers). What remains is about what anti-aliasing off leaves (outside 8 of
-// the 11 at the same pixels): one ray per pixel against 16 — highlights and grazing shading narrower
-// than a pixel, not surfaces the march steps over (at the reference's own 0.125-voxel step the
-// march leaves 11 and 2 with anti-aliasing, 12 and 2 without).
+// state, PartialImage::slivers). What that left (11 outside, 2 inside) were not surfaces the march
+// steps over but one shading sample against the reference's 16 — grazing rims, creases and highlights
+// narrower than a pixel. The shading filtered over the pixel footprint (shade_hit_footprint()) takes 7
+// of the 13 (5 and 1 remain: dark rims in valleys where two sheets meet and creases, whose right
+// colour lies beyond half a voxel from the hit, farther than a brick may read round it).
+// Anti-aliasing off keeps its 9 and 2.
 TEST(IsoEdges, SpecklesAgainstTheSupersampledSurface) {
   const ShellScene sc;
   const camera::Rig rig =
@@ -311,11 +318,20 @@ TEST(IsoEdges, SpecklesAgainstTheSupersampledSurface) {
     const char* where = views == &outside ? "outside" : "inside";
     int n_on = 0, n_off = 0;
     double se_on = 0, se_off = 0, count = 0;
-    for (const View& v : *views) {
+    for (std::size_t vi = 0; vi < views->size(); ++vi) {
+      const View& v = (*views)[vi];
       const Frame a = render_iso(v.cam, sc, on), b = render_iso(v.cam, sc, off);
       const Frame r = downsample(render_iso(v.big, sc, ref), S);
-      n_on += speckles(a, r);
-      n_off += speckles(b, r);
+      const std::string tag_on = std::string(where) + " view " + std::to_string(vi) + " on",
+                        tag_off = std::string(where) + " view " + std::to_string(vi) + " off";
+      if (const char* dir = std::getenv("PANOPTES_ISO_FRAMES")) {  // the frames docs/rendering.md's crops are cut from
+        const std::string stem = std::string(dir) + "/" + where + std::to_string(vi);
+        write_png(stem + "_on.png", a.img);
+        write_png(stem + "_off.png", b.img);
+        write_png(stem + "_ref.png", r.img);
+      }
+      n_on += speckles(a, r, tag_on.c_str());
+      n_off += speckles(b, r, tag_off.c_str());
       for (std::size_t i = 0; i < a.img.pixels.size(); ++i) {
         if (i % 4 == 3) continue;
         const double d1 = double(a.img.pixels[i]) - r.img.pixels[i], d2 = double(b.img.pixels[i]) - r.img.pixels[i];
@@ -323,15 +339,16 @@ TEST(IsoEdges, SpecklesAgainstTheSupersampledSurface) {
       }
     }
     const double db_on = 10 * std::log10(255.0 * 255.0 * count / se_on), db_off = 10 * std::log10(255.0 * 255.0 * count / se_off);
-    std::printf("%s (%zu views): speckles with anti-aliasing %d, without %d; PSNR against the supersampled frames %.2f dB "
-                "with, %.2f dB without\n",
+    std::printf("%s (%zu views): speckles with anti-aliasing %d, without %d; PSNR against the supersampled frames %.3f dB "
+                "with, %.3f dB without\n",
                 where, views->size(), n_on, n_off, db_on, db_off);
     RecordProperty(std::string(where) + "_speckles_on_off", std::to_string(n_on) + " " + std::to_string(n_off));
     // Measured (without anti-aliasing 9 outside, 2 inside; 43.6 and 47.0 dB): before issue 41 121 and
     // 89 speckles, 39.5 and 40.4 dB; with exits checked for their entry within the ghost layers
     // (issue 43) 51 and 12, 42.5 and 45.7 dB; with the sliver state carried across bricks 11 and 2,
-    // 46.2 and 49.2 dB.
-    EXPECT_LE(n_on, n_off + (views == &outside ? 3 : 0)) << where;
-    EXPECT_GE(db_on, views == &outside ? 45.5 : 48.5) << where;
+    // 46.15 and 49.20 dB; with the shading filtered over the footprint 5 and 1, 46.23 and 49.26 dB
+    // (PANOPTES_ISO_SPECKLES=1 lists them). Issue 41 asks for none.
+    EXPECT_LE(n_on, views == &outside ? 5 : 1) << where;
+    EXPECT_GE(db_on, views == &outside ? 46.15 : 49.2) << where;  // no worse than before the filter
   }
 }

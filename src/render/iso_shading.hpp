@@ -28,6 +28,14 @@ void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const
 /// ∇f at index-space position p in field units per world unit: shade_hit()'s central differences
 /// (the same six interpolations as one 8-lane evaluation), without the shading.
 void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], double g[3]);
+/// Anti-aliasing's hit shading filtered over the pixel footprint (`width` world units across at the
+/// hit; issue 41's speckles: one shading sample where the reference's sub-rays see a grazing rim, a
+/// crease or a highlight narrower than the pixel). On entry a = shade_hit()'s colour at p (gradient g
+/// there); where the shading bends across the footprint, replaced by the mean of 4 × 4 sub-rays meeting
+/// the surface modelled from one gather within `reach` (half a voxel, world units) of p on every axis
+/// (what a brick may read round a hit). Returns whether it filtered.
+bool shade_hit_footprint(const FieldAcc& f, const Vec3& spacing, const double p[3], const Vec3& dir, const double g[3],
+                         double width, double reach, const float colour[3], float* a);
 /// The pre-issue-10 hit shading (six scalar interpolations, std::pow): the reference renderer's.
 void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
                       const Vec3& dir, const float colour[3], float* a);
