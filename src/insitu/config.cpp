@@ -231,8 +231,8 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance", "equirect_adaptive", "equirect_tolerance", "iso_antialias", "field",
-                                      "share_scale"});
+                                      "adaptive_tolerance", "adaptive_linear_tolerance", "equirect_adaptive", "equirect_tolerance",
+                                      "iso_antialias", "field", "share_scale"});
     const std::string ref = str(c, *r, "reference", "render.", "running");
     if (ref == "fixed") c.fail("render.reference", "\"fixed\" needs a value per field: [render.field.NAME] reference = \"fixed\", value = V");
     try {
@@ -279,6 +279,9 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
     if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");
     s.render.adaptive_tolerance = float(tol / 255);
+    const double lin = num(c, *r, "adaptive_linear_tolerance", "render.", double(s.render.adaptive_linear_tolerance) * 255);
+    if (!(lin >= 0 && lin <= 255)) c.fail("render.adaptive_linear_tolerance", "expected 0..255 (units of 1/255)");
+    s.render.adaptive_linear_tolerance = float(lin / 255);
     // 360° frames have their own: from inside a dense field 4/255 refined a third of the pixels to single
     // ones for 59 dB, 10/255 marches 15 % at 50 dB (docs/rendering.md, Round 12).
     const double eq_tol = num(c, *r, "equirect_tolerance", "render.", double(s.render.equirect_tolerance) * 255);
@@ -387,7 +390,9 @@ const char* config_keys_help() {
             units); share_scale = "units" (two-field pictures of fields with the same unit on one scale)
             | "none"; skip_empty = true; termination_alpha = 0.998;
             adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
-            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere);
+            corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere, and stop
+            refining where the first split's new points lie within adaptive_linear_tolerance = 2 of
+            the bilinear image of its corners; 0 = off);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
             apart whose columns widen toward the poles, whatever adaptive says; false = every pixel);
             equirect_tolerance = 10 (360° frames: the largest corner range interpolated, units of 1/255)

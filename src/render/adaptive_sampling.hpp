@@ -94,7 +94,11 @@ class AdaptiveTile {
   /// `stride` is the coarse lattice spacing (2 or 4; larger values work, refining by halves);
   /// `tolerance` the largest range of any premultiplied channel over a cell's corners that is still
   /// interpolated (the final image's units: 1/255 ≈ 0.0039).
-  AdaptiveTile(int stride, float tolerance) : stride_(stride), tolerance_(tolerance) {}
+  /// `linear` (0: off): a cell split at its midpoints whose new lattice points all lie within `linear`
+  /// of the bilinear interpolation of its corners is filled from them without splitting further
+  /// (volume tasks only: see linear()).
+  AdaptiveTile(int stride, float tolerance, float linear = 0)
+      : stride_(stride), tolerance_(tolerance), linear_(linear) {}
 
   /// Counters of the pixels handled so far: marched (for at least one task), and interpolated for
   /// every task (marched for none).
@@ -244,8 +248,51 @@ class AdaptiveTile {
     if (ny == 2) yv[1] = y1;
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) mark_marched(xv[i], yv[j], r, march);
+    const std::uint64_t lin = linear_ ? linear(x0, y0, x1, y1, xv, nx, yv, ny, r) : 0;
     for (int j = 0; j + 1 < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) refine(xv[i], yv[j], xv[i + 1], yv[j + 1], r, march, locate);
+      for (int i = 0; i + 1 < nx; ++i) {
+        if (lin) fill(xv[i], yv[j], xv[i + 1], yv[j + 1], lin, march, locate);
+        if (r & ~lin) refine(xv[i], yv[j], xv[i + 1], yv[j + 1], r & ~lin, march, locate);
+      }
+  }
+
+  // The tasks of `mask` (plain ones: no follow, keyed or sliver images) for which the cell's new
+  // lattice points (xv × yv, just marched) are within linear_ of the bilinear interpolation of its
+  // four corners: the image is bilinear there to that tolerance, so the sub-cells are filled from
+  // their own corners without splitting further (Round 13). The range test alone splits every cell
+  // across which the image changes by more than the tolerance, even where it changes linearly — in
+  // a dense field most cells — and their sub-cells again, down to single pixels; this test ends the
+  // split one level up where the first level's midpoints show that it may. Every new point of the
+  // split is still marched, and a cell whose corners or new points disagree on hit or miss goes on
+  // splitting as before.
+  std::uint64_t linear(int x0, int y0, int x1, int y1, const int* xv, int nx, const int* yv, int ny,
+                       std::uint64_t mask) const {
+    const PartialImage& o0 = out_[0];
+    const bool hit = depth(o0, x0, y0) != PartialImage::kNoDepth;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        if ((depth(o0, xv[i], yv[j]) != PartialImage::kNoDepth) != hit) return 0;
+    if (!hit) return 0;
+    const float sx = x1 > x0 ? 1.0f / float(x1 - x0) : 0.0f, sy = y1 > y0 ? 1.0f / float(y1 - y0) : 0.0f;
+    std::uint64_t lin = 0;
+    for (std::uint64_t m = mask & ~follow_ & ~keyed_; m; m &= m - 1) {
+      const PartialImage& o = out_[std::size_t(std::countr_zero(m))];
+      if (o.slivers) continue;
+      const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *d = o.rgba_at(x1, y1);
+      bool ok = true;
+      for (int j = 0; j < ny && ok; ++j)
+        for (int i = 0; i < nx && ok; ++i) {
+          const float u = float(xv[i] - x0) * sx, v = float(yv[j] - y0) * sy;
+          const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
+          const float* q = o.rgba_at(xv[i], yv[j]);
+          for (int k = 0; k < 4; ++k) {
+            const float e = q[k] - (w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * d[k]);
+            if (e > linear_ || e < -linear_) ok = false;
+          }
+        }
+      if (ok) lin |= m & -m;
+    }
+    return lin;
   }
 
   // Bilinear interpolation, for the tasks of `mask`, of the cell's pixels not marched for them. A
@@ -322,6 +369,7 @@ class AdaptiveTile {
 
   int stride_;
   float tolerance_;
+  float linear_ = 0;
   std::uint64_t follow_ = 0, keyed_ = 0;
   PixelRect tile_;
   std::span<PartialImage> out_;

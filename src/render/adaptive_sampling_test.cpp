@@ -40,8 +40,8 @@ struct Scene {
     out[0].depth[std::size_t(y) * kW + std::size_t(x)] = 5.0f;
     return 0;
   }
-  void run() {
-    AdaptiveTile tile(4, 0.1f);  // corners of a cell differ by 0.06 at most on the ramp
+  void run(float tolerance = 0.1f, float linear = 0) {
+    AdaptiveTile tile(4, tolerance, linear);  // corners of a cell differ by 0.06 at most on the ramp
     tile.run(PixelRect{0, 0, kW, kH}, out, [&](int x, int y, std::uint64_t m) { return march(x, y, m); },
              [](int, int, std::uint8_t) { return 5.0f; }, 0, nullptr, 0, 2);
   }
@@ -77,4 +77,22 @@ TEST(AdaptiveSampling, AJumpBetweenCornersIsRefinedToItsPixels) {
   s.run();
   for (int y = 0; y < kH; ++y)
     for (int x = 18; x < 24; ++x) ASSERT_NEAR(s.out[0].rgba_at(x, y)[0], s.ramp(x, y), 1e-5f) << x << "," << y;
+}
+
+// Round 13's linear test: with a tolerance below the ramp's change across a cell, the range test splits
+// every cell down to its pixels; with `linear` the first split's new points lie on the bilinear image
+// of the cell's corners, so its sub-cells are filled from them (exactly, on a ramp) without splitting
+// further, while a jump is still refined to its pixels.
+TEST(AdaptiveSampling, ALinearRampStopsTheSplitOneLevelUp) {
+  Scene full, lin;
+  full.run(0.02f, 0);
+  lin.run(0.02f, 0.01f);
+  EXPECT_LT(lin.marches, full.marches / 2) << lin.marches << " vs " << full.marches;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) ASSERT_NEAR(lin.out[0].rgba_at(x, y)[0], lin.ramp(x, y), 1e-5f) << x << "," << y;
+  Scene jump;
+  jump.step = true;
+  jump.run(0.02f, 0.01f);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 18; x < 24; ++x) ASSERT_NEAR(jump.out[0].rgba_at(x, y)[0], jump.ramp(x, y), 1e-5f) << x << "," << y;
 }

@@ -126,9 +126,9 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   if (opt.adaptive && opt.adaptive_stride < 2)
     throw Error("render: adaptive stride " + std::to_string(opt.adaptive_stride) + "; expected >= 2");
   const float tolerance = sphere ? opt.equirect_tolerance : opt.adaptive_tolerance;
-  if (adaptive && !(tolerance >= 0))
+  if (adaptive && (!(tolerance >= 0) || (!sphere && !(opt.adaptive_linear_tolerance >= 0))))
     throw Error(std::string("render: ") + (sphere ? "equirect" : "adaptive") + " tolerance " + std::to_string(tolerance) +
-                "; expected >= 0");
+                " (linear " + std::to_string(opt.adaptive_linear_tolerance) + "); expected >= 0");
   std::uint64_t n_rays = 0, n_eff = 0, n_marched = 0, n_interpolated = 0;
   const std::uint64_t all_tasks = K == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << K) - 1;
   // Adaptive sampling: isosurfaces and slices are refined wherever any task is (their edges are thin),
@@ -300,7 +300,7 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
   {
     alignas(64) float acc[kMaxTasksPerMarch][4];
     march::IsoSliver sliver[kMaxTasksPerMarch];
-    AdaptiveTile refiner(stride, tolerance);
+    AdaptiveTile refiner(stride, tolerance, sphere ? 0.0f : opt.adaptive_linear_tolerance);
 #pragma omp for schedule(dynamic, 1)
     for (int ti = 0; ti < ntx * nty; ++ti) {
       const int tx0 = std::max(rect.x0, (tx_first + ti % ntx) * tile_w), ty0 = std::max(rect.y0, (ty_first + ti / ntx) * tile_h);
