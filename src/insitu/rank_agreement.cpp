@@ -87,11 +87,16 @@ bool wait_for(MPI_Request& request, double timeout_s) {
     const double waited = std::chrono::duration<double>(Clock::now() - start).count();
     if (waited > timeout_s) return false;
     // A non-blocking collective advances only inside MPI calls: poll without giving the core away for
-    // the first 0.2 ms (a yield there made an agreement of ranks in step cost ~50 us against ~1 us for
-    // a blocking MPI_Allreduce on a loaded machine), then yield, then sleep.
-    if (waited < 0.0002) continue;
+    // the first 20 us (ranks in step arrive within microseconds), then sleep: 20 us at a time for the
+    // first 2 ms, then in growing steps. The agreement runs at every step's process() call, so when
+    // the ranks drift apart (a loaded node: a rank descheduled for a time slice) the early rank waits
+    // at every step; it used to spin for 0.2 ms and yield up to 2 ms, burning a core for the whole
+    // wait — measured in insitu_overhead_bench's setting (2 ranks, 8,000 steps, 2 shared cores): the
+    // session's own CPU 7.0–17.7 s in six runs (median 14.1), 7.2–9.4 s (median 8.7) with sleeps
+    // (docs/rendering.md, Round 13).
+    if (waited < 0.00002) continue;
     if (waited < 0.002) {
-      std::this_thread::yield();
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
       continue;
     }
     pause = std::min(std::chrono::microseconds(2000), pause + std::chrono::microseconds(50));
