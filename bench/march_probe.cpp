@@ -6,7 +6,8 @@
 // REF_DIR/ref_<i>.raw (written there with "save", from a full march: adaptive off), with the largest
 // channel error and the pixels per image off by more than 8/255. Environment: PROBE_SPARSE=1 (two
 // fronts 2 voxels wide) or =thin (0.7 voxel) instead of the dense scene; PROBE_STEP (sample distance,
-// voxels); PROBE_LIN (RenderOptions::adaptive_linear_tolerance in 1/255). docs/rendering.md, Round 13.
+// voxels); PROBE_LIN (RenderOptions::adaptive_linear_tolerance in 1/255); PROBE_ISO (an isosurface
+// task at 0.3 of the window as well: the hash then covers both images). docs/rendering.md, Round 13.
 #include <time.h>
 
 #include <cmath>
@@ -50,10 +51,11 @@ int main(int argc, char** argv) {
                                : DenseWaveScene{wave_field(grid, std::string(sp) == "thin" ? thin : pf), {}};
   const FieldView view = FieldView::whole(grid, waves.p.data());
   const double w = abs_percentile(view, 0.999);
-  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, w))};
+  std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, w))};
+  if (std::getenv("PROBE_ISO")) tasks.push_back(TaskSpec::isosurface(0, float(0.3 * w)));  // a mixed march
   const std::vector<FieldView> views{view};
   const std::vector<PreparedField> fields = prepare_fields(views, tasks);
-  std::vector<PartialImage> out(1);
+  std::vector<PartialImage> out(tasks.size());
   RenderOptions opt;
   opt.sample_distance = 1.0;
   opt.adaptive = !save;
@@ -68,11 +70,12 @@ int main(int argc, char** argv) {
     const camera::Camera cam = anchor_camera(grid, i);
     const RenderStats st = render_brick(cam, fields, tasks, out, opt);
     rays += st.rays, marched += st.marched_samples, samples += st.samples, interp += st.interpolated_pixels;
-    for (float f : out[0].rgba) {
-      std::uint32_t b;
-      std::memcpy(&b, &f, 4);
-      hash = (hash ^ b) * 1099511628211ull;
-    }
+    for (const PartialImage& o : out)
+      for (float f : o.rgba) {
+        std::uint32_t b;
+        std::memcpy(&b, &f, 4);
+        hash = (hash ^ b) * 1099511628211ull;
+      }
     finish_image_into(out[0], cam, grid, image, {0, 0, 0}, OutlineStyle{false});
     if (!ref.empty()) {
       const std::string path = ref + "/ref_" + std::to_string(i) + ".raw";

@@ -96,7 +96,7 @@ class AdaptiveTile {
   /// interpolated (the final image's units: 1/255 ≈ 0.0039).
   /// `linear` (0: off): a cell split at its midpoints whose new lattice points all lie within `linear`
   /// of the bilinear interpolation of its corners is filled from them without splitting further
-  /// (volume tasks only: see linear()).
+  /// (see linear(); not in cells split with `follow` tasks, whose images then stay as without it).
   AdaptiveTile(int stride, float tolerance, float linear = 0)
       : stride_(stride), tolerance_(tolerance), linear_(linear) {}
 
@@ -248,7 +248,9 @@ class AdaptiveTile {
     if (ny == 2) yv[1] = y1;
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) mark_marched(xv[i], yv[j], r, march);
-    const std::uint64_t lin = linear_ ? linear(x0, y0, x1, y1, xv, nx, yv, ny, r) : 0;
+    // Not where `follow` tasks are split with this cell: they are refined wherever any task is, and
+    // would lose that refinement in the sub-cells of the tasks filled here.
+    const std::uint64_t lin = linear_ > 0 && !(r & follow_) ? linear(x0, y0, x1, y1, xv, nx, yv, ny, r) : 0;
     for (int j = 0; j + 1 < ny; ++j)
       for (int i = 0; i + 1 < nx; ++i) {
         if (lin) fill(xv[i], yv[j], xv[i + 1], yv[j + 1], lin, march, locate);
@@ -256,7 +258,7 @@ class AdaptiveTile {
       }
   }
 
-  // The tasks of `mask` (plain ones: no follow, keyed or sliver images) for which the cell's new
+  // The tasks of `mask` (plain ones: no keyed or sliver images) for which the cell's new
   // lattice points (xv × yv, just marched) are within linear_ of the bilinear interpolation of its
   // four corners: the image is bilinear there to that tolerance, so the sub-cells are filled from
   // their own corners without splitting further (Round 13). The range test alone splits every cell
@@ -275,7 +277,7 @@ class AdaptiveTile {
     if (!hit) return 0;
     const float sx = x1 > x0 ? 1.0f / float(x1 - x0) : 0.0f, sy = y1 > y0 ? 1.0f / float(y1 - y0) : 0.0f;
     std::uint64_t lin = 0;
-    for (std::uint64_t m = mask & ~follow_ & ~keyed_; m; m &= m - 1) {
+    for (std::uint64_t m = mask & ~keyed_; m; m &= m - 1) {
       const PartialImage& o = out_[std::size_t(std::countr_zero(m))];
       if (o.slivers) continue;
       const float *a = o.rgba_at(x0, y0), *b = o.rgba_at(x1, y0), *c = o.rgba_at(x0, y1), *d = o.rgba_at(x1, y1);

@@ -34,7 +34,8 @@ struct RenderOptions {
   float adaptive_tolerance = 4.0f / 255;  ///< largest corner range interpolated (4/255: Round 4 of docs/rendering.md)
   /// A cell split at its midpoints whose new lattice points all lie within this of the bilinear
   /// interpolation of its four corners (every premultiplied channel) is filled without splitting
-  /// further, for volume tasks (isosurfaces, slices, maxima split as before); 0: off. 2/255 (Round 13
+  /// further; not where isosurfaces, slices or maxima are split with the cell (their refinement, and
+  /// so every image of such a march, stays as without it); 0: off. 2/255 (Round 13
   /// of docs/rendering.md): the dense anchor marches 22 % of its rays instead of 32 % (−17 % CPU) at
   /// 59.8 instead of 60.7 dB of the full march, max error 8/255 instead of 7. Perspective frames only.
   float adaptive_linear_tolerance = 2.0f / 255;
