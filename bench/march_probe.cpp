@@ -7,7 +7,7 @@
 // channel error and the pixels per image off by more than 8/255. Environment: PROBE_SPARSE=1 (two
 // fronts 2 voxels wide) or =thin (0.7 voxel) instead of the dense scene; PROBE_STEP (sample distance,
 // voxels); PROBE_LIN (RenderOptions::adaptive_linear_tolerance in 1/255); PROBE_ISO (an isosurface
-// task at 0.3 of the window as well: the hash then covers both images). docs/rendering.md, Round 13.
+// task at 0.3 of the window as well: the hash then covers both images); PROBE_STRIDE (adaptive_stride). docs/rendering.md, Round 13.
 #include <time.h>
 
 #include <cmath>
@@ -51,7 +51,9 @@ int main(int argc, char** argv) {
                                : DenseWaveScene{wave_field(grid, std::string(sp) == "thin" ? thin : pf), {}};
   const FieldView view = FieldView::whole(grid, waves.p.data());
   const double w = abs_percentile(view, 0.999);
+  int opt_stride = 4;
   std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, w))};
+  if (const char* s = std::getenv("PROBE_STRIDE")) opt_stride = std::atoi(s);
   if (std::getenv("PROBE_ISO")) tasks.push_back(TaskSpec::isosurface(0, float(0.3 * w)));  // a mixed march
   const std::vector<FieldView> views{view};
   const std::vector<PreparedField> fields = prepare_fields(views, tasks);
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
   RenderOptions opt;
   opt.sample_distance = 1.0;
   opt.adaptive = !save;
+  opt.adaptive_stride = opt_stride;
   if (const char* s = std::getenv("PROBE_STEP")) opt.sample_distance = std::atof(s);
   if (const char* s = std::getenv("PROBE_LIN")) opt.adaptive_linear_tolerance = float(std::atof(s) / 255);
   Image image;
