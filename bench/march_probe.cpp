@@ -8,7 +8,6 @@
 // fronts 2 voxels wide) or =thin (0.7 voxel) instead of the dense scene; PROBE_STEP (sample distance,
 // voxels); PROBE_LIN (RenderOptions::adaptive_linear_tolerance in 1/255); PROBE_ISO (an isosurface
 // task at 0.3 of the window as well: the hash then covers both images); PROBE_STRIDE (adaptive_stride). docs/rendering.md, Round 13.
-#include <time.h>
 
 #include <cmath>
 #include <cstdio>
@@ -21,22 +20,10 @@
 #include "core/image.hpp"
 #include "render/renderer.hpp"
 #include "render/synthetic_fields.hpp"
+#include "anchor_scene.hpp"
 
 using namespace panoptes;
 using namespace panoptes::render;
-
-namespace {
-double cpu_seconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-camera::Camera anchor_camera(const GridGeometry& g, int i) {
-  const Vec3 ext = g.domain_hi() - g.domain_lo();
-  const Vec3 dir = normalize(Vec3{i & 1 ? 1.0 : -1.0, i & 2 ? 1.0 : -1.0, i & 4 ? 0.6 : -0.6});
-  return camera::Camera(g.centre() + dir * (1.1 * norm(ext)), g.centre(), {0, 0, 1}, 30, 920, 896);
-}
-}  // namespace
 
 int main(int argc, char** argv) {
   const int rounds = argc > 1 ? std::atoi(argv[1]) : 3;
@@ -70,7 +57,7 @@ int main(int argc, char** argv) {
   int maxerr = 0;
   long over8 = 0;
   for (int i = 0; i < 8; ++i) {
-    const camera::Camera cam = anchor_camera(grid, i);
+    const camera::Camera cam = bench::anchor_camera(grid, i);
     const RenderStats st = render_brick(cam, fields, tasks, out, opt);
     rays += st.rays, marched += st.marched_samples, samples += st.samples, interp += st.interpolated_pixels;
     for (const PartialImage& o : out)
@@ -99,14 +86,14 @@ int main(int argc, char** argv) {
       }
     }
   }
-  const double c0 = cpu_seconds();
+  const double c0 = bench::process_cpu_seconds();
   for (int r = 0; r < rounds; ++r)
     for (int i = 0; i < 8; ++i) {
-      const camera::Camera cam = anchor_camera(grid, i);
+      const camera::Camera cam = bench::anchor_camera(grid, i);
       render_brick(cam, fields, tasks, out, opt);
       finish_image_into(out[0], cam, grid, image, {0, 0, 0}, OutlineStyle{false});
     }
-  const double cpu = (cpu_seconds() - c0) / (8.0 * rounds);
+  const double cpu = (bench::process_cpu_seconds() - c0) / (8.0 * rounds);
   std::printf("cpu_s_per_image %.5f hash %016llx rays %.3f%% marched/ray %.1f samples/ray %.1f", cpu,
               (unsigned long long)hash, 100.0 * double(rays) / double(rays + interp), double(marched) / double(rays),
               double(samples) / double(rays));

@@ -14,7 +14,6 @@
 // one round of the 8 images (warm-up, saved as DIR/panoptes_step<D>_<i>.png), then ROUNDS rounds
 // (default 3) timed by the process's CPU time around render + final RGBA frame. Prints one line per
 // sample distance: "step D cpu_s_per_image X images N".
-#include <time.h>
 
 #include <cmath>
 #include <cstdio>
@@ -29,25 +28,10 @@
 #include "core/png.hpp"
 #include "render/renderer.hpp"
 #include "render/synthetic_fields.hpp"
+#include "anchor_scene.hpp"
 
 using namespace panoptes;
 using namespace panoptes::render;
-
-namespace {
-
-double cpu_seconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-camera::Camera anchor_camera(const GridGeometry& g, int i) {
-  const Vec3 ext = g.domain_hi() - g.domain_lo();
-  const Vec3 dir = normalize(Vec3{i & 1 ? 1.0 : -1.0, i & 2 ? 1.0 : -1.0, i & 4 ? 0.6 : -0.6});
-  return camera::Camera(g.centre() + dir * (1.1 * norm(ext)), g.centre(), {0, 0, 1}, 30, 920, 896);
-}
-
-}  // namespace
 
 int main(int argc, char** argv) try {
   if (argc < 2 || argc > 3) {
@@ -80,7 +64,7 @@ int main(int argc, char** argv) try {
     opt.sample_distance = step;
     opt.adaptive = true;  // panoptes render's default
     auto one = [&](int i) {
-      const camera::Camera cam = anchor_camera(grid, i);
+      const camera::Camera cam = bench::anchor_camera(grid, i);
       render_brick(cam, fields, tasks, out, opt);
       finish_image_into(out[0], cam, grid, image, {0, 0, 0}, OutlineStyle{false});
     };
@@ -90,10 +74,10 @@ int main(int argc, char** argv) try {
       std::snprintf(name, sizeof name, "panoptes_step%.1f_%d.png", step, i);
       write_png((dir / name).string(), image);
     }
-    const double c0 = cpu_seconds();
+    const double c0 = bench::process_cpu_seconds();
     for (int r = 0; r < rounds; ++r)
       for (int i = 0; i < 8; ++i) one(i);
-    std::printf("step %.1f cpu_s_per_image %.5f images %d\n", step, (cpu_seconds() - c0) / (8.0 * rounds), 8 * rounds);
+    std::printf("step %.1f cpu_s_per_image %.5f images %d\n", step, (bench::process_cpu_seconds() - c0) / (8.0 * rounds), 8 * rounds);
   }
   return 0;
 } catch (const std::exception& e) {
