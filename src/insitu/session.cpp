@@ -208,6 +208,7 @@ void Session::Impl::take_snapshot(double time, const std::vector<FieldInput>& fi
   }
   m.last_references = ref;
   m.plan.resolve(ref, m.specs);
+  m.prepare_fields();
   m.time.copy += since(t0);
   m.render_snapshot(m.snapshots);
   ++m.snapshots;

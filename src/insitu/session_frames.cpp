@@ -65,17 +65,21 @@ void Session::Impl::load_fields(const std::vector<FieldInput>& fields) {
   }
   exchange.load(inputs, req, buffers);
   prepared.clear();
-  if (b.has_brick) {
-    render::PointRange pr{req.lo, req.hi};
-    std::vector<render::FieldView> views;
-    for (std::size_t f = 0; f < field_names.size(); ++f)
-      views.push_back(render::FieldView::of_brick(grid, b.brick, pr, buffers[f].data()));
-    // Every camera renders every task in one march: the fields the volume tasks read together get
-    // one interleaved corner copy (render::prepare_fields()).
-    std::vector<render::TaskSpec> uses;
-    for (const PlannedTask& t : plan.tasks()) uses.push_back(t.spec);
-    prepared = render::prepare_fields(views, uses);
-  }
+}
+
+void Session::Impl::prepare_fields() {
+  prepared.clear();
+  const BlockInfo& b = me();
+  if (!b.has_brick) return;
+  const Box& req = b.required;
+  render::PointRange pr{req.lo, req.hi};
+  std::vector<render::FieldView> views;
+  for (std::size_t f = 0; f < field_names.size(); ++f)
+    views.push_back(render::FieldView::of_brick(grid, b.brick, pr, buffers[f].data()));
+  // Every camera renders every task in one march: the fields the volume tasks read together get one
+  // interleaved corner copy, clamped to what this snapshot's windows tell apart (render::prepare_fields()),
+  // so the tasks' references must be resolved first.
+  prepared = render::prepare_fields(views, specs);
 }
 
 // The q-quantile of |v| over a fixed lattice of global points (the same set whatever the

@@ -168,6 +168,8 @@ struct Session::Impl {
   std::exception_ptr time_refusal(double time) const;
   std::exception_ptr field_refusal(const std::vector<FieldInput>& fields) const;
   void load_fields(const std::vector<FieldInput>& fields);
+  // The render's prepared fields (corner copies) of the loaded buffers, for `specs` as resolved.
+  void prepare_fields();
   double global_percentile(int field);
   double window_reference(int field);
   void render_snapshot(int frame);

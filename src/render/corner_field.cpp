@@ -46,15 +46,16 @@ bool CornerField::shape(const FieldView& f) {
   return true;
 }
 
-CornerField::CornerField(const FieldView& f) {
+CornerField::CornerField(const FieldView& f, QuantizationRange keep) {
   if (!shape(f)) return;
-  const std::vector<std::uint16_t> pq = quantize(f);
+  const std::vector<std::uint16_t> pq = quantize(f, keep);
   const std::vector<std::uint16_t>* const list[1] = {&pq};
   q_ = write_records(list, 1, f, counts_);
   data_ = q_.get();
 }
 
-std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const FieldView& b) {
+std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const FieldView& b, QuantizationRange keep_a,
+                                                       QuantizationRange keep_b) {
   a.validate();
   b.validate();
   if (a.points.lo != b.points.lo || a.points.hi != b.points.hi)
@@ -63,7 +64,7 @@ std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const
                 std::to_string(b.points.hi[0]) + ") along x, or along y or z); a joint copy needs the same range");
   std::pair<CornerField, CornerField> r;
   if (!r.first.shape(a) || !r.second.shape(b)) return {};
-  const std::vector<std::uint16_t> pa = r.first.quantize(a), pb = r.second.quantize(b);
+  const std::vector<std::uint16_t> pa = r.first.quantize(a, keep_a), pb = r.second.quantize(b, keep_b);
   const std::vector<std::uint16_t>* const list[2] = {&pa, &pb};
   r.first.q_ = r.second.q_ = write_records(list, 2, a, r.first.counts_);
   r.first.record_ = r.second.record_ = 16;
@@ -72,7 +73,7 @@ std::pair<CornerField, CornerField> CornerField::joint(const FieldView& a, const
   return r;
 }
 
-std::vector<std::uint16_t> CornerField::quantize(const FieldView& f) {
+std::vector<std::uint16_t> CornerField::quantize(const FieldView& f, QuantizationRange keep) {
   const PointRange& pr = f.points;
   const int nx = pr.hi[0] - pr.lo[0], ny = pr.hi[1] - pr.lo[1], nz = pr.hi[2] - pr.lo[2];
   auto at = [&](int i, int j, int k) {
@@ -89,6 +90,10 @@ std::vector<std::uint16_t> CornerField::quantize(const FieldView& f) {
         if (v > vmax) vmax = v;
       }
   if (!(vmin <= vmax)) vmin = vmax = 0;  // all NaN
+  // Clamped to what the tasks tell apart; a field wholly on one side of it becomes that bound.
+  if (vmax < keep.lo) vmin = vmax = keep.lo;
+  else if (vmin > keep.hi) vmin = vmax = keep.hi;
+  else vmin = std::max(vmin, keep.lo), vmax = std::min(vmax, keep.hi);
   offset_ = vmin;
   scale_ = (vmax - vmin) / 65535.0f;
   const float inv = scale_ > 0 ? 1.0f / scale_ : 0.0f;
@@ -98,7 +103,8 @@ std::vector<std::uint16_t> CornerField::quantize(const FieldView& f) {
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
-        const float u = (at(i, j, k) - vmin) * inv + 0.5f;
+        const float v = at(i, j, k);
+        const float u = ((v < vmin ? vmin : v > vmax ? vmax : v) - vmin) * inv + 0.5f;  // NaN stays NaN
         pq[std::size_t(i + std::int64_t(nx) * (j + std::int64_t(ny) * k))] =
             u >= 0 ? std::uint16_t(std::min(u, 65535.0f)) : std::uint16_t(0);  // also NaN → 0
       }

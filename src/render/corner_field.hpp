@@ -3,6 +3,7 @@
 // and stored together, so one trilinear sample is one 16-byte load instead of eight gathered floats.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <new>
 #include <utility>
@@ -29,10 +30,22 @@ struct HugePageAllocator {
   bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }
 };
 
+/// The values a march must tell apart in a corner copy: beyond [lo, hi] every task reading the copy
+/// shows the same thing (its transfer function is constant past its window), so the copy clamps the
+/// field to it and spends its 65,536 levels inside (prepare_fields() derives it from the tasks). The
+/// default keeps the whole value range.
+struct QuantizationRange {
+  float lo = -std::numeric_limits<float>::infinity();
+  float hi = std::numeric_limits<float>::infinity();
+};
+
 /// For every cell whose lower corner (i, j, k) lies in [points.lo, points.hi − 2] of a view, the
 /// field at its 8 corners in the order (0,0,0), (1,0,0), (0,1,0), (1,1,0), (0,0,1), (1,0,1),
 /// (0,1,1), (1,1,1), as q ∈ [0, 65535] with value = offset + scale·q (rounded to nearest: the error
-/// is at most scale / 2 = (max − min) / 131070 of the view's value range). 16 bytes per cell: four
+/// is at most scale / 2 = (max − min) / 131070 of the view's value range, clamped to the
+/// QuantizationRange). Without the clamp a source's near field 26,000x a task's fixed window left a
+/// step of 0.8x the window: zero read back as 0.4x it, and the paper's p movies showed an orange box
+/// where the solver's field was exactly zero. 16 bytes per cell: four
 /// times the float32 field, paid once per snapshot and shared by every camera and task.
 ///
 /// Two fields of one point range that a march reads together (the paper's p and s) may share one
@@ -44,11 +57,12 @@ class CornerField {
   CornerField() = default;
   /// Builds the copy (OpenMP-parallel). Views with more than 2^31 − 1 cells get an empty copy (the
   /// renderer then reads the float field).
-  explicit CornerField(const FieldView& view);
+  explicit CornerField(const FieldView& view, QuantizationRange keep = {});
   /// The copies of two views with the same point range in one interleaved buffer: first.data() and
   /// second.data() point 8 values apart, record() = 16. Throws panoptes::Error when the point
   /// ranges differ.
-  static std::pair<CornerField, CornerField> joint(const FieldView& a, const FieldView& b);
+  static std::pair<CornerField, CornerField> joint(const FieldView& a, const FieldView& b, QuantizationRange keep_a = {},
+                                                   QuantizationRange keep_b = {});
 
   bool empty() const { return data_ == nullptr; }
   /// This field's 8 values of cell c start at data() + record()·c (cells x fastest over counts()).
@@ -70,7 +84,7 @@ class CornerField {
   // Checks the view, sets lo_ and counts_; false when the copy would have too many cells.
   bool shape(const FieldView& view);
   // The view's points quantized (sets offset_ and scale_), x fastest.
-  std::vector<std::uint16_t> quantize(const FieldView& view);
+  std::vector<std::uint16_t> quantize(const FieldView& view, QuantizationRange keep);
   // Allocates the buffer (huge pages, not zeroed: every value is written) and writes the records
   // of nf fields (1 or 2) from their quantized points, one pass over the buffer.
   static std::shared_ptr<std::uint16_t> write_records(const std::vector<std::uint16_t>* const* pq, int nf,

@@ -46,10 +46,11 @@ struct PreparedField {
 
   PreparedField() = default;
   /// Validates the view and builds its macro-cells and, with FieldCopy::corners16, the corner copy.
+  /// `keep`: the values the tasks tell apart (prepare_fields(); the default keeps the whole range).
   explicit PreparedField(const FieldView& v, int macro_cell_size = MacroCells::kDefaultSize,
-                         FieldCopy copy = FieldCopy::corners16)
+                         FieldCopy copy = FieldCopy::corners16, QuantizationRange keep = {})
       : view((v.validate(), v)), cells(v, macro_cell_size) {
-    if (copy == FieldCopy::corners16) corners = CornerField(v);
+    if (copy == FieldCopy::corners16) corners = CornerField(v, keep);
   }
   /// With a corner copy built elsewhere (e.g. one half of CornerField::joint()).
   PreparedField(const FieldView& v, CornerField copy, int macro_cell_size = MacroCells::kDefaultSize)

@@ -348,6 +348,55 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
 }
 
 
+std::vector<QuantizationRange> quantization_ranges(int n_fields, std::span<const TaskSpec> tasks) {
+  // Past a window's ends a transfer function is constant, so a sample there looks the same whatever
+  // the value. The margin of 64 window widths keeps trilinear samples between a clamped corner and
+  // its neighbours within 1/64 of a cell of where the true field crosses the window's end, and leaves
+  // a quantization step of 1/500 of the window (half a step: 1/4 of an 8-bit colour level).
+  constexpr double kMargin = 64;
+  std::vector<double> lo(std::size_t(n_fields), std::numeric_limits<double>::infinity()),
+      hi(std::size_t(n_fields), -std::numeric_limits<double>::infinity());
+  auto add = [&](int f, double a, double b) {
+    if (f < 0 || f >= n_fields) return;  // prepare_fields() names the bad index
+    lo[std::size_t(f)] = std::min(lo[std::size_t(f)], a);
+    hi[std::size_t(f)] = std::max(hi[std::size_t(f)], b);
+  };
+  auto add_window = [&](int f, const TransferFunction& tf, const ValueWindow& w, double reference) {
+    const ValueWindow r = w.resolve(reference);
+    const double m = kMargin * (r.hi - r.lo);
+    if (tf.absolute_value) {
+      const double b = std::max(std::abs(r.lo), std::abs(r.hi)) + m;
+      add(f, -b, b);
+    } else {
+      add(f, r.lo - m, r.hi + m);
+    }
+  };
+  for (const TaskSpec& t : tasks) {
+    switch (t.kind) {
+      case TaskKind::volume:
+        add_window(t.field, t.tf, t.window, t.reference);
+        if (t.field2 >= 0) add_window(t.field2, t.tf2, t.window2, t.reference2);
+        break;
+      case TaskKind::mip:  // reads the march's samples of its field, as a volume does
+        add_window(t.field, t.tf, t.window, t.reference);
+        break;
+      case TaskKind::isosurface:  // the crossing must stay on its side of the clamp
+        add(t.field, t.isovalue, t.isovalue);
+        break;
+      default:  // slices read the float field
+        break;
+    }
+  }
+  std::vector<QuantizationRange> out(static_cast<std::size_t>(n_fields));
+  for (std::size_t f = 0; f < out.size(); ++f)
+    if (lo[f] <= hi[f]) {
+      // Rounded outwards to float, so that the window's own ends are inside.
+      out[f].lo = std::nextafter(float(lo[f]), -std::numeric_limits<float>::infinity());
+      out[f].hi = std::nextafter(float(hi[f]), std::numeric_limits<float>::infinity());
+    }
+  return out;
+}
+
 std::vector<PreparedField> prepare_fields(std::span<const FieldView> views, std::span<const TaskSpec> tasks,
                                           int macro_cell_size) {
   const int n = int(views.size());
@@ -382,18 +431,20 @@ std::vector<PreparedField> prepare_fields(std::span<const FieldView> views, std:
   for (const auto& [a, b] : wanted)
     if (partner[std::size_t(a)] < 0 && partner[std::size_t(b)] < 0 && same_range(a, b))
       partner[std::size_t(a)] = b, partner[std::size_t(b)] = a;
+  const std::vector<QuantizationRange> keep = quantization_ranges(n, tasks);
   std::vector<PreparedField> out(static_cast<std::size_t>(n));
   for (int f = 0; f < n; ++f) {
     const FieldView& v = views[std::size_t(f)];
     const int p = partner[std::size_t(f)];
     if (p >= 0 && p < f) continue;  // built with its partner
     if (p >= 0) {
-      auto [cf, cp] = CornerField::joint(v, views[std::size_t(p)]);
+      auto [cf, cp] = CornerField::joint(v, views[std::size_t(p)], keep[std::size_t(f)], keep[std::size_t(p)]);
       out[std::size_t(f)] = PreparedField(v, std::move(cf), macro_cell_size);
       out[std::size_t(p)] = PreparedField(views[std::size_t(p)], std::move(cp), macro_cell_size);
     } else {
       out[std::size_t(f)] =
-          PreparedField(v, macro_cell_size, volume[std::size_t(f)] ? FieldCopy::corners16 : FieldCopy::none);
+          PreparedField(v, macro_cell_size, volume[std::size_t(f)] ? FieldCopy::corners16 : FieldCopy::none,
+                        keep[std::size_t(f)]);
     }
   }
   return out;

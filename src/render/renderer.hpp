@@ -91,9 +91,17 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
 /// volume task reads, none for the others (isosurfaces and slices read the float field), and the
 /// copies of two such fields with the same point range interleaved (CornerField::joint()) — first
 /// the two fields of each two-field volume task, then the rest in order — since every march of
-/// the task list reads them sample by sample together. Images are those of separately prepared
-/// fields, bit for bit. Throws panoptes::Error when a task names a field outside `views`.
+/// the task list reads them sample by sample together. Each copy is clamped to the values its tasks
+/// tell apart (quantization_ranges()), so `tasks` must be the tasks as they will be rendered, their
+/// references resolved. Images are those of fields prepared separately with the same ranges, bit
+/// for bit. Throws panoptes::Error when a task names a field outside `views`.
 std::vector<PreparedField> prepare_fields(std::span<const FieldView> views, std::span<const TaskSpec> tasks,
                                           int macro_cell_size = MacroCells::kDefaultSize);
+
+/// Per field of `n_fields`, the values the tasks that read its corner copy tell apart: the union over
+/// its volume and MIP tasks of their resolved windows (of ±|v| for an absolute-value map) widened by
+/// 64 window widths on each side, and its isovalues; the whole range for a field no such task reads.
+/// Throws panoptes::Error when a window cannot be resolved (ValueWindow::resolve()).
+std::vector<QuantizationRange> quantization_ranges(int n_fields, std::span<const TaskSpec> tasks);
 
 }  // namespace panoptes::render

@@ -294,3 +294,42 @@ TEST(Renderer, IsosurfaceHitShadingMatchesTheScalarFormula) {
   EXPECT_LE(worst, 1e-6);
   std::printf("hit shading: renderer vs scalar formula, worst channel difference %.3g\n", worst);
 }
+
+// A source's near field far above a fixed window (the paper run at h = 100 m: 1.3 1/s beside a
+// window of 5e-5 1/s) must leave the field's zeros black. The 16-bit corner copy once spread its
+// levels over the whole value range, so zero read back as 0.3x the window and the box glowed where
+// the field was exactly zero; prepare_fields() now clamps each copy to what its tasks tell apart.
+TEST(Renderer, FarAboveTheWindowZerosStayBlack) {
+  const GridGeometry g{{24, 24, 24}, {-11.5, -11.5, -11.5}, {1, 1, 1}};
+  std::vector<float> v(24 * 24 * 24, 0.0f);
+  auto at = [&](int i, int j, int k) -> float& { return v[std::size_t(i + 24 * (j + 24 * k))]; };
+  at(11, 11, 11) = 1.0f;  // both signs, so zero is not the range's end
+  at(12, 11, 11) = -1.0f;
+  const double window_top = 5e-5;
+  const std::vector<TaskSpec> tasks{
+      TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::relative_to(0, 1), window_top)};
+  const camera::Camera cam({40, -30, 25}, {0, 0, 0}, {0, 0, 1}, 40, 96, 72);
+  const FieldView view = FieldView::whole(g, v.data());
+  auto lit_far_from_the_spike = [&](const std::vector<PreparedField>& fields) {
+    std::vector<PartialImage> out(1);
+    render_brick(cam, fields, tasks, out);
+    const Image im = finish_image(out[0], cam, g, {0, 0, 0}, {false});
+    // The spike projects near the image centre; count lit pixels outside a central disc.
+    int lit = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        const double dx = x - im.width / 2.0, dy = y - im.height / 2.0;
+        if (dx * dx + dy * dy < 15.0 * 15.0) continue;
+        const auto* p = im.at(x, y);
+        if (p[0] + p[1] + p[2] > 6) ++lit;
+      }
+    return lit;
+  };
+  // The whole range in 16 bits (what every march read before): the box glows.
+  EXPECT_GT(lit_far_from_the_spike({PreparedField(view)}), 1000);
+  // As the in-situ session prepares it: nothing away from the spike.
+  EXPECT_EQ(lit_far_from_the_spike(prepare_fields(std::span(&view, 1), tasks)), 0);
+  const std::vector<QuantizationRange> keep = quantization_ranges(1, tasks);
+  EXPECT_NEAR(keep[0].hi, window_top * 65, 1e-9);
+  EXPECT_NEAR(keep[0].lo, -window_top * 65, 1e-9);
+}
