@@ -250,6 +250,7 @@ void Session::finalize() {
     }
     m.agree(Call::finalize, CallRecord{}, local, Failure::failed);
     m.finalized = true;
+    m.warn_invisible_tasks();
 #ifdef PANOPTES_HAVE_MPI
     if (m.size > 1) MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_MIN, m.comm);
 #endif

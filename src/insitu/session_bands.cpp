@@ -123,9 +123,11 @@ void Session::Impl::render_snapshot_banded(int frame) {
         empty_partial.reset(W, H, {0, 0, 0, 0});
         render::finish_image_into(empty_partial, cam, grid, out, bg, outline);
       } else if (p.size() == 1) {
+        note_shown(t, frame, *p[0]);
         render::finish_image_into(*p[0], cam, grid, out, bg, outline);
       } else {
         render::composite_into(specs[std::size_t(t)].kind, p, composited[std::size_t(t)]);
+        note_shown(t, frame, composited[std::size_t(t)]);
         render::finish_image_into(composited[std::size_t(t)], cam, grid, out, bg, outline);
       }
       const std::size_t row_bytes = std::size_t(W) * 4, n = row_bytes * std::size_t(y1 - y0);

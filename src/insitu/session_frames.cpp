@@ -188,6 +188,7 @@ void Session::Impl::render_sweep_snapshot(int frame) {
       for (int t = 0; t < K; ++t) {
         try {
           sweep_frames.to_partial(t, part);
+          note_shown(t, frame, part);
           render::finish_image_into(part, cam, grid, image, bg, outline);
           if (observer) {
 #pragma omp critical(panoptes_sweep_observer)
@@ -225,9 +226,11 @@ void Session::Impl::finish_camera(int camera, int frame) {
       empty_partial.reset(cfg.width, cfg.height, {0, 0, 0, 0});
       render::finish_image_into(empty_partial, cam, grid, out, bg, outline);
     } else if (p.size() == 1) {
+      note_shown(t, frame, *p[0]);
       render::finish_image_into(*p[0], cam, grid, out, bg, outline);
     } else {
       render::composite_into(specs[std::size_t(t)].kind, p, composited[std::size_t(t)]);  // the kind's blend
+      note_shown(t, frame, composited[std::size_t(t)]);
       render::finish_image_into(composited[std::size_t(t)], cam, grid, out, bg, outline);
     }
   }
@@ -258,7 +261,24 @@ void Session::Impl::render_own_cameras(int frame) {
   encode_batch();
 }
 
+void Session::Impl::note_shown(int task, int frame, const render::PartialImage& p) {
+  std::vector<char>& f = shown[std::size_t(task)];
+  if (f[std::size_t(frame)] == 2) return;  // one camera is enough: most frames cost one short scan
+  constexpr float kVisible = 2.0f / 255.0f;
+  const std::size_t n = p.rgba.size();
+  for (std::size_t i = 3; i < n; i += 4)
+    if (p.rgba[i] > kVisible) {
+      f[std::size_t(frame)] = 2;
+      return;
+    }
+}
+
 void Session::Impl::render_snapshot(int frame) {
+  shown.resize(plan.size());
+  for (auto& f : shown) {
+    f.resize(std::max(f.size(), std::size_t(frame) + 1), 0);
+    f[std::size_t(frame)] = 1;  // rendered here; 2 once something showed
+  }
   if (sweep && render::is_sweep(specs)) return render_sweep_snapshot(frame);
   if (split == RenderSplit::cameras) return render_own_cameras(frame);
   const int C = rig.size();
@@ -400,6 +420,66 @@ void Session::Impl::checkpoint(double t) {
     }
   }
   time.checkpoint += since(t0);
+}
+
+void Session::Impl::warn_invisible_tasks() {
+  const int K = int(plan.size());
+  const int F = snapshots;
+  if (K == 0 || F == 0) return;
+  std::vector<unsigned char> all(std::size_t(K) * std::size_t(F), 0);
+  for (int t = 0; t < K && std::size_t(t) < shown.size(); ++t)
+    for (int f = 0; f < F && std::size_t(f) < shown[std::size_t(t)].size(); ++f)
+      all[std::size_t(t) * F + f] = static_cast<unsigned char>(shown[std::size_t(t)][std::size_t(f)]);
+#ifdef PANOPTES_HAVE_MPI
+  if (size > 1) MPI_Allreduce(MPI_IN_PLACE, all.data(), int(all.size()), MPI_UNSIGNED_CHAR, MPI_MAX, comm);
+#endif
+  if (rank != 0) return;
+  for (int t = 0; t < K; ++t) {
+    int rendered = 0, empty = 0;
+    std::string ranges;
+    int run_start = -1, listed = 0;
+    auto close_run = [&](int end) {  // frames [run_start, end)
+      if (run_start < 0) return;
+      if (listed < 4) ranges += std::string(listed ? ", " : "") + std::to_string(run_start) +
+                                (end - 1 > run_start ? "-" + std::to_string(end - 1) : "");
+      else if (listed == 4) ranges += ", ...";
+      ++listed;
+      run_start = -1;
+    };
+    for (int f = 0; f < F; ++f) {
+      const unsigned char v = all[std::size_t(t) * F + f];
+      if (v >= 1) ++rendered;
+      if (v == 1) {
+        ++empty;
+        if (run_start < 0) run_start = f;
+      } else {
+        close_run(f);
+      }
+    }
+    close_run(F);
+    // A few empty frames are physics (a wave not yet started); a quarter of the run is a scale or a
+    // window that hides the field, which nobody would see until the movies are opened.
+    if (empty < 3 || 4 * empty < rendered) continue;
+    const PlannedTask& p = plan.tasks()[std::size_t(t)];
+    std::string scale;
+    if (p.shared && p.spec.field2 >= 0 && std::size_t(p.spec.field2) < field_names.size())
+      scale = "; its windows are relative to the larger of " + field_names[std::size_t(p.spec.field)] + "'s and " +
+              field_names[std::size_t(p.spec.field2)] + "'s references (a shared scale): lower them if the fields are weaker";
+    else if (p.relative && p.spec.field >= 0 && std::size_t(p.spec.field) < field_names.size()) {
+      const FieldScale fs = cfg.scale_of(field_names[std::size_t(p.spec.field)]);
+      scale = fs.mode == ReferenceMode::fixed
+                  ? "; its window is relative to " + field_names[std::size_t(p.spec.field)] + "'s fixed reference " +
+                        number_text(fs.value) + ": lower it if the field is weaker"
+                  : fs.mode == ReferenceMode::running
+                        ? "; its window is relative to the largest reference so far of " +
+                              field_names[std::size_t(p.spec.field)] +
+                              ", which a source's near field can set far above the waves: a fixed reference may suit"
+                        : "";
+    }
+    log::warn(cfg.output_dir + ": task \"" + p.entry.name + "\" showed nothing in " + std::to_string(empty) + " of " +
+              std::to_string(rendered) + " frames (" + ranges + ") from any camera: every sample was transparent" + scale +
+              " (docs/insitu.md, \"When running fails\")");
+  }
 }
 
 }  // namespace panoptes::insitu

@@ -106,6 +106,12 @@ struct Session::Impl {
   std::vector<char> recv_buf;
   std::vector<std::vector<render::PartialImage>> received;  // [rank][task]
   std::vector<render::PartialImage> composited;
+  // [task][frame]: 1 once some camera of this rank showed something of the task in the frame (a pixel
+  // more than 2/255 opaque); reduced over ranks at finalize for the "nothing visible" warning.
+  std::vector<std::vector<char>> shown;
+  void note_shown(int task, int frame, const render::PartialImage& p);
+  // Rank 0 warns of tasks that showed nothing in many frames (collective).
+  void warn_invisible_tasks();
   // Per owned camera: the partials of each task in rank order, and the empty partial of a camera
   // no brick reaches (members, so their capacity is reused from camera to camera).
   std::vector<std::vector<const render::PartialImage*>> parts;  // [task]

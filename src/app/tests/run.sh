@@ -62,6 +62,15 @@ check_complete() {
 grep -q "4 cameras x 2 tasks = 8 streams, 4 frames each" run1.log || { cat run1.log; echo "FAIL: summary"; exit 1; }
 grep -q "raw fields" run1.log || { cat run1.log; echo "FAIL: no raw-size comparison"; exit 1; }
 check_complete tiny_db
+if grep -q "showed nothing" run1.log; then cat run1.log; echo "FAIL: a visible run warned of empty frames"; exit 1; fi
+
+# A scale far above the field (a fixed reference 1e5 times the waves' 1/s) leaves every frame of the p
+# task black: the run says so at its end instead of leaving it to whoever opens the movies.
+printf '[render.field.phi_p]\nreference = "fixed"\nvalue = 10.0\n' | cat tiny.toml - > dark.toml
+"$bin" run dark.toml --out dark_db > dark.log 2>&1 || { cat dark.log; echo "FAIL: run dark.toml"; exit 1; }
+grep -qF 'task "p" showed nothing in 4 of 4 frames (0-3) from any camera' dark.log ||
+  { cat dark.log; echo "FAIL: no warning for a task that showed nothing"; exit 1; }
+grep -qF "fixed reference 10" dark.log || { cat dark.log; echo "FAIL: the warning does not name the reference"; exit 1; }
 
 # An existing database is refused unless --overwrite.
 if "$bin" run tiny.toml > again.log 2>&1; then echo "FAIL: existing database overwritten"; exit 1; fi
@@ -89,6 +98,9 @@ grep -q "seismograms: 1 receiver" rec.log || { cat rec.log; echo "FAIL: the run 
 if command -v mpirun > /dev/null; then
   mpirun --oversubscribe -np 2 "$bin" run tiny.toml --out tiny_db2 -q > mpi.log 2>&1 || { cat mpi.log; echo "FAIL: mpirun"; exit 1; }
   check_complete tiny_db2
+  mpirun --oversubscribe -np 2 "$bin" run dark.toml --out dark_db2 > mpi_dark.log 2>&1 || { cat mpi_dark.log; echo "FAIL: mpirun dark.toml"; exit 1; }
+  [ "$(grep -c 'task "p" showed nothing in 4 of 4 frames' mpi_dark.log)" = 1 ] ||
+    { cat mpi_dark.log; echo "FAIL: 2 ranks: not one warning for the black task"; exit 1; }
   mpirun --oversubscribe -np 2 "$bin" run rec.toml --out rec_db2 -q > mpi_rec.log 2>&1 || { cat mpi_rec.log; echo "FAIL: mpirun with a receiver"; exit 1; }
   check_seismograms rec_db2
 fi
