@@ -189,7 +189,7 @@ panoptes::app::CommandRegistration reg([](CLI::App& root) {
   sub->add_flag("--no-vsync", args->no_vsync, "Do not wait for the display refresh");
   sub->add_option("--max-frames", args->max_frames, "Window: close after this many presented frames")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--screenshot-on-exit", args->screenshot_on_exit, "Window: save the final window image as PNG");
+  sub->add_option("--screenshot-on-exit", args->screenshot_on_exit, "Window: save the final window image (frame, HUD and legend, also after one frame) as PNG");
   sub->add_option("--output-dir", args->output_dir, "Window: directory for screenshots (S) and recordings (R)");
   sub->add_option("--latency-log", args->latency_log,
                   "Window: write every key / click / wheel turn's latency to FILE, one line each (from the input's "

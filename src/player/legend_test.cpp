@@ -134,6 +134,37 @@ TEST(Legend, ScaleModeChangeAndSharedReference) {
   EXPECT_EQ(legend_scale_text(task_legend(m, 0, 0)[0]), "");
 }
 
+// Fixed scales (examples/paper.toml: reference = "fixed", one value in every frame): the legend gives
+// the window times that value in the field's unit, names the scale "fixed" and never a change.
+TEST(Legend, FixedScalesShowTheConfiguredValueInEveryFrame) {
+  store::Manifest m = seismic_like();
+  m.fields[0].references = {5e-5, 5e-5, 5e-5};
+  m.fields[0].reference_mode = "fixed";
+  m.fields[1].references = {1.5e-4, 1.5e-4, 1.5e-4};
+  m.fields[1].reference_mode = "fixed";
+  m.provenance.extra["insitu.running_max"] = "0 0";  // as the paper run records it: the mode wins
+  for (int frame = 0; frame < 4; ++frame) {  // frame 3: past the recorded ones, the last reference
+    const auto p = task_legend(m, 0, frame);
+    ASSERT_EQ(p.size(), 1u);
+    EXPECT_TRUE(p[0].physical);
+    EXPECT_EQ(p[0].scale, "fixed");
+    EXPECT_DOUBLE_EQ(p[0].hi, 5e-5);
+    EXPECT_EQ(legend_range_text(p[0]), "0 .. 5.00e-05 1/s");
+    EXPECT_EQ(legend_scale_text(p[0]), "fixed") << "frame " << frame;
+    EXPECT_EQ(legend_change_text(p[0]), "");
+  }
+  // p+s on the shared scale: both windows multiply the larger value, phi_s's 1.5e-4.
+  m.tasks[1].parameters["scale"] = "shared";
+  m.tasks[1].parameters["window"] = {0.0, 0.33};
+  m.tasks[1].parameters["window2"] = {0.0, 1.0};
+  const auto ps = task_legend(m, 1, 2);
+  ASSERT_EQ(ps.size(), 2u);
+  EXPECT_EQ(legend_range_text(ps[0]), "0 .. 4.95e-05 1/s");
+  EXPECT_EQ(legend_range_text(ps[1]), "0 .. 1.50e-04 1/s");
+  EXPECT_EQ(legend_scale_text(ps[0], "phi_s"), "fixed, shared with phi_s");
+  EXPECT_EQ(legend_scale_text(ps[1], "phi_p"), "fixed, shared with phi_p");
+}
+
 // Issue 41.4: a slice is drawn opaque (render/march_plan.cpp: slice_opacity 1, the colour map's colour
 // as it is), so its legend shows the colour map itself. Drawn as a volume's thin layer over black, the
 // diverging preset's zero — light grey (222, 222, 222) on the plane — was black in the legend.

@@ -192,6 +192,9 @@ void SdlWindow::native_size(int& w, int& h) const {
 void SdlWindow::begin_imgui_frame() {
   ImGui_ImplSDLRenderer_NewFrame();
   ImGui_ImplSDL2_NewFrame();
+  // Two passes in one window frame (the layout pass before a screenshot on exit) may read the same
+  // performance-counter tick: ImGui asserts a positive frame time.
+  if (!(ImGui::GetIO().DeltaTime > 0)) ImGui::GetIO().DeltaTime = 1e-6f;
   // The backend keeps reporting the pointer while the window has keyboard focus, even after it left
   // the window (a mini-map tooltip then stayed on screen): no pointer unless it is over this window.
   if (SDL_GetMouseFocus() != window_) ImGui::GetIO().MousePos = ImVec2(-FLT_MAX, -FLT_MAX);

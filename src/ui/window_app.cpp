@@ -627,8 +627,19 @@ WindowResult WindowApp::run() {
       next_stats_ = wall + 0.5;
     }
     ImGui::GetIO().FontGlobalScale = Hud::scale_for(float(win_w_), float(win_h_));
+    const HudInfo info = gather_hud_info(shown);
+    // ImGui draws an auto-sized window only from the frame after the one it (re)appears in, where it
+    // measures it: `--max-frames 1 --screenshot-on-exit` held the frame without HUD and legend (also a
+    // HUD turned on with I in the last frame). The picture taken on exit gets a pass that only lays
+    // the overlay out (nothing drawn, its requests ignored), so every window it holds is measured.
+    if (last && !options_.screenshot_on_exit.empty()) {
+      window_.begin_imgui_frame();
+      hud_.draw(info, float(win_w_), float(win_h_));
+      draw_value_readout(shown);
+      ImGui::EndFrame();
+    }
     window_.begin_imgui_frame();
-    const HudRequests req = hud_.draw(gather_hud_info(shown), float(win_w_), float(win_h_));
+    const HudRequests req = hud_.draw(info, float(win_w_), float(win_h_));
     draw_value_readout(shown);
     window_.render_imgui();
     apply_hud_requests(req);

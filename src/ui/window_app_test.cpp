@@ -510,7 +510,10 @@ TEST_F(WindowTest, TheValueUnderThePointerOfASlice) {
 // a 16-camera Yin-Yang rig around the demo's domain laid out like the demo's, 3 frames. Frames are grey
 // with their stamp, so the picture is told apart from the window's clear colour and from the HUD.
 constexpr int kDemoW = 528, kDemoH = 512;
-void write_demo_like_database(const std::filesystem::path& dir, bool legend = false) {
+// `fixed`: the field's reference is a fixed scale (manifest reference_mode "fixed", 5e-5 1/s in every
+// frame, as examples/paper.toml writes); otherwise 0.01 x (frame + 1) with no mode recorded.
+constexpr double kFixedReference = 5e-5;
+void write_demo_like_database(const std::filesystem::path& dir, bool legend = false, bool fixed = false) {
   store::Manifest m;
   m.title = "demo-like";
   m.provenance.program = "ui_window_test";
@@ -544,7 +547,7 @@ void write_demo_like_database(const std::filesystem::path& dir, bool legend = fa
   t.method = "synthetic";
   if (legend) {  // as `panoptes run` writes a p-wave task (issue 34)
     m.time_units = "s";
-    m.fields = {{"phi_p", "1/s", {}, ""}};
+    m.fields = {{"phi_p", "1/s", {}, fixed ? "fixed" : ""}};
     t.name = "p-wave";
     t.method = "volume";
     t.fields = {"phi_p"};
@@ -565,7 +568,7 @@ void write_demo_like_database(const std::filesystem::path& dir, bool legend = fa
       writer.append(c, 0, img);
     }
     writer.set_time(f, f);
-    if (legend) writer.set_field_reference(f, 0, 0.01 * (f + 1));
+    if (legend) writer.set_field_reference(f, 0, fixed ? kFixedReference : 0.01 * (f + 1));
     writer.checkpoint();
   }
   writer.finalize();
@@ -686,6 +689,50 @@ TEST_F(WindowTest, At1920x1200TheHelpFitsAndTheLegendIsDrawn) {
       orange += p[0] > 120 && p[0] > p[1] + 30 && p[1] > p[2] + 20;
     }
   EXPECT_GT(orange, 500) << "no colour bar in the bottom-left corner";
+}
+
+// `panoptes play DB --max-frames 1 --screenshot-on-exit X.png` on a database with a fixed reference
+// (examples/paper.toml's) showed the movie frame without HUD or legend: ImGui measures an auto-sized
+// window in the frame it first appears and draws it from the next, so the one frame had none. The
+// screenshot on exit holds the HUD and the legend (in physical values: reference x window) whatever
+// the frame count.
+TEST_F(WindowTest, ScreenshotOnExitAfterOneFrameHoldsTheHudAndTheFixedScaleLegend) {
+  if (!have_display()) GTEST_SKIP() << "no DISPLAY (run under xvfb-run)";
+  const auto db = dir_->path / "fixed";
+  write_demo_like_database(db, true, true);
+  for (const int frames : {1, 2, 4}) {
+    SCOPED_TRACE("--max-frames " + std::to_string(frames));
+    WindowOptions o = test_window();
+    o.width = kDemoW;
+    o.height = kDemoH;
+    o.frame = 1;
+    o.max_frames = frames;
+    o.screenshot_on_exit = dir_->path / ("fixed_" + std::to_string(frames) + ".png");
+    const WindowResult r = run_window(db, o);
+    keep_for_humans(o.screenshot_on_exit, "ui_window_fixed_" + std::to_string(frames) + ".png");
+    EXPECT_EQ(r.frames_presented, frames);
+    EXPECT_EQ(r.frame, 1);
+    EXPECT_EQ(r.legend, "0 .. 5.00e-05 1/s");
+    const Image shot = read_png(o.screenshot_on_exit.string());
+    ASSERT_EQ(shot.width, kDemoW);
+    ASSERT_EQ(shot.height, kDemoH);
+    // The legend's colour bar: the p-wave orange in the bottom-left quarter (the frame is grey).
+    int orange = 0;
+    for (int y = shot.height / 2; y < shot.height; ++y)
+      for (int x = 0; x < shot.width / 2; ++x) {
+        const std::uint8_t* p = shot.at(x, y);
+        orange += p[0] > 120 && p[0] > p[1] + 30 && p[1] > p[2] + 20;
+      }
+    EXPECT_GT(orange, 200) << "no colour bar in the bottom-left corner; see " << o.screenshot_on_exit;
+    // The status panel, top right: darker than the grey frame under it.
+    int panel = 0;
+    for (int y = 0; y < shot.height / 8; ++y)
+      for (int x = shot.width / 2; x < shot.width; ++x) {
+        const std::uint8_t* p = shot.at(x, y);
+        panel += p[0] + 24 < kGrey && p[1] + 24 < kGrey && p[2] + 24 < kGrey;
+      }
+    EXPECT_GT(panel, 2000) << "no status panel in the top-right corner; see " << o.screenshot_on_exit;
+  }
 }
 
 // Issue 14: a 360° lattice database shows a look-around filling the window; the arrows and PgUp walk

@@ -3,7 +3,7 @@
 // reference exactly as the window does (issue 41). Run: node --test web/test/legend_scale_test.mjs
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { taskLegend, legendScaleText } from "../player/legend.js";
+import { taskLegend, legendScaleText, legendChangeText, legendNumber } from "../player/legend.js";
 
 const pwave = { colour: [[0, 0.9, 0.35, 0.05], [1, 1.0, 0.8, 0.4]], extinction: [[0, 0], [0.1, 0], [1, 0.5]], absolute_value: true };
 function seismicLike() {
@@ -52,4 +52,25 @@ test("older databases: the mode from the running-maximum note, absolute windows 
   assert.equal(taskLegend(db, 0, 0)[0].scale, "running");
   db.tasks[0].parameters.relative = false;
   assert.equal(legendScaleText(taskLegend(db, 0, 0)[0]), "");
+});
+
+test("fixed scales: the configured value in every frame, named fixed, never a change", () => {
+  const db = seismicLike();
+  db.fields[0] = { name: "phi_p", units: "1/s", references: [5e-5, 5e-5, 5e-5], reference_mode: "fixed" };
+  db.fields[1] = { name: "phi_s", units: "1/s", references: [1.5e-4, 1.5e-4, 1.5e-4], reference_mode: "fixed" };
+  db.provenance = { extra: { "insitu.running_max": "0 0" } };
+  for (let frame = 0; frame < 4; ++frame) {
+    const [p] = taskLegend(db, 0, frame);
+    assert.equal(p.scale, "fixed");
+    assert.equal(p.physical, true);
+    assert.equal(legendNumber(p.hi), "5.00e-05");
+    assert.equal(legendScaleText(p), "fixed");
+    assert.equal(legendChangeText(p), "");
+  }
+  db.tasks[1].parameters.window = [0, 0.33];
+  db.tasks[1].parameters.window2 = [0, 1];
+  const ps = taskLegend(db, 1, 2);
+  assert.equal(legendNumber(ps[0].hi), "4.95e-05");
+  assert.equal(legendNumber(ps[1].hi), "1.50e-04");
+  assert.equal(legendScaleText(ps[0], "phi_s"), "fixed, shared with phi_s");
 });
