@@ -189,6 +189,7 @@ void Engine::set_playing(bool playing) {
   m.anchor_time = m.now();
 }
 void Engine::toggle_playing() { set_playing(!impl_->is_playing); }
+void Engine::restart_clock() { impl_->anchor_time = impl_->now(); }
 double Engine::speed() const { return impl_->speed_factor; }
 void Engine::set_speed(double speed) {
   Impl& m = *impl_;

@@ -204,6 +204,10 @@ class Engine {
   bool playing() const;
   /// Starts/stops the clock. Starting at the end of a non-looping run restarts from the other end.
   void set_playing(bool playing);
+  /// Re-anchors the playback clock at the time source's now, keeping the position: a front end calls it
+  /// once its first frame is on the screen, so that opening the window and decoding that frame (half a
+  /// second on the paper's database) do not count as time played and the movie starts at its frame.
+  void restart_clock();
   void toggle_playing();
   /// Playback speed factor, clamped to [0.25, 8].
   double speed() const;

@@ -523,6 +523,9 @@ WindowResult WindowApp::run() {
   WindowResult result;
   const double frame_period = 1.0 / engine_.fps();
   bool last = false;
+  // Opening the window took time the movie must not have played through (the first frame shown was
+  // frame 5 or 16 of the paper's database, not 0): the clock starts now, and again once frame 0 is up.
+  engine_.restart_clock();
   while (!last) {
     if (options_.before_frame) options_.before_frame(result.frames_presented);
     const std::size_t commands_before = next_command_;
@@ -651,6 +654,7 @@ WindowResult WindowApp::run() {
     draw_ms_.push_back((wall_seconds() - draw0) * 1e3);
 
     ++result.frames_presented;
+    if (result.frames_presented == 1) engine_.restart_clock();  // the first frame's decode and upload
     if (last_present_ > 0) {
       const double dt = wall - last_present_;
       if (dt > 0) display_fps_ = display_fps_ > 0 ? 0.9 * display_fps_ + 0.1 / dt : 1 / dt;
@@ -741,6 +745,7 @@ WindowResult run_window(const std::filesystem::path& db, const WindowOptions& op
                                      : player::starting_speed(engine.frame_count(), engine.fps(),
                                                               engine.manifest().playback_fps));
 
+  if (options.before_open_window) options.before_open_window();
   const auto& m = engine.manifest();
   SdlWindowOptions wo;
   wo.title = "Panoptes - " + (m.title.empty() ? db.filename().string() : m.title);

@@ -53,6 +53,8 @@ struct WindowOptions {
   /// Called at the start of every window frame with the number of frames presented so far, before
   /// the frame's events are polled: tests push synthetic SDL mouse events here. Empty = none.
   std::function<void(int)> before_frame;
+  /// Called once after the database is opened and before the window opens (tests: a slow start).
+  std::function<void()> before_open_window;
   /// Write every measured input → presented-frame latency here, one line each (monotonic clock, ms):
   /// what desktop_latency_bench compares with pixels watched from outside. Empty = none.
   std::filesystem::path latency_log;
