@@ -187,8 +187,7 @@ void Session::Impl::render_sweep_snapshot(int frame) {
 #pragma omp for schedule(dynamic)
       for (int t = 0; t < K; ++t) {
         try {
-          sweep_frames.to_partial(t, part);
-          note_shown(t, frame, part);
+          sweep_frames.to_partial(t, part);  // (not note_shown(): a sweep's values may show nothing, on purpose)
           render::finish_image_into(part, cam, grid, image, bg, outline);
           if (observer) {
 #pragma omp critical(panoptes_sweep_observer)
@@ -459,8 +458,11 @@ void Session::Impl::warn_invisible_tasks() {
     close_run(F);
     // A few empty frames are physics (a wave not yet started); a quarter of the run is a scale or a
     // window that hides the field, which nobody would see until the movies are opened.
-    if (empty < 3 || 4 * empty < rendered) continue;
     const PlannedTask& p = plan.tasks()[std::size_t(t)];
+    // A value of a parameter sweep that shows nothing is an answer (an isovalue above the field), not a
+    // misconfigured scale.
+    if (!p.entry.axes.empty()) continue;
+    if (empty < 3 || 4 * empty < rendered) continue;
     std::string scale;
     if (p.shared && p.spec.field2 >= 0 && std::size_t(p.spec.field2) < field_names.size())
       scale = "; its windows are relative to the larger of " + field_names[std::size_t(p.spec.field)] + "'s and " +
