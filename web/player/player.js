@@ -103,6 +103,7 @@ const S = {
   pending: null,      // switch waiting to be shown: {t0, command, from}
   switches: [],       // {command, from, to, ms, hit}
   firstFrameMs: null,
+  firstShown: null,  // what the first drawn frame showed ({camera, task, frame, status})
   message: "",
 };
 
@@ -286,6 +287,9 @@ function onScreen(w) {
 /// input's handler: the change then reaches the next display frame instead of waiting a frame for
 /// the next rAF callback to draw it.
 function render(now) {
+  // Until the first frame is on the screen the clock stands at the start frame: fetching the index and
+  // decoding the first frame is not time played (the desktop window: Engine::restart_clock()).
+  if (S.firstFrameMs === null && S.playing) S.anchorTime = performance.now();
   const frame = currentFrame();
   const st = stream(S.camera, S.task);
   const key = `${S.camera}/${S.task}/${frame}`;
@@ -348,7 +352,7 @@ function render(now) {
     const now = performance.now();
     S.shown = { camera: S.camera, task: S.task, frame: shownFrame, status };
     S.shownKey = `${S.camera}/${S.task}/${shownFrame}`;
-    if (S.firstFrameMs === null) { S.firstFrameMs = now; mark("drawn"); }
+    if (S.firstFrameMs === null) { S.firstFrameMs = now; S.firstShown = { ...S.shown }; mark("drawn"); }
     if (S.pending) {
       // ms: until the display frame that shows this draw (set at the next rAF; until then the draw).
       const w = { command: S.pending.command, from: S.pending.from, to: [S.camera, S.task], ms: now - S.pending.t0, drawMs: now - S.pending.t0,

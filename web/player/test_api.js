@@ -37,6 +37,8 @@ export function installTestApi(p) {
     switches: () => S.switches,
     traffic: () => ({ ...traffic }),
     firstFrameMs: () => S.firstFrameMs,
+    /// The first frame drawn ({camera, task, frame, status}): playing starts at the start frame.
+    firstShown: () => S.firstShown,
     /// The steps to the first frame (ms since navigation start): scripts, database.json, index, init, ...
     marks: () => ({ ...marks }),
     /// When the camera table was in and parsed (performance.now() ms) and its size; null before.
