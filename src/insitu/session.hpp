@@ -51,7 +51,7 @@ enum class ScalarType { f32, f64 };
 
 /// This rank's part of the global grid: the points it OWNS (a box; the boxes of all ranks partition
 /// the grid's points) and the ghost layers its arrays hold around them. The session needs, for its
-/// brick, 2 ghost layers below and 2 above the owned box on every split axis (render::required_points).
+/// brick, 2 ghost layers below and 3 above the owned box on every split axis (render::required_points).
 /// It reads from the arrays only the owned points and the ghosts the caller keeps valid: the valid
 /// layers (valid_lo/hi) beside each face, and edge and corner ghosts only when edges_valid. Every other
 /// point it needs is fetched from its owner (one extra exchange per snapshot), so any ghost width,

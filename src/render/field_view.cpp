@@ -40,7 +40,7 @@ PointRange required_points(const GridGeometry& g, const Brick& b) {
   PointRange r;
   for (int a = 0; a < 3; ++a) {
     r.lo[a] = std::max(0, b.lo[a] - 2);
-    r.hi[a] = std::min(g.dims[a], b.hi[a] + 2);
+    r.hi[a] = std::min(g.dims[a], b.hi[a] + 3);
   }
   return r;
 }
@@ -89,7 +89,7 @@ void FieldView::validate() const {
   if (!points.contains(need))
     throw Error("field view: data covers points " + str(points.lo) + "-" + str(points.hi) + " but brick " +
                 str(brick.lo) + "-" + str(brick.hi) + " needs points " + str(need.lo) + "-" + str(need.hi) +
-                " (two ghost layers below, the shared point and one more above)");
+                " (two ghost layers below, the shared point and two more above)");
 }
 
 }  // namespace panoptes::render

@@ -54,12 +54,15 @@ struct Brick {
 
 /// Point range [lo, hi) a brick's field data must cover (the brick's points plus ghost layers).
 /// Trilinear interpolation of the samples in cells [blo, bhi) reads points blo … bhi. An isosurface
-/// crossing between a brick's first sample and the sample one step before it (≤ 1 voxel outside
-/// when the sample distance is ≤ 1 voxel) belongs to the brick, and the hit normal uses central
-/// differences ±0.5 voxel around the hit, so the requirement is points [blo − 2, bhi + 2) clipped
-/// to [0, dims): TWO ghost layers below the brick and, above it, the point bhi (shared with the
-/// next brick) plus ONE more. Volume and slice tasks alone read only points [blo, bhi + 1) plus
-/// one margin point on each side for the macro-cells' min/max.
+/// hit lies at most one step Δ outside the brick (a crossing between the brick's first sample and the
+/// one before it, or a sliver between its last sample and the next; Δ ≤ 1 voxel), and what is read
+/// round a hit reaches at most one voxel farther on every axis: its normal's central differences ±0.5
+/// voxel, anti-aliasing's footprint filter the renderer's gradient at points up to half a voxel from
+/// the hit (iso_shading.cpp, shade_hit_footprint()). Positions in [blo − 2, bhi + 2) read points
+/// blo − 2 … bhi + 2, so the requirement is points [blo − 2, bhi + 3) clipped to [0, dims): TWO ghost
+/// layers below the brick and, above it, the point bhi (shared with the next brick) plus TWO more.
+/// Volume and slice tasks alone read only points [blo, bhi + 1) plus one margin point on each side
+/// for the macro-cells' min/max.
 struct PointRange {
   Index3 lo{0, 0, 0};
   Index3 hi{0, 0, 0};

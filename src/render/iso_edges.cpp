@@ -147,9 +147,10 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       // The shading filtered over the pixel footprint (issue 41's last speckles: one shading sample
       // where the reference's sub-rays see a grazing rim, a crease or a highlight narrower than the
       // pixel), only for events that add it (an exit that closes a sliver adds nothing). Its reads
-      // stay within half a voxel of the hit on every axis, so every brick computes the same.
+      // stay within a voxel of the hit on every axis (the ghost layers: required_points()), so every
+      // brick computes the same.
       const auto filter = [&] {
-        shade_hit_footprint(f, S.spacing, ph, dir, g, th * pitch, half_voxel, T.colour, rgb);
+        shade_hit_footprint(f, S.grid.dims, S.spacing, ph, dir, g, th * pitch, half_voxel, T.iso, T.colour, rgb);
       };
       double alpha = 1;
       // A grazing ray: the parabola has a second root close by (its vertex on the other side of
@@ -270,7 +271,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
       // Its depth is at least |s| at the point found / |∇f|: coverage of the pair in one event.
       const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_out) / gn / (th * pitch) : 1.0;
-      shade_hit_footprint(f, S.spacing, ph, dir, g, th * pitch, half_voxel, T.colour, rgb);
+      shade_hit_footprint(f, S.grid.dims, S.spacing, ph, dir, g, th * pitch, half_voxel, T.iso, T.colour, rgb);
       if (add(rgb, std::min(1.0, cover))) return std::max(j - 1, 0);
       continue;
     }
@@ -288,6 +289,9 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     if (x > half_voxel) continue;  // beyond the macro-cells' margin: not seen alike by every brick
     const double cover = 0.5 - x / footprint;
     if (cover <= 0) continue;
+    // A rim seen at its point of closest approach is dark (n·d ≈ 0); the sub-rays that meet the
+    // surface within the pixel meet it farther in, lighter: their mean (issue 41's dark rims in valleys).
+    shade_near_miss_footprint(f, S.grid.dims, S.spacing, pv, dir, g, footprint, half_voxel, x, T.iso, T.colour, rgb);
     if (add(rgb, cover)) return std::max(j - 1, 0);
   }
   if (k0 + n - 1 == k_last && t_exit > t0 + double(k_last) * dt) {

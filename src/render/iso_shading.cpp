@@ -97,16 +97,9 @@ void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const
 }
 
 namespace {
-// Anti-aliasing's shading filter (shade_hit_footprint()); issue 41's scene decided the constants
-// (iso_edges_test.cpp, IsoEdges.SpecklesAgainstTheSupersampledSurface: fewest speckles with the PSNR
-// against the supersampled reference no lower than without the filter).
-// Only near a rim (|n·d| below kRimBelow, where the footprint stretches round the surface) or in the
-// highlight (above kHighlightFrom, where 0.25·|n·l|^32 bends) is the surface looked at: between them
-// the diffuse term is linear in n, so a box filter leaves the centre's shading unless the normal
-// bends sharply within the pixel (a crease: one speckle of issue 41's scene, camera 115, stays). It
-// saves most of the filter's cost (BM_Isosurfaces from outside: +12 … +22 % of an anti-aliased
-// isosurface frame when every hit is looked at, +4 … +10 % so; docs/rendering.md).
-constexpr double kRimBelow = 0.3, kHighlightFrom = 0.92;
+// Anti-aliasing's shading filter (shade_hit_footprint(), shade_near_miss_footprint()); issue 41's scene
+// decided the constants (iso_edges_test.cpp, IsoEdges.SpecklesAgainstTheSupersampledSurface: no
+// speckles, the PSNR against the supersampled reference highest).
 // Filtered where the footprint corners' mean departs from the centre by more than this (three times
 // a box filter's departure for a quadratic change: ~2.7 levels).
 constexpr float kBends = 8.0f / 255;
@@ -115,14 +108,15 @@ constexpr float kBends = 8.0f / 255;
 // They count with this weight with the rim's own shading, the rest of their weight going to those
 // that meet the surface (1: the valleys keep dark speckles; 0: outer rims turn light).
 constexpr double kBeyondRim = 0.6;
-// The renderer's normals are central differences over a voxel; the field's bend between samples ½
-// voxel apart is sharper than theirs. Dividing it by 1.5 matched the reference best (measured with
-// every hit looked at: 1 left 3 speckles outside instead of 4 but lost 0.3 dB; 2 left 6).
-constexpr double kCurvatureScale = 1.5;
-// The tangents' samples reach as far as half a voxel on every axis allows, at most twice `reach`.
+// The gradients beside the hit lie as far along t1 and t2 as `reach` on every axis allows, at most
+// this times `reach` (a tangent along a diagonal of the grid).
 constexpr double kRadiusCap = 2.0;
+// A near miss is filtered only near a rim (|n·d| below this at its point of closest approach) and
+// where the patch puts the centre ray within half a footprint of the rim.
+constexpr double kNearMissRim = 0.3;
 
 inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline double dot3(const double* a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // The field at eight index-space positions (interp_clamped()'s values) as one gather evaluation.
 void field_values8(const FieldAcc& f, const double (*q)[3], float v[8]) {
@@ -139,6 +133,19 @@ void field_values8(const FieldAcc& f, const double (*q)[3], float v[8]) {
   }
 #endif
   for (int l = 0; l < 8; ++l) v[l] = interp_clamped(f, q[l][0], q[l][1], q[l][2]);
+}
+
+// field_gradient() (the same positions and differences) and the field itself at index-space position
+// q, as one gather evaluation.
+void gradient_and_value(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double q[3], double G[3],
+                        double& value) {
+  double pts[8][3], h[3];
+  gradient_points(q, dims, spacing, pts, h);
+  for (int c = 0; c < 3; ++c) pts[6][c] = pts[7][c] = q[c];
+  float v[8];
+  field_values8(f, pts, v);
+  for (int a = 0; a < 3; ++a) G[a] = h[a] > 0 ? (double(v[2 * a + 1]) - double(v[2 * a])) / h[a] : 0.0;
+  value = v[6];
 }
 
 // The surface's frame at a hit: unit normal n, t1 = d on the tangent plane (the direction the
@@ -162,50 +169,71 @@ struct HitFrame {
   }
 };
 
-// The surface round a hit, as far as a brick may read: a hit lies up to half a voxel beyond the
-// brick's last sample and its own gradient reads half a voxel farther, so nothing may be read
-// farther than half a voxel from it on any axis (gradients taken ½ voxel away broke compositing by
-// 3/255). One gather gives the surface's second fundamental form: the field at p and at ±r along t1,
-// t2 and their diagonal, g·t = 0, so f(p ± r·t) − f(p) = ½ r²·tᵀHt to third order; the normal anywhere
-// on the patch is then n + x·∂n/∂t1 + y·∂n/∂t2, ∂n/∂t = P·H·t / |∇f|. A sub-ray at image offset (α
-// along t1's image, β along t2) meets the surface at y = β and x with α = −(n·d·x + ½ k·x² + k2·x·y)
-// (n·d changes by k per unit of x, k2 per unit of y), or passes beyond the rim where that has no root:
-// a grazing ray's footprint reaches round the surface's rim, which no read near p could show.
+// The surface round a hit from the renderer's own gradient field (what the reference's sub-rays shade
+// with), read within a voxel of the hit on every axis (the ghost layers cover that: required_points()).
+// field_gradient() at p ± r1·t1 and p ± r2·t2 on the tangent plane, r within `reach` (half a voxel)
+// of p on every axis: their differences are how the gradient changes along t1 and t2 (D1, D2 per
+// world unit), so the gradient anywhere on the patch is g + x·D1 + y·D2 (extrapolated beyond r: a
+// grazing ray's footprint stretches by 1 / |n·d| along t1 and reaches round the rim) and the normal
+// changes by ∂n/∂t = P·D / |∇f|. A sub-ray at image offset (α along t1's image, β along t2) meets the
+// surface at y = β and x with α = −(n·d·x + ½ k·x² + k2·x·y) (n·d changes by k per unit of x, k2 per
+// unit of y), or passes beyond the rim where that has no root. Where the model's meeting point lies
+// within `reach` of p, one Newton step on the field along the sub-ray itself moves it onto the
+// surface and the sub-ray is shaded with the gradient there: across a crease, where the smooth model
+// puts the sub-rays on the wrong sheet, they see the sheet the reference's sub-rays see.
 struct Patch {
+  const FieldAcc& f;
+  const Index3& dims;
+  const Vec3& spacing;
+  const double* p;
   const HitFrame& H;
   const Vec3& dir;
   const float* colour;
-  double h11 = 0, h12 = 0, h22 = 0, k = 0, k2 = 0, xmax = 0;
-  Patch(const FieldAcc& f, const Vec3& spacing, const double p[3], const Vec3& d, const HitFrame& frame, double gn,
-        double reach, const float* col)
-      : H(frame), dir(d), colour(col) {
+  double iso, gn, reach_index;
+  double g0[3], D1[3], D2[3], G[4][3];
+  double k = 0, k2 = 0, xmax = 0;
+  Patch(const FieldAcc& f_, const Index3& dims_, const Vec3& spacing_, const double p_[3], const Vec3& d,
+        const HitFrame& frame, const double g[3], double gnorm, double reach, const float* col, double iso_)
+      : f(f_), dims(dims_), spacing(spacing_), p(p_), H(frame), dir(d), colour(col), iso(iso_), gn(gnorm) {
     const double hmin = std::min({spacing[0], spacing[1], spacing[2]});
-    double u[3];
-    for (int c = 0; c < 3; ++c) u[c] = 0.70710678118654752 * (H.t1[c] + H.t2[c]);
-    const auto radius = [&](const double* t) {  // within half a voxel on every axis
+    reach_index = reach / hmin;
+    const auto radius = [&](const double* t) {  // within `reach` on every axis
       double r = kRadiusCap * reach;
       for (int c = 0; c < 3; ++c)
         if (std::abs(t[c]) > 1e-12) r = std::min(r, reach * spacing[c] / (std::abs(t[c]) * hmin));
       return r;
     };
-    const double r1 = radius(H.t1), r2 = radius(H.t2), ru = radius(u);
-    double q[8][3];
-    for (int c = 0; c < 3; ++c) {
-      const double a1 = r1 * H.t1[c] / spacing[c], a2 = r2 * H.t2[c] / spacing[c], au = ru * u[c] / spacing[c];
-      q[0][c] = q[7][c] = p[c];
-      q[1][c] = p[c] + a1, q[2][c] = p[c] - a1, q[3][c] = p[c] + a2, q[4][c] = p[c] - a2, q[5][c] = p[c] + au,
-      q[6][c] = p[c] - au;
+    const double r1 = radius(H.t1), r2 = radius(H.t2);
+    double c[4][3];  // p + r1·t1, p − r1·t1, p + r2·t2, p − r2·t2 (index space)
+    for (int a = 0; a < 3; ++a) {
+      const double a1 = r1 * H.t1[a] / spacing[a], a2 = r2 * H.t2[a] / spacing[a];
+      c[0][a] = p[a] + a1, c[1][a] = p[a] - a1, c[2][a] = p[a] + a2, c[3][a] = p[a] - a2;
     }
-    float v[8];
-    field_values8(f, q, v);
-    const double f0 = v[0], gs = gn * kCurvatureScale;
-    h11 = (double(v[1]) + double(v[2]) - 2 * f0) / (r1 * r1 * gs);
-    h22 = (double(v[3]) + double(v[4]) - 2 * f0) / (r2 * r2 * gs);
-    h12 = (double(v[5]) + double(v[6]) - 2 * f0) / (ru * ru * gs) - 0.5 * (h11 + h22);
-    const double s1 = H.t1[0] * dir[0] + H.t1[1] * dir[1] + H.t1[2] * dir[2];
-    k = h11 * s1, k2 = h12 * s1;
-    const double kmax = std::max({std::abs(h11), std::abs(h12), std::abs(h22)});
-    xmax = kmax > 0 ? 1.0 / kmax : 1e30;  // the linear model is believed for a radian's turn
+    // The four gradients' 24 interpolations as three gather evaluations.
+    double q[24][3], h[4][3];
+    for (int i = 0; i < 4; ++i) gradient_points(c[i], dims, spacing, q + 6 * i, h[i]);
+    float v[24];
+    for (int b = 0; b < 3; ++b) field_values8(f, q + 8 * b, v + 8 * b);
+    for (int i = 0; i < 4; ++i)
+      for (int a = 0; a < 3; ++a)
+        G[i][a] = h[i][a] > 0 ? (double(v[6 * i + 2 * a + 1]) - double(v[6 * i + 2 * a])) / h[i][a] : 0.0;
+    for (int a = 0; a < 3; ++a) {
+      g0[a] = g[a];
+      D1[a] = (G[0][a] - G[1][a]) / (2 * r1);
+      D2[a] = (G[2][a] - G[3][a]) / (2 * r2);
+    }
+    // n·d along the patch: ∂(n·d)/∂t = (D·d − (n·D)(n·d)) / |∇f|.
+    k = (dot3(D1, dir) - dot3(H.n, D1) * H.nd) / gn;
+    k2 = (dot3(D2, dir) - dot3(H.n, D2) * H.nd) / gn;
+    // The linear model is believed for a radian's turn of the normal.
+    double kmax = 0;
+    for (const double* D : {D1, D2}) {
+      const double nD = dot3(H.n, D);
+      double t[3];
+      for (int a = 0; a < 3; ++a) t[a] = D[a] - nD * H.n[a];
+      kmax = std::max(kmax, std::sqrt(dot3(t, t)) / gn);
+    }
+    xmax = kmax > 0 ? 1.0 / kmax : 1e30;
   }
   // The surface point (x, y) of the sub-ray at (α, β); false beyond the rim (then the rim's point).
   bool meet(double alpha, double beta, double& x, double& y) const {
@@ -221,63 +249,116 @@ struct Patch {
     x = std::clamp(x, -xmax, xmax);
     return hit;
   }
-  void shade(double x, double y, float* rgb) const {
-    double m[3];
-    for (int c = 0; c < 3; ++c) m[c] = H.n[c] + x * (h11 * H.t1[c] + h12 * H.t2[c]) + y * (h12 * H.t1[c] + h22 * H.t2[c]);
-    shade_from_gradient(m, dir, colour, true, rgb);
+  // The patch's gradient at (x, y).
+  void model_gradient(double x, double y, double m[3]) const {
+    for (int c = 0; c < 3; ++c) m[c] = g0[c] + x * D1[c] + y * D2[c];
+  }
+  static double shade1(double c, double ndl) {  // one channel's shading (shade_from_gradient())
+    double p32 = ndl;
+    for (int i = 0; i < 5; ++i) p32 *= p32;
+    return std::min(1.0, c * (0.15 + 0.85 * ndl) + 0.25 * p32);
+  }
+  static double abs_cos(const double* m, const Vec3& d) {
+    const double mm = dot3(m, m);
+    return mm > 0 ? std::min(1.0, std::abs(dot3(m, d)) / std::sqrt(mm)) : 1.0;
   }
   // Whether the shading can change non-linearly across a footprint `span` wide (a box filter of a
   // linear change is the centre's value, so only a bend matters: a highlight narrower than the pixel,
-  // a rim, a crease): the four corners' mean against the centre, or a corner beyond the rim.
+  // a rim, a crease): the model's four footprint corners against the centre, or a corner beyond the
+  // rim, or the four gradients read beside the hit against it (a crease bends them unlike the model).
   bool bends(double span) const {
     const double h = 0.5 * span;
-    // |x·∂n/∂t1 + y·∂n/∂t2|² = a11·x² + 2·a12·x·y + a22·y² (∂n/∂t ⟂ n): the patch normal's length.
-    const double a11 = h11 * h11 + h12 * h12, a12 = h11 * h12 + h12 * h22, a22 = h12 * h12 + h22 * h22;
     const double c = std::max({colour[0], colour[1], colour[2]});  // the channel that changes most
-    const auto shade1 = [c](double ndl) {
-      double p32 = ndl;
-      for (int i = 0; i < 5; ++i) p32 *= p32;
-      return std::min(1.0, c * (0.15 + 0.85 * ndl) + 0.25 * p32);
-    };
-    double mean = 0;
+    const double centre = shade1(c, std::abs(H.nd));
+    double mean = 0, beside = 0;
     for (int i = 0; i < 4; ++i) {
-      double x, y;
+      double x, y, m[3];
       if (!meet(i & 1 ? h : -h, i & 2 ? h : -h, x, y)) return true;
-      const double md = H.nd + k * x + k2 * y, mm = 1 + a11 * x * x + 2 * a12 * x * y + a22 * y * y;
-      mean += 0.25 * shade1(std::min(1.0, std::abs(md) / std::sqrt(mm)));
+      model_gradient(x, y, m);
+      mean += 0.25 * shade1(c, abs_cos(m, dir));
+      beside += 0.25 * shade1(c, abs_cos(G[i], dir));
     }
-    return std::abs(mean - shade1(std::abs(H.nd))) > kBends;
+    return std::abs(mean - centre) > kBends || std::abs(beside - centre) > kBends;
   }
-  // The box filter over the footprint: 4 × 4 sub-rays, the reference's pattern.
-  void filter(double span, float* a) const {
+  // One sub-ray at image offset (α, β) that meets the patch at (x, y): one Newton step on the field
+  // along p + α·e1 + β·t2 + λ·d (e1 = s1·n − n·d·t1, the image of t1; s1 = t1·d) from the patch's
+  // meeting point, the gradient at the point it lands on; the patch's gradient where a point would
+  // lie beyond `reach` of p on some axis or the sub-ray runs along the surface.
+  void sub_ray_gradient(double alpha, double beta, double x, double y, double m[3]) const {
+    const double s1 = dot3(H.t1, dir);
+    double o[3];
+    for (int c = 0; c < 3; ++c) o[c] = alpha * (s1 * H.n[c] - H.nd * H.t1[c]) + beta * H.t2[c];
+    double lam = x * s1, fv = 0;
+    for (int it = 0; it < 2; ++it) {
+      double q[3], far = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double off = (o[c] + lam * dir[c]) / spacing[c];
+        far = std::max(far, std::abs(off));
+        q[c] = p[c] + off;
+      }
+      if (far > reach_index) break;
+      double Gq[3];
+      gradient_and_value(f, dims, spacing, q, Gq, fv);
+      if (it == 1) {
+        std::copy_n(Gq, 3, m);
+        return;
+      }
+      const double gd = dot3(Gq, dir);
+      if (!(std::abs(gd) > 1e-3 * gn)) break;
+      lam -= (fv - iso) / gd;
+    }
+    model_gradient(x, y, m);
+  }
+  // The box filter over the footprint: 4 × 4 sub-rays, the reference's pattern, the centre ray at
+  // image offset (alpha0, 0). `hits_only`: the mean of the sub-rays that meet the surface (a near
+  // miss, whose coverage is counted apart); false when none does.
+  bool filter(double span, float* a, double alpha0 = 0, bool hits_only = false) const {
     float sum[3] = {0, 0, 0};
     double wsum = 0;
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j) {
-        double x, y;
-        const double w = meet(span * ((i + 0.5) / 4 - 0.5), span * ((j + 0.5) / 4 - 0.5), x, y) ? 1.0 : kBeyondRim;
+        const double alpha = alpha0 + span * ((i + 0.5) / 4 - 0.5), beta = span * ((j + 0.5) / 4 - 0.5);
+        double x, y, m[3];
+        const bool hit = meet(alpha, beta, x, y);
+        if (!hit && hits_only) continue;
+        const double w = hit ? 1.0 : kBeyondRim;
+        if (hit) sub_ray_gradient(alpha, beta, x, y, m);
+        else model_gradient(x, y, m);
         float rgb[4];
-        shade(x, y, rgb);
+        shade_from_gradient(m, dir, colour, true, rgb);
         for (int c = 0; c < 3; ++c) sum[c] += float(w) * rgb[c];
         wsum += w;
       }
+    if (!(wsum > 0)) return false;
     for (int c = 0; c < 3; ++c) a[c] = sum[c] / float(wsum);
+    return true;
   }
 };
 
 }  // namespace
 
-bool shade_hit_footprint(const FieldAcc& f, const Vec3& spacing, const double p[3], const Vec3& dir, const double g[3],
-                         double width, double reach, const float colour[3], float* a) {
+bool shade_hit_footprint(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
+                         const double g[3], double width, double reach, double iso, const float colour[3], float* a) {
   const double gn = std::sqrt(dot3(g, g));
   if (!(gn > 0 && width > 0)) return false;
-  const double ndabs = std::abs(g[0] * dir[0] + g[1] * dir[1] + g[2] * dir[2]) / gn;
-  if (ndabs >= kRimBelow && ndabs < kHighlightFrom) return false;
   const HitFrame H(g, gn, dir);
-  const Patch patch(f, spacing, p, dir, H, gn, reach, colour);
+  const Patch patch(f, dims, spacing, p, dir, H, g, gn, reach, colour, iso);
   if (!patch.bends(width)) return false;
-  patch.filter(width, a);
-  return true;
+  return patch.filter(width, a);
+}
+
+bool shade_near_miss_footprint(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
+                               const Vec3& dir, const double g[3], double width, double reach, double miss, double iso,
+                               const float colour[3], float* a) {
+  const double gn = std::sqrt(dot3(g, g));
+  if (!(gn > 0 && width > 0) || std::abs(dot3(g, dir)) >= kNearMissRim * gn) return false;
+  const HitFrame H(g, gn, dir);
+  const Patch patch(f, dims, spacing, p, dir, H, g, gn, reach, colour, iso);
+  if (patch.k == 0) return false;
+  // The centre ray passes `miss` beyond the patch's rim (where n·d² − 2kα = 0).
+  const double alpha0 = H.nd * H.nd / (2 * patch.k) + std::copysign(miss, patch.k);
+  if (std::abs(alpha0) > 0.5 * width) return false;
+  return patch.filter(width, a, alpha0, true);
 }
 
 }  // namespace march

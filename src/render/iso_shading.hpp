@@ -31,11 +31,22 @@ void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, 
 /// Anti-aliasing's hit shading filtered over the pixel footprint (`width` world units across at the
 /// hit; issue 41's speckles: one shading sample where the reference's sub-rays see a grazing rim, a
 /// crease or a highlight narrower than the pixel). On entry a = shade_hit()'s colour at p (gradient g
-/// there); where the shading bends across the footprint, replaced by the mean of 4 × 4 sub-rays meeting
-/// the surface modelled from one gather within `reach` (half a voxel, world units) of p on every axis
-/// (what a brick may read round a hit). Returns whether it filtered.
-bool shade_hit_footprint(const FieldAcc& f, const Vec3& spacing, const double p[3], const Vec3& dir, const double g[3],
-                         double width, double reach, const float colour[3], float* a);
+/// there, isovalue iso); where the shading bends across the footprint, replaced by the mean of 4 × 4
+/// sub-rays meeting the surface modelled from the renderer's gradient (field_gradient()) at four
+/// points up to `reach` (half a voxel, world units) from p on every axis along the tangent plane, each
+/// sub-ray moved onto the surface by one Newton step along itself and shaded with the gradient there.
+/// Its reads stay within `reach` + ½ voxel of p on every axis (one voxel: the ghost layers of
+/// required_points() cover that for hits up to a step ≤ 1 voxel outside the brick). Returns whether
+/// it filtered.
+bool shade_hit_footprint(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
+                         const double g[3], double width, double reach, double iso, const float colour[3], float* a);
+/// The same for a near miss near a rim (|n·d| < 0.3) at its point of closest approach p, `miss` world
+/// units outside the surface: the mean of the sub-rays that meet the surface (the coverage is the near
+/// miss's own), which see the rim farther in than its tangent point and so lighter. Returns whether
+/// it filtered (not when no sub-ray meets the surface or the model puts the rim beyond the pixel).
+bool shade_near_miss_footprint(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
+                               const Vec3& dir, const double g[3], double width, double reach, double miss, double iso,
+                               const float colour[3], float* a);
 /// The pre-issue-10 hit shading (six scalar interpolations, std::pow): the reference renderer's.
 void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3],
                       const Vec3& dir, const float colour[3], float* a);

@@ -17,9 +17,9 @@ namespace panoptes::render {
 struct RenderOptions {
   /// Distance between samples along a ray, in voxels (GridGeometry::voxel()). Opacity is corrected
   /// for it exactly (α = 1 − exp(−σ·Δ)). Volume and slice tasks are compositable across bricks for
-  /// any value; isosurfaces for values ≤ 0.5 (a hit up to one step outside the brick is shaded with
-  /// central differences ±0.5 voxel, which the two ghost layers cover only for steps ≤ 0.5; at 0.9
-  /// and 1.0 a few hit pixels are shaded from clamped positions, measured up to 8/255 off).
+  /// any value; isosurfaces for values ≤ 1 (a hit up to one step outside the brick reads up to a
+  /// voxel round it — its normal, anti-aliasing's footprint filter — which the ghost layers of
+  /// required_points() cover for steps ≤ 1; beyond, hit pixels are shaded from clamped positions).
   double sample_distance = 0.5;
   bool skip_empty = true;            ///< empty-space skipping with macro-cells
   float termination_alpha = 0.998f;  ///< early ray termination (the rest adds < 1/255)
