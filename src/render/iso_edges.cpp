@@ -136,13 +136,14 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     const double uv = c2 != 0 ? -b / (2 * c2) : INFINITY;
     const double sv = c2 != 0 ? double(sc) - b * b / (4 * c2) : double(sc);
     alignas(16) float rgb[4];
+    float gs[8];  // the values shade_hit()'s gradient read (shade_hit_footprint()'s cheap look)
     double g[3], gn = 0;
     if (cross) {
       // The hit: linear estimate and one regula-falsi step, as without anti-aliasing.
       const double ta = t0 + double(k - 1) * dt;
       const double th = refine_hit(ta, ta + dt, sp, sc);
       const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
-      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g, gs);
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
       // The shading filtered over the pixel footprint (issue 41's last speckles: one shading sample
       // where the reference's sub-rays see a grazing rim, a crease or a highlight narrower than the
@@ -150,7 +151,7 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       // stay within a voxel of the hit on every axis (the ghost layers: required_points()), so every
       // brick computes the same.
       const auto filter = [&] {
-        shade_hit_footprint(f, S.grid.dims, S.spacing, ph, dir, g, th * pitch, half_voxel, T.iso, T.colour, rgb);
+        shade_hit_footprint(f, S.grid.dims, S.spacing, ph, dir, g, th * pitch, half_voxel, T.iso, T.colour, rgb, gs);
       };
       double alpha = 1;
       // A grazing ray: the parabola has a second root close by (its vertex on the other side of
@@ -267,11 +268,11 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
       // A sliver: the entry by regula falsi between u_in and u_out.
       const double th = refine_hit(t0 + (double(k) + u_in) * dt, t0 + (double(k) + u_out) * dt, s_in, s_out);
       const double ph[3] = {O[0] + th * D[0], O[1] + th * D[1], O[2] + th * D[2]};
-      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g);
+      shade_hit(f, S.grid.dims, S.spacing, ph, dir, T.colour, rgb, g, gs);
       gn = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
       // Its depth is at least |s| at the point found / |∇f|: coverage of the pair in one event.
       const double cover = gn > 0 && th > 0 ? 0.5 + std::abs(s_out) / gn / (th * pitch) : 1.0;
-      shade_hit_footprint(f, S.grid.dims, S.spacing, ph, dir, g, th * pitch, half_voxel, T.iso, T.colour, rgb);
+      shade_hit_footprint(f, S.grid.dims, S.spacing, ph, dir, g, th * pitch, half_voxel, T.iso, T.colour, rgb, gs);
       if (add(rgb, std::min(1.0, cover))) return std::max(j - 1, 0);
       continue;
     }

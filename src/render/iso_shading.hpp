@@ -22,12 +22,14 @@ namespace panoptes::render::march {
 
 /// The renderer's hit shading on the march's view of a field (what shade_isosurface_hit() with
 /// renderer = true computes): the six gradient interpolations as one 8-lane gather evaluation.
-/// `gradient` (optional, 3 values) receives ∇f in field units per world unit (anti-aliasing's distances).
+/// `gradient` (optional, 3 values) receives ∇f in field units per world unit (anti-aliasing's distances);
+/// `samples` (optional, 8 values) the field at p ∓ ½ voxel per axis (x−, x+, y−, y+, z−, z+) and at p twice.
 void shade_hit(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
-               const float colour[3], float* a, double* gradient = nullptr);
+               const float colour[3], float* a, double* gradient = nullptr, float* samples = nullptr);
 /// ∇f at index-space position p in field units per world unit: shade_hit()'s central differences
 /// (the same six interpolations as one 8-lane evaluation), without the shading.
-void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], double g[3]);
+void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], double g[3],
+                    float* samples = nullptr);
 /// Anti-aliasing's hit shading filtered over the pixel footprint (`width` world units across at the
 /// hit; issue 41's speckles: one shading sample where the reference's sub-rays see a grazing rim, a
 /// crease or a highlight narrower than the pixel). On entry a = shade_hit()'s colour at p (gradient g
@@ -37,9 +39,11 @@ void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, 
 /// sub-ray moved onto the surface by one Newton step along itself and shaded with the gradient there.
 /// Its reads stay within `reach` + ½ voxel of p on every axis (one voxel: the ghost layers of
 /// required_points() cover that for hits up to a step ≤ 1 voxel outside the brick). Returns whether
-/// it filtered.
+/// it filtered. `samples`: the eight values shade_hit() read for g (its `samples`), which let a hit
+/// away from a rim skip the patch where a Hessian from them shows no bend (nullptr: always the patch).
 bool shade_hit_footprint(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], const Vec3& dir,
-                         const double g[3], double width, double reach, double iso, const float colour[3], float* a);
+                         const double g[3], double width, double reach, double iso, const float colour[3], float* a,
+                         const float* samples = nullptr);
 /// The same for a near miss near a rim (|n·d| < 0.3) at its point of closest approach p, `miss` world
 /// units outside the surface: the mean of the sub-rays that meet the surface (the coverage is the near
 /// miss's own), which see the rim farther in than its tangent point and so lighter. Returns whether
