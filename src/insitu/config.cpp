@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <fstream>
@@ -231,7 +232,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
   }
   if (const auto* r = table(c, root, "render")) {
     only_keys(c, *r, "render", {"sample_distance", "percentile", "reference", "skip_empty", "termination_alpha", "adaptive",
-                                      "adaptive_tolerance", "adaptive_linear_tolerance", "equirect_adaptive", "equirect_tolerance",
+                                      "adaptive_stride", "adaptive_tolerance", "adaptive_linear_tolerance", "equirect_adaptive", "equirect_tolerance",
                                       "iso_antialias", "field", "share_scale"});
     const std::string ref = str(c, *r, "reference", "render.", "running");
     if (ref == "fixed") c.fail("render.reference", "\"fixed\" needs a value per field: [render.field.NAME] reference = \"fixed\", value = V");
@@ -275,6 +276,11 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
       c.fail("render.termination_alpha", "expected a value in (0.5, 1]");
     s.render.adaptive = boolean(c, *r, "adaptive", "render.", false);
     s.render.equirect_adaptive = boolean(c, *r, "equirect_adaptive", "render.", true);
+    // The coarse lattice's spacing: where a voxel covers several pixels (the demo: 3.5-4 px per voxel at
+    // 528x512) a wider lattice still samples every voxel's change; refinement halves it where corners differ.
+    s.render.adaptive_stride = int_in(c, *r, "adaptive_stride", "render.", s.render.adaptive_stride, 2, 32);
+    if (!std::has_single_bit(unsigned(s.render.adaptive_stride)))
+      c.fail("render.adaptive_stride", std::to_string(s.render.adaptive_stride) + "; expected 2, 4, 8, 16 or 32 pixels (cells are split at their midpoints)");
     // In the final image's units (1/255) in the file: what users see.
     const double tol = num(c, *r, "adaptive_tolerance", "render.", double(s.render.adaptive_tolerance) * 255);
     if (!(tol >= 0 && tol <= 255)) c.fail("render.adaptive_tolerance", "expected 0..255 (units of 1/255)");

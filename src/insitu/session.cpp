@@ -2,6 +2,8 @@
 // the ranks' agreement (Impl::agree, rank_agreement.hpp).
 #include "insitu/session_impl.hpp"
 
+#include "render/corner_field.hpp"
+
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -128,6 +130,9 @@ Session::~Session() {
     if (!fin) MPI_Comm_free(&impl_->comm);
   }
 #endif
+  // The corner copies' blocks were kept for the next snapshot's (render/corner_field.hpp): there is none.
+  impl_.reset();
+  render::release_idle_huge_blocks();
 }
 
 // The schedule's answer on this rank (the agreement before it made every rank's arguments and state alike).

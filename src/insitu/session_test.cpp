@@ -101,6 +101,16 @@ TEST(InsituConfig, EquirectToleranceIsItsOwnKey) {
             std::string::npos);
 }
 
+// The adaptive lattice's spacing: 4 pixels by default, a power of two up to 32 (cells split at midpoints).
+TEST(InsituConfig, AdaptiveStrideIsAPowerOfTwo) {
+  EXPECT_EQ(insitu::parse_session_config_text(std::string(kTask), "t").render.adaptive_stride, 4);
+  EXPECT_EQ(insitu::parse_session_config_text(std::string(kTask) + "[render]\nadaptive_stride = 8\n", "t").render.adaptive_stride, 8);
+  for (const char* bad : {"6", "1", "64", "0", "-4", "4.5"})
+    EXPECT_NE(error_of(std::string(kTask) + "[render]\nadaptive_stride = " + bad + "\n").find("render.adaptive_stride"),
+              std::string::npos)
+        << bad;
+}
+
 TEST(InsituConfig, RigSpecsAreBounded) {
   // More cameras over all shells than the limit (each shell alone is allowed).
   EXPECT_NE(error_of(std::string(kTask) + "[rig]\nspec = \"fibonacci:5000000@2,3,4\"\n").find("is more than the limit"),

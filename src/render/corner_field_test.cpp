@@ -24,6 +24,32 @@ TEST(CornerField, HugePageAllocatorAlignsLargeBlocksAndKeepsContents) {
   EXPECT_EQ(big[0], 7);
 }
 
+// Every snapshot frees its corner copies and asks for blocks of the same sizes: the freed blocks are
+// handed out again (no page fault, no zeroing by the kernel), at most kIdleHugeBlocks of them kept.
+TEST(CornerField, FreedLargeBlocksAreReusedForTheSameSize) {
+  release_idle_huge_blocks();
+  constexpr std::size_t kMiB = std::size_t(1) << 20;
+  void* a = allocate_huge(5 * kMiB);
+  deallocate_huge(a);
+  EXPECT_EQ(idle_huge_bytes(), 6 * kMiB);  // rounded to whole 2 MiB pages
+  void* b = allocate_huge(5 * kMiB + 100);  // the same rounded size
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(idle_huge_bytes(), 0u);
+  void* c = allocate_huge(9 * kMiB);  // another size: a new block
+  EXPECT_NE(c, b);
+  std::vector<void*> more;
+  for (std::size_t i = 0; i < kIdleHugeBlocks + 2; ++i) more.push_back(allocate_huge(2 * kMiB));
+  for (void* p : more) deallocate_huge(p);
+  EXPECT_EQ(idle_huge_bytes(), kIdleHugeBlocks * 2 * kMiB);  // the oldest went back to the system
+  void* small = allocate_huge(1000);  // below 2 MiB: plain malloc, never kept
+  deallocate_huge(small);
+  EXPECT_EQ(idle_huge_bytes(), kIdleHugeBlocks * 2 * kMiB);
+  deallocate_huge(b);
+  deallocate_huge(c);
+  release_idle_huge_blocks();
+  EXPECT_EQ(idle_huge_bytes(), 0u);
+}
+
 // A joint copy holds, record by record, exactly the values of the two separate copies (so the
 // march reads the same numbers from either), with the same quantization.
 TEST(CornerField, JointCopyInterleavesTheTwoSeparateCopies) {
