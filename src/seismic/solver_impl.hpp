@@ -14,8 +14,6 @@
 #include <string>
 #include <vector>
 
-#include <sys/mman.h>
-
 #include "core/error.hpp"
 #include "seismic/medium.hpp"
 #include "seismic/solver.hpp"
@@ -45,14 +43,9 @@ struct ShiftedAllocator {
     if (bytes < small_limit) return std::allocator<T>().allocate(n);
     static std::atomic<unsigned> counter{0};
     const std::size_t shift = 64 + std::size_t(counter++ % 31) * 4160;  // < 128 KiB, the L2 set period
-    // 2 MiB-aligned and advised as transparent huge pages: the sweeps stream a dozen arrays at once
-    // (4 KiB pages: a TLB miss every 1,024 floats of each), and first touch faults a 2 MiB page at a
-    // time instead of 512 small ones (the paper grid's setup: 7.5 s, most of it page faults).
-    constexpr std::size_t huge = std::size_t(2) << 20;
-    const std::size_t rounded = (bytes + shift + huge - 1) / huge * huge;
-    auto* p = static_cast<char*>(std::aligned_alloc(huge, rounded));
+    const std::size_t rounded = (bytes + shift + page - 1) / page * page;
+    auto* p = static_cast<char*>(std::aligned_alloc(page, rounded));
     if (!p) throw std::bad_alloc();
-    ::madvise(p, rounded, MADV_HUGEPAGE);  // advice only
     std::memcpy(p + shift - sizeof(std::size_t), &shift, sizeof(std::size_t));
     return reinterpret_cast<T*>(p + shift);
   }
