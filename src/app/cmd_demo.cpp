@@ -146,14 +146,14 @@ std::string measured_time() {
 
 // Printed under the overhead line, which for the demo alone reads as alarming, and so does the size line
 // above it: its simulation is tiny on purpose. The paper-scale figures are the measured paper run of
-// 2026-11-25 (docs/rendering.md, round 6: 27.7 min, database 624 MB = 6.2 % of the raw fields).
+// 2026-11-29 (docs/rendering.md, round 14: 18.1-19.0 min in four runs, database 580 MB = 5.8 % of the raw fields).
 const char* kOverheadNote =
     "  (the demo's grid, 64x128x40, is small so that the demo runs in minutes: its simulation is cheap and this\n"
     "  ratio large. At the paper's 256x512x160 grid, panoptes run examples/paper.toml (60 snapshots, 390 movies\n"
-    "  of 920x896) took 27.7 min on 2 cores, visualization 6.1x the simulation in wall time: docs/rendering.md, round 6.)\n"
+    "  of 920x896) took 18-19 min on 2 cores, visualization 3.4x the simulation in wall time: docs/rendering.md, round 14.)\n"
     "  Why the movies outweigh the raw fields here: movies grow with cameras x pixels (390 pictures of 400x390\n"
     "  per snapshot), raw fields with the grid (2 x 0.33 M voxels here). At the paper's size the same 390\n"
-    "  movies took 624 MB against 10.1 GB of raw phi_p, phi_s: 6.2 % (measured 2026-11-25, docs/rendering.md);\n"
+    "  movies took 580 MB against 10.1 GB of raw phi_p, phi_s: 5.8 % (measured 2026-11-29, docs/rendering.md);\n"
     "  the larger the simulation, the smaller that share.";
 
 CommandRegistration reg([](CLI::App& root) {
