@@ -87,6 +87,6 @@ if(PANOPTES_BUILD_TESTS AND TARGET panoptes AND TARGET panoptes_capi AND TARGET 
   add_test(NAME capi.install
            COMMAND bash ${PROJECT_SOURCE_DIR}/src/capi/install_test.sh ${PROJECT_BINARY_DIR}
                         ${PROJECT_BINARY_DIR}/install_test)
-  set_tests_properties(capi.install PROPERTIES TIMEOUT 240 LABELS "capi;install;mpi" RESOURCE_LOCK mpi
+  set_tests_properties(capi.install PROPERTIES TIMEOUT 240 COST 34 LABELS "capi;install;mpi" RESOURCE_LOCK mpi
                        ENVIRONMENT "OMP_NUM_THREADS=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
 endif()

@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
     o.frames = 3;
     store::write_synthetic_database(out / "_db_gop2", o);
   }
-  for (const fs::path d : {db, out / "_db_gop2"})
+  for (const fs::path& d : {db, out / "_db_gop2"})
     for (const auto& e : fs::recursive_directory_iterator(d))
       if (e.path().extension() == ".mp4")
         for (const char* target : {"movie", "mp4_fragments"})

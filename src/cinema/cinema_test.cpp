@@ -2,6 +2,7 @@
 // ParaView and Ascent write them, and bad inputs with their messages.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -37,9 +38,12 @@ Image picture(double phi, double theta, double time, int tint, int w = 48, int h
     for (int x = 0; x < w; ++x) {
       std::uint8_t* p = img.at(x, y);
       const double b = std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (r * r));
-      p[0] = std::uint8_t(40 + 2 * x + 150 * b);
-      p[1] = std::uint8_t(30 + 3 * y + 120 * b);
-      p[2] = std::uint8_t(60 + 50 * tint + 100 * b);
+      // Saturated, as a renderer's colours are (a wider picture used to wrap around past 255: a float
+      // to integer conversion out of range, undefined behaviour that clang's UBSan reports).
+      const auto byte = [](double v) { return std::uint8_t(std::clamp(v, 0.0, 255.0)); };
+      p[0] = byte(40 + 2 * x + 150 * b);
+      p[1] = byte(30 + 3 * y + 120 * b);
+      p[2] = byte(60 + 50 * tint + 100 * b);
     }
   return img;
 }
