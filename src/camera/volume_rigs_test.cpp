@@ -13,7 +13,7 @@ using namespace panoptes;
 using namespace panoptes::camera;
 
 namespace {
-const Domain kDomain{{10, -5, 0}, {400, 300, 160}};
+const Domain kVolumeDomain{{10, -5, 0}, {400, 300, 160}};
 
 // The world axis index and sign of the move that goes +x / +y / +z.
 Move move_along(UpAxis up, int axis) {
@@ -25,7 +25,7 @@ Move move_along(UpAxis up, int axis) {
 
 TEST(LatticeRig, NodesAtCellCentresLookingNorthWithTheSkyUp) {
   RigSpec spec = RigSpec::parse("lattice:4x4x3");
-  const Rig rig = make_rig(spec, kDomain);
+  const Rig rig = make_rig(spec, kVolumeDomain);
   ASSERT_EQ(rig.size(), 48);
   EXPECT_EQ(rig.lattice, (std::array<int, 3>{4, 4, 3}));
   EXPECT_EQ(rig.spec, "lattice:4x4x3@0");
@@ -40,7 +40,7 @@ TEST(LatticeRig, NodesAtCellCentresLookingNorthWithTheSkyUp) {
   EXPECT_EQ(c.fov_y_degrees, kInsideFovDegrees);
   EXPECT_EQ(c.patch, "lattice");
   // A margin shrinks the box: node 0 of a 1-node axis stays at the centre, the outer nodes move inwards.
-  const Rig m = make_rig("lattice:2x1x1@0.25", kDomain);
+  const Rig m = make_rig("lattice:2x1x1@0.25", kVolumeDomain);
   EXPECT_NEAR(m.cameras[0].position.x, 10 + 400 * (0.25 + 0.5 * 0.25), 1e-9);
   EXPECT_NEAR(m.cameras[0].position.y, -5 + 150, 1e-9);
 }
@@ -49,7 +49,7 @@ TEST(LatticeRig, WalkingForwardAlongEveryWorldAxisReachesTheNeighbour) {
   for (UpAxis up : {UpAxis::z_up, UpAxis::z_down}) {
     RigSpec spec = RigSpec::parse("lattice:4x3x2");
     spec.up_axis = up;
-    const Rig rig = make_rig(spec, kDomain);
+    const Rig rig = make_rig(spec, kVolumeDomain);
     const NavigationGraph g = build_navigation_graph(rig);
     ASSERT_EQ(g.size(), rig.size());
     const std::array<int, 3> n = rig.lattice;
@@ -103,7 +103,7 @@ TEST(PathRig, CamerasLookAlongThePathAndWalkInOut) {
   {
     std::ofstream(file) << "# a flight\n100 100 80\n200, 100, 80\n\n200 200 40  # turn\n";
   }
-  const Rig rig = make_rig("path:" + file.string(), kDomain);
+  const Rig rig = make_rig("path:" + file.string(), kVolumeDomain);
   ASSERT_EQ(rig.size(), 3);
   EXPECT_TRUE(rig.path);
   EXPECT_NEAR(rig.camera(0, 8, 8).forward().x, 1, 1e-12);
@@ -118,7 +118,7 @@ TEST(PathRig, CamerasLookAlongThePathAndWalkInOut) {
     std::ofstream(file) << "1 2 3\n1 2 3\n";
   }
   try {
-    make_rig("path:" + file.string(), kDomain);
+    make_rig("path:" + file.string(), kVolumeDomain);
     ADD_FAILURE();
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
@@ -126,7 +126,7 @@ TEST(PathRig, CamerasLookAlongThePathAndWalkInOut) {
   {
     std::ofstream(file) << "1 2\n";
   }
-  EXPECT_THROW(make_rig("path:" + file.string(), kDomain), FileError);
+  EXPECT_THROW(make_rig("path:" + file.string(), kVolumeDomain), FileError);
   std::filesystem::remove(file);
 }
 

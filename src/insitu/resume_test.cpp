@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string error_of(const std::string& toml) {
+std::string resume_error_of(const std::string& toml) {
   try {
     (void)insitu::parse_session_config_text(toml + "[[task]]\nname = \"v\"\nfield = \"f\"\n", "test.toml");
   } catch (const Error& e) {
@@ -37,10 +37,10 @@ TEST(InsituOutputMode, KeyAndItsOldSpelling) {
   EXPECT_EQ(mode("mode = \"overwrite\""), insitu::OutputMode::overwrite);
   EXPECT_EQ(mode("overwrite = true"), insitu::OutputMode::overwrite);
   EXPECT_EQ(mode("overwrite = false"), insitu::OutputMode::create);
-  const std::string bad = error_of("[output]\nmode = \"append\"\n");
+  const std::string bad = resume_error_of("[output]\nmode = \"append\"\n");
   EXPECT_NE(bad.find("output.mode"), std::string::npos) << bad;
   EXPECT_NE(bad.find("\"resume\""), std::string::npos) << bad;
-  const std::string both = error_of("[output]\nmode = \"resume\"\noverwrite = true\n");
+  const std::string both = resume_error_of("[output]\nmode = \"resume\"\noverwrite = true\n");
   EXPECT_NE(both.find("give only [output] mode"), std::string::npos) << both;
 }
 
@@ -74,7 +74,7 @@ insitu::SessionConfig config(const fs::path& dir, insitu::OutputMode mode) {
 
 render::GridGeometry test_grid() { return {{20, 18, 16}, {0, 0, 0}, {1, 1, 1}}; }
 
-std::vector<float> field(double t) {
+std::vector<float> resume_field(double t) {
   const render::GridGeometry g = test_grid();
   // A wave that grows until the last snapshot before the kill (t = 0.4) and then fades: the frames
   // after the restart depend on the running reference kept across it.
@@ -94,7 +94,7 @@ void run(const fs::path& dir, insitu::OutputMode mode, int first, int kill_in = 
       if (frame == kill_in && camera == 2) ::raise(SIGKILL);
     });
   for (int step = first; step < kSteps; ++step) {
-    const auto f = field(time_of(step));
+    const auto f = resume_field(time_of(step));
     s.process(step, time_of(step), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }
   s.finalize();
@@ -153,7 +153,7 @@ TEST(InsituResume, RefusesAnotherConfigurationNamingWhatDiffers) {
   fs::remove_all(dir);
   {
     insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
-    const auto f = field(0);
+    const auto f = resume_field(0);
     s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }  // destroyed without finalize: interrupted
   auto refusal = [&](insitu::SessionConfig c, const render::GridGeometry& g) -> std::string {
@@ -194,7 +194,7 @@ TEST(InsituResume, NothingToResumeStartsANewDatabase) {
   {
     insitu::Session s(config(dir, insitu::OutputMode::resume), test_grid(), insitu::LocalBlock::whole(test_grid()));
     EXPECT_EQ(s.snapshots(), 0);
-    const auto f = field(0);
+    const auto f = resume_field(0);
     EXPECT_TRUE(s.process(0, 0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
     s.finalize();
   }
@@ -203,7 +203,7 @@ TEST(InsituResume, NothingToResumeStartsANewDatabase) {
 }
 
 std::string refusal_of(insitu::Session& s, double time, int step = -1) {
-  const auto f = field(0);
+  const auto f = resume_field(0);
   const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
   try {
     if (step >= 0)
@@ -224,7 +224,7 @@ TEST(InsituTimes, NonFiniteAndDecreasingTimesAreRefused) {
   fs::remove_all(dir);
   {
     insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
-    const auto f = field(0);
+    const auto f = resume_field(0);
     const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
     for (double t : {0.0, 1.0, 2.0}) s.snapshot(t, in);
     EXPECT_NE(refusal_of(s, NAN).find("snapshot: time nan; expected a finite"), std::string::npos) << refusal_of(s, NAN);
@@ -248,7 +248,7 @@ TEST(InsituTimes, NonFiniteAndDecreasingTimesAreRefused) {
 TEST(InsituTimes, ResumeSkipsRepeatedTimesOnlyBeforeItsFirstNewSnapshot) {
   const fs::path dir = fs::temp_directory_path() / ("insitu_times_resume_" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  const auto f = field(0);
+  const auto f = resume_field(0);
   const std::vector<insitu::FieldInput> in{{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}};
   {
     insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
@@ -308,7 +308,7 @@ TEST(InsituResume, ResumeCompleteAppendsToAFinishedRun) {
   {
     insitu::Session s(c, test_grid(), insitu::LocalBlock::whole(test_grid()));
     EXPECT_EQ(s.snapshots(), kSteps);
-    const auto f = field(time_of(kSteps));
+    const auto f = resume_field(time_of(kSteps));
     EXPECT_TRUE(s.process(kSteps, time_of(kSteps), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}}));
     s.finalize();
   }
@@ -323,7 +323,7 @@ TEST(InsituResume, RefusesAnotherSchedule) {
   fs::remove_all(dir);
   {
     insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
-    const auto f = field(0);
+    const auto f = resume_field(0);
     s.snapshot(0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }  // interrupted
   insitu::SessionConfig steps = config(dir, insitu::OutputMode::resume);
@@ -355,7 +355,7 @@ TEST(InsituResume, OverwriteKeepsAnInterruptedRunBeside) {
   {
     insitu::Session s(config(dir, insitu::OutputMode::create), test_grid(), insitu::LocalBlock::whole(test_grid()));
     for (int step = 0; step < 2; ++step) {
-      const auto f = field(time_of(step));
+      const auto f = resume_field(time_of(step));
       s.process(step, time_of(step), {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
     }
   }  // no finalize: interrupted
@@ -373,7 +373,7 @@ TEST(InsituResume, OverwriteKeepsAnInterruptedRunBeside) {
   {
     insitu::SessionConfig c = config(dir, insitu::OutputMode::overwrite);
     insitu::Session s(c, test_grid(), insitu::LocalBlock::whole(test_grid()));
-    const auto f = field(0);
+    const auto f = resume_field(0);
     s.process(0, 0, {{"f", f.data(), insitu::ScalarType::f32, {0, 0, 0}}});
   }
   insitu::SessionConfig c = config(dir, insitu::OutputMode::overwrite);

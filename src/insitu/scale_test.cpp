@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-render::GridGeometry test_grid() { return {{32, 32, 32}, {0, 0, 0}, {1, 1, 1}}; }
+render::GridGeometry scale_test_grid() { return {{32, 32, 32}, {0, 0, 0}, {1, 1, 1}}; }
 
 fs::path temp_dir(const std::string& name) {
   return fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
@@ -42,7 +42,7 @@ every_steps = 1
 
 // A spherical shell of radius r and width w (value amp on it), as a P front of an explosion.
 std::vector<float> shell(double r, double w, double amp) {
-  const render::GridGeometry g = test_grid();
+  const render::GridGeometry g = scale_test_grid();
   std::vector<float> v(std::size_t(g.dims[0]) * g.dims[1] * g.dims[2]);
   std::size_t n = 0;
   for (int k = 0; k < g.dims[2]; ++k)
@@ -89,7 +89,7 @@ std::vector<Image> two_field_frames(const fs::path& dir, const std::string& a, c
   auto cfg = config(dir, toml + "[[task]]\nname = \"two\"\ntype = \"volume2\"\nfields = [\"" + a + "\", \"" + b +
                              "\"]\npreset = \"p-wave\"\npreset2 = \"s-wave\"\n");
   std::vector<Image> frames;
-  insitu::Session s(cfg, test_grid(), insitu::LocalBlock::whole(test_grid()));
+  insitu::Session s(cfg, scale_test_grid(), insitu::LocalBlock::whole(scale_test_grid()));
   s.set_frame_observer([&](int, int, int, const Image& im) { frames.push_back(im); });
   const auto strong = shell(9, 2, 1.0), weak = residue(1.0 / 148);
   s.snapshot(0.72, {{a, strong.data(), insitu::ScalarType::f32, {0, 0, 0}}, {b, weak.data(), insitu::ScalarType::f32, {0, 0, 0}}});
@@ -140,7 +140,7 @@ preset = "p-wave"
     std::vector<std::vector<Image>> frames(6);
     std::vector<double> amplitude;
     {
-      insitu::Session s(cfg, test_grid(), insitu::LocalBlock::whole(test_grid()));
+      insitu::Session s(cfg, scale_test_grid(), insitu::LocalBlock::whole(scale_test_grid()));
       s.set_frame_observer([&](int, int, int frame, const Image& im) { frames[std::size_t(frame)].push_back(im); });
       for (int k = 0; k < 6; ++k) {
         // Core: a thin bright shell (few points: it sets the 99.9th percentile); body: a broad weak one.
@@ -187,7 +187,7 @@ name = "b"
 field = "b"
 )");
   {
-    insitu::Session s(cfg, test_grid(), insitu::LocalBlock::whole(test_grid()));
+    insitu::Session s(cfg, scale_test_grid(), insitu::LocalBlock::whole(scale_test_grid()));
     for (int k = 0; k < 3; ++k) {
       const auto v = shell(8, 2, std::pow(0.5, k));
       s.snapshot(k, {{"a", v.data(), insitu::ScalarType::f32, {0, 0, 0}}, {"b", v.data(), insitu::ScalarType::f32, {0, 0, 0}}});
@@ -229,7 +229,7 @@ TEST(HonestScale, ConfigErrorsNameTheKey) {
   const fs::path dir = temp_dir("scale_typo");
   auto cfg = config(dir, "[render.field.phi_q]\nreference = \"fixed\"\nvalue = 1\n[[task]]\nname = \"v\"\nfield = \"phi_p\"\n");
   try {
-    insitu::Session s(cfg, test_grid(), insitu::LocalBlock::whole(test_grid()));
+    insitu::Session s(cfg, scale_test_grid(), insitu::LocalBlock::whole(scale_test_grid()));
     ADD_FAILURE() << "a scale for an unread field was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("render.field.phi_q"), std::string::npos) << e.what();

@@ -21,7 +21,7 @@ namespace {
 
 constexpr int kFrames = 3;
 
-void make_database(const fs::path& dir) {
+void make_checked_database(const fs::path& dir) {
   Manifest m = sample_manifest(2, 1, 32, 32);
   m.video.gop = 1;
   DatabaseWriter w = DatabaseWriter::create(dir, m);
@@ -49,8 +49,8 @@ int damaged_reads(const Database& db, int camera, int task) {
 
 TEST(FrameChecks, NewDatabasesRecordTheirSchemeAndIdentity) {
   TempDir a, b;
-  make_database(a.path);
-  make_database(b.path);
+  make_checked_database(a.path);
+  make_checked_database(b.path);
   const Database da = Database::open(a.path), db = Database::open(b.path);
   EXPECT_EQ(da.manifest().frame_checks.scheme, kFrameCheckScheme);
   EXPECT_EQ(da.manifest().frame_checks.database_id.size(), 16u);
@@ -62,8 +62,8 @@ TEST(FrameChecks, NewDatabasesRecordTheirSchemeAndIdentity) {
 
 TEST(FrameChecks, AMovieInAnotherStreamsPlaceIsDamaged) {
   TempDir dir, other;
-  make_database(dir.path);
-  make_database(other.path);
+  make_checked_database(dir.path);
+  make_checked_database(other.path);
   const Database db = Database::open(dir.path);
   // Camera 1's movie as camera 0's (same database), then another database's camera 1.
   for (const fs::path& from : {db.stream_path(1, 0), Database::open(other.path).stream_path(1, 0)}) {
@@ -83,7 +83,7 @@ TEST(FrameChecks, AMovieInAnotherStreamsPlaceIsDamaged) {
 
 TEST(FrameChecks, DatabasesWithoutTheRecordKeepTodaysReading) {
   TempDir dir;
-  make_database(dir.path);
+  make_checked_database(dir.path);
   // Remove the record, as a database written before it existed has none.
   std::string text;
   {
@@ -103,7 +103,7 @@ TEST(FrameChecks, DatabasesWithoutTheRecordKeepTodaysReading) {
 
 TEST(FrameChecks, UnknownSchemesAndBadIdsAreRefused) {
   TempDir dir;
-  make_database(dir.path);
+  make_checked_database(dir.path);
   std::string text;
   {
     std::ifstream in(dir / kManifestFileName);
@@ -144,7 +144,7 @@ TEST(FrameChecks, NonRootWritersStampTheRootsIdentity) {
 
 TEST(FrameChecks, AKilledWritersTempManifestIsRemovedByTheNextWriter) {
   TempDir dir;
-  make_database(dir.path);
+  make_checked_database(dir.path);
   // What a writer killed between creating and renaming leaves (this version's name and the old one).
   std::ofstream(dir / (std::string(kTempPrefix) + "panoptes.json.tmp.123.456")) << "{";
   std::ofstream(dir / "panoptes.json.tmp.123.789") << "{";
@@ -161,7 +161,7 @@ TEST(FrameChecks, AKilledWritersTempManifestIsRemovedByTheNextWriter) {
 // movie unreadable or every frame damaged, never a frame that reads as good.
 TEST(FrameChecks, EveryBitOfTheParameterSetsIsChecked) {
   TempDir dir;
-  make_database(dir.path);
+  make_checked_database(dir.path);
   const Database db = Database::open(dir.path);
   ASSERT_TRUE(db.frame_checks(0, 0).parameter_sets);
   const fs::path movie = db.stream_path(0, 0);

@@ -19,14 +19,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
+std::string owned_slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
 }
 
-void spit(const fs::path& p, const std::string& text) {
+void owned_spit(const fs::path& p, const std::string& text) {
   fs::create_directories(p.parent_path());
   std::ofstream(p, std::ios::binary | std::ios::trunc) << text;
 }
@@ -46,13 +46,13 @@ void make_database(const fs::path& dir, const std::string& pattern, int cameras,
 TEST(OwnedFiles, OverwriteKeepsFilesTheDatabaseNeverWrote) {
   TempDir dir;
   make_database(dir.path, "holiday/c{camera}/t{task}.mp4", 3, 2);
-  spit(dir / "holiday/precious.txt", "precious\n");
-  spit(dir / "holiday/c1/notes.txt", "notes\n");
-  spit(dir / "holiday/c2/t7.mp4", "not listed: task 7 of 2\n");
+  owned_spit(dir / "holiday/precious.txt", "precious\n");
+  owned_spit(dir / "holiday/c1/notes.txt", "notes\n");
+  owned_spit(dir / "holiday/c2/t7.mp4", "not listed: task 7 of 2\n");
   make_database(dir.path, "movies/c{camera}/t{task}.mp4", 1, 1, /*overwrite=*/true);
-  EXPECT_EQ(slurp(dir / "holiday/precious.txt"), "precious\n");
-  EXPECT_EQ(slurp(dir / "holiday/c1/notes.txt"), "notes\n");
-  EXPECT_EQ(slurp(dir / "holiday/c2/t7.mp4"), "not listed: task 7 of 2\n");
+  EXPECT_EQ(owned_slurp(dir / "holiday/precious.txt"), "precious\n");
+  EXPECT_EQ(owned_slurp(dir / "holiday/c1/notes.txt"), "notes\n");
+  EXPECT_EQ(owned_slurp(dir / "holiday/c2/t7.mp4"), "not listed: task 7 of 2\n");
   EXPECT_FALSE(fs::exists(dir / "holiday/c1/t0.mp4"));
   EXPECT_FALSE(fs::exists(dir / "holiday/c0"));  // emptied: the directory the writer made goes too
   EXPECT_TRUE(fs::exists(dir / "movies/c0/t0.mp4"));
@@ -64,33 +64,33 @@ TEST(OwnedFiles, OverwriteNeverFollowsALinkInTheOldTree) {
   make_database(dir.path, "movies/c{camera}/t{task}.mp4", 2, 1);
   // movies/c1 replaced by a link to a directory of the user's that happens to hold a "t0.mp4".
   fs::remove_all(dir / "movies/c1");
-  spit(outside / "t0.mp4", "the user's own movie\n");
+  owned_spit(outside / "t0.mp4", "the user's own movie\n");
   fs::create_directory_symlink(outside.path, dir / "movies/c1");
   // movies/c0/t0.mp4 replaced by a link to a file of the user's: the link goes, the file stays.
   fs::remove(dir / "movies/c0/t0.mp4");
-  spit(outside / "keep.txt", "keep\n");
+  owned_spit(outside / "keep.txt", "keep\n");
   fs::create_symlink(outside / "keep.txt", dir / "movies/c0/t0.mp4");
   make_database(dir.path, "other/{camera}_{task}.mp4", 1, 1, /*overwrite=*/true);
-  EXPECT_EQ(slurp(outside / "t0.mp4"), "the user's own movie\n");
-  EXPECT_EQ(slurp(outside / "keep.txt"), "keep\n");
+  EXPECT_EQ(owned_slurp(outside / "t0.mp4"), "the user's own movie\n");
+  EXPECT_EQ(owned_slurp(outside / "keep.txt"), "keep\n");
   EXPECT_FALSE(fs::is_symlink(dir / "movies/c0/t0.mp4"));
   EXPECT_TRUE(fs::is_symlink(dir / "movies/c1"));  // not ours to remove: it is not a movie
 }
 
 TEST(OwnedFiles, FlatPatternsMatchOnlyListedIndices) {
   TempDir dir;
-  spit(dir / "3_1.mp4", "");
-  spit(dir / "3_10.mp4", "");   // task 10 of 2: not listed
-  spit(dir / "03_1.mp4", "");   // std::to_string never writes a leading zero
-  spit(dir / "3_1.mp4.bak", "");
-  spit(dir / "12_0.mp4", "");
+  owned_spit(dir / "3_1.mp4", "");
+  owned_spit(dir / "3_10.mp4", "");   // task 10 of 2: not listed
+  owned_spit(dir / "03_1.mp4", "");   // std::to_string never writes a leading zero
+  owned_spit(dir / "3_1.mp4.bak", "");
+  owned_spit(dir / "12_0.mp4", "");
   const FileHandle d = open_directory(dir.path);
   EXPECT_EQ(find_listed_movies(d.get(), "{camera}_{task}.mp4", 13, 2),
             (std::vector<std::string>{"12_0.mp4", "3_1.mp4"}));
   EXPECT_TRUE(find_listed_movies(d.get(), "{camera}_{task}.mp4", -1, 2).empty());
   // A camera named twice must agree with itself.
-  spit(dir / "c4/4-1.mp4", "");
-  spit(dir / "c4/5-1.mp4", "");
+  owned_spit(dir / "c4/4-1.mp4", "");
+  owned_spit(dir / "c4/5-1.mp4", "");
   EXPECT_EQ(find_listed_movies(d.get(), "c{camera}/{camera}-{task}.mp4", 10, 2),
             (std::vector<std::string>{"c4/4-1.mp4"}));
 }
@@ -98,7 +98,7 @@ TEST(OwnedFiles, FlatPatternsMatchOnlyListedIndices) {
 TEST(OwnedFiles, AnUnreadableOldManifestListsNothing) {
   TempDir dir;
   make_database(dir.path, "movies/c{camera}/t{task}.mp4", 2, 1);
-  spit(dir / kManifestFileName, "{ not json");
+  owned_spit(dir / kManifestFileName, "{ not json");
   make_database(dir.path, "new/c{camera}/t{task}.mp4", 1, 1, /*overwrite=*/true);
   EXPECT_TRUE(fs::exists(dir / "movies/c1/t0.mp4"));
   EXPECT_EQ(Database::open(dir.path).stream_count(), 1);
