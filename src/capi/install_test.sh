@@ -8,12 +8,20 @@
 # every database is checked with the installed `panoptes info`. Also: only the C API is exported from
 # libpanoptes.so, the installed executable runs without LD_LIBRARY_PATH, and the installed Python
 # package imports and reads a frame.
-#   install_test.sh BUILD_DIR WORK_DIR
+#   install_test.sh BUILD_DIR WORK_DIR [build|run|all]
+# The phases (ctest runs them as two tests, capi.install_build and capi.install): "build" installs and
+# compiles every example into WORK_DIR, "run" runs and checks them there (MPI: it takes turns with the
+# other MPI tests; the compiles need not), "all" (the default) does both.
 set -euo pipefail
 build=$(cd "$1" && pwd)
 work=$2
-rm -rf "$work"
-mkdir -p "$work"
+phase=${3:-all}
+case "$phase" in build|run|all) ;; *) echo "install_test: phase '$phase' (expected build, run or all)" >&2; exit 2 ;; esac
+if [ "$phase" != run ]; then
+  rm -rf "$work"
+  mkdir -p "$work"
+fi
+[ -d "$work" ] || { echo "install_test: $work missing: run the build phase first" >&2; exit 1; }
 work=$(cd "$work" && pwd)
 prefix=$work/prefix
 unset LD_LIBRARY_PATH PKG_CONFIG_PATH CMAKE_PREFIX_PATH || true
@@ -22,8 +30,10 @@ fail() { echo "install_test: FAIL: $*" >&2; exit 1; }
 start=$(date +%s%N)
 step() { local ms=$((($(date +%s%N) - start) / 1000000)); printf '== [%d.%d s] %s\n' $((ms / 1000)) $((ms % 1000 / 100)) "$*"; }
 
-step "cmake --install $build --prefix $prefix"
-cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
+if [ "$phase" != run ]; then
+  step "cmake --install $build --prefix $prefix"
+  cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
+fi
 libdir=$(dirname "$(find "$prefix" -name 'libpanoptes.so' | head -1)")
 [ -n "$libdir" ] && [ -d "$libdir" ] || fail "no libpanoptes.so installed"
 for f in bin/panoptes include/panoptes.h include/panoptes.hpp include/panoptes/fortran/panoptes.mod \
@@ -53,6 +63,7 @@ step "installed panoptes runs from another directory without LD_LIBRARY_PATH"
 ex=$doc/examples
 steps=20   # snapshots at steps 0, 10, 20 (heat.toml: every_steps = 10)
 run_and_check() {  # name binary example ranks...
+  [ "$phase" != build ] || return 0
   local name=$1 bin=$2 example=$3
   shift 3
   for np in "$@"; do
@@ -70,6 +81,7 @@ run_and_check() {  # name binary example ranks...
 
 step "CMake: find_package(Panoptes) builds of the examples"
 for example in heat_c heat_cpp heat_fortran; do
+  [ "$phase" != run ] || { run_and_check "cmake_$example" "$work/cmake_$example/$example" $example 1 2; continue; }
   cmake -S "$ex/$example" -B "$work/cmake_$example" -G Ninja -DCMAKE_BUILD_TYPE=Release \
         -DCMAKE_PREFIX_PATH="$prefix" >"$work/cmake_$example.log" 2>&1 ||
     { cat "$work/cmake_$example.log"; fail "configure $example against the install"; }
@@ -80,27 +92,27 @@ done
 
 step "pkg-config builds of the examples"
 export PKG_CONFIG_PATH=$libdir/pkgconfig
-cc -O2 "$ex/heat_c/heat.c" $(pkg-config --cflags --libs panoptes) -o "$work/pkg_heat_c" ||
+[ "$phase" = run ] || cc -O2 "$ex/heat_c/heat.c" $(pkg-config --cflags --libs panoptes) -o "$work/pkg_heat_c" ||
   fail "cc heat.c \$(pkg-config --cflags --libs panoptes)"
 run_and_check pkg_heat_c "$work/pkg_heat_c" heat_c 2
-mpifort -O2 "$ex/heat_fortran/heat.f90" $(pkg-config --cflags --libs panoptes-fortran) -o "$work/pkg_heat_fortran" ||
+[ "$phase" = run ] || mpifort -O2 "$ex/heat_fortran/heat.f90" $(pkg-config --cflags --libs panoptes-fortran) -o "$work/pkg_heat_fortran" ||
   fail "mpifort heat.f90 \$(pkg-config --cflags --libs panoptes-fortran)"
 run_and_check pkg_heat_fortran "$work/pkg_heat_fortran" heat_fortran 2
 
 # C++ with plain c++ (no MPI wrapper): <mpi.h> in C++ must not leave MPI C++ symbols undefined.
-c++ -O2 -std=c++17 "$ex/heat_cpp/heat.cpp" $(pkg-config --cflags --libs panoptes) -o "$work/pkg_heat_cpp" ||
+[ "$phase" = run ] || c++ -O2 -std=c++17 "$ex/heat_cpp/heat.cpp" $(pkg-config --cflags --libs panoptes) -o "$work/pkg_heat_cpp" ||
   fail "c++ heat.cpp \$(pkg-config --cflags --libs panoptes)"
 run_and_check pkg_heat_cpp "$work/pkg_heat_cpp" heat_cpp 2
 
 step "Fortran module built from the installed source"
 mkdir -p "$work/f90src"
-(cd "$work/f90src" && mpifort -O2 -c "$prefix/share/panoptes/fortran/panoptes.f90" &&
+[ "$phase" = run ] || (cd "$work/f90src" && mpifort -O2 -c "$prefix/share/panoptes/fortran/panoptes.f90" &&
    mpifort -O2 "$ex/heat_fortran/heat.f90" panoptes.o -L"$libdir" -Wl,-rpath,"$libdir" -lpanoptes -o heat_fortran) ||
   fail "mpifort panoptes.f90 heat.f90 -lpanoptes"
 run_and_check src_heat_fortran "$work/f90src/heat_fortran" heat_fortran 2
 
 pydir=$(find "$prefix" -type d -name panoptes -path '*-packages/*' | head -1)
-if [ -n "$pydir" ]; then
+if [ -n "$pydir" ] && [ "$phase" != build ]; then
   step "installed Python package"
   PYTHONPATH=$(dirname "$pydir") /usr/bin/python3 -c "
 import sys, panoptes
@@ -111,4 +123,4 @@ assert f.shape == (96, 96, 3) and f.dtype.name == 'uint8', (f.shape, f.dtype)
 print('python:', panoptes.__file__, db.frame_count, 'frames', f.shape)
 " || fail "import panoptes from the install"
 fi
-step "install_test: OK"
+step "install_test ($phase): OK"
