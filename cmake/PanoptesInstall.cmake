@@ -86,7 +86,7 @@ endforeach()
 if(PANOPTES_BUILD_TESTS AND TARGET panoptes AND TARGET panoptes_capi AND TARGET MPI::MPI_C)
   # Two tests: the install and the examples' compiles (no MPI run: beside the other tests), then their
   # runs, which take turns with the other MPI tests. The MPI tests run one at a time and are the suite's
-  # longest chain (272 of its 351 s on a clean 2-core machine, 2026-11-30); the compiles were ~20 s of it.
+  # longest chain (272 of its 351 s on a clean 2-core machine, 2026-11-30); the compiles were ~14 s of it.
   add_test(NAME capi.install_build
            COMMAND bash ${PROJECT_SOURCE_DIR}/src/capi/install_test.sh ${PROJECT_BINARY_DIR}
                         ${PROJECT_BINARY_DIR}/install_test build)
