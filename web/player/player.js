@@ -31,6 +31,7 @@ import { LookView, drawOrientationMarks } from "./look_view.js";
 import { LatticeMap } from "./lattice_map.js";
 import { SphereMap } from "./sphere_map.js";
 import { installTestApi } from "./test_api.js";
+import { lateFrame } from "./late_frame.js";
 
 const params = new URLSearchParams(location.search);
 const base = new URL(".", location.href).href.split("?")[0];
@@ -334,16 +335,21 @@ function render(now) {
       // The engine waits for the frame it needs; here the clock runs on meanwhile, so when a frame of
       // this stream decoded on demand arrives late, show it rather than keep the old stream on screen.
       if (S.playing) {
-        for (let back = 1; back <= 3; back++) {
-          const g = (frame - back * S.dir + S.db.frames) % S.db.frames;  // behind the playhead, either direction
-          if (S.shown && S.shown.camera === S.camera && S.shown.task === S.task && S.shown.frame === g) break;
-          const late = cache.get(`${S.camera}/${S.task}/${g}`);
-          if (late) {
-            drawFrame(late);
-            drawn = true;
-            shownFrame = g;
-            break;
-          }
+        const sameStream = S.shown && S.shown.camera === S.camera && S.shown.task === S.task;
+        const late = lateFrame({
+          frame, dir: S.dir, frames: S.db.frames, shownFrame: sameStream ? S.shown.frame : null,
+          isDecoded: (g) => cache.has(`${S.camera}/${S.task}/${g}`),
+          isDamaged: (g) => st.status === "ok" && !!st.damaged && st.damaged.has(g),
+        });
+        if (late && late.damaged) {
+          status = "damaged";
+          drawPlaceholder(S.camera, S.task, status, `${st.url}: frame ${late.frame} fails its frame checks (checksum, movie identity or position)`);
+        } else if (late) {
+          drawFrame(cache.get(`${S.camera}/${S.task}/${late.frame}`));
+        }
+        if (late) {
+          drawn = true;
+          shownFrame = late.frame;
         }
       }
     }
