@@ -11,6 +11,7 @@
 #include "render/march_plan.hpp"
 #include "render/ray_march.hpp"
 #include "render/sample_blocks.hpp"
+#include "render/tile_schedule.hpp"
 #include "camera/pixel_rays.hpp"
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include <bit>
 #include <chrono>
 #include <limits>
+#include <omp.h>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -296,12 +298,13 @@ RenderStats render_brick(const camera::Camera& cam, std::span<const PreparedFiel
     }
   };
 
+  const int chunk = tile_chunk(ntx, ntx * nty, omp_get_max_threads());
 #pragma omp parallel reduction(+ : n_rays, n_eff, n_marched, n_interpolated)
   {
     alignas(64) float acc[kMaxTasksPerMarch][4];
     march::IsoSliver sliver[kMaxTasksPerMarch];
     AdaptiveTile refiner(stride, tolerance, sphere ? 0.0f : opt.adaptive_linear_tolerance);
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(dynamic, chunk)
     for (int ti = 0; ti < ntx * nty; ++ti) {
       const int tx0 = std::max(rect.x0, (tx_first + ti % ntx) * tile_w), ty0 = std::max(rect.y0, (ty_first + ti / ntx) * tile_h);
       const int tx1 = std::min((tx_first + ti % ntx + 1) * tile_w, rect.x1), ty1 = std::min((ty_first + ti / ntx + 1) * tile_h, rect.y1);

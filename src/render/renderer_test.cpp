@@ -6,10 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <omp.h>
 
 #include "render/iso_shading.hpp"
 #include "render/render_test_util.hpp"
 #include "render/synthetic_fields.hpp"
+#include "render/tile_schedule.hpp"
 
 using namespace panoptes;
 using namespace panoptes::render;
@@ -332,4 +334,38 @@ TEST(Renderer, FarAboveTheWindowZerosStayBlack) {
   const std::vector<QuantizationRange> keep = quantization_ranges(1, tasks);
   EXPECT_NEAR(keep[0].hi, window_top * 65, 1e-9);
   EXPECT_NEAR(keep[0].lo, -window_top * 65, 1e-9);
+}
+
+// The tiles' hand-out (tile_schedule.hpp): a row of tiles for few threads, smaller hand-outs when
+// many threads share a small frame, never none.
+TEST(TileSchedule, ARowOfTilesWhileEveryThreadGetsSixteen) {
+  EXPECT_EQ(tile_chunk(58, 58 * 56, 2), 58);   // 920x896 in 16-pixel tiles, 2 threads
+  EXPECT_EQ(tile_chunk(20, 20 * 20, 2), 12);   // 320x320: 400 tiles, 16 hand-outs per thread
+  EXPECT_EQ(tile_chunk(58, 58 * 56, 64), 3);
+  EXPECT_EQ(tile_chunk(4, 8, 64), 1);
+  EXPECT_EQ(tile_chunk(1, 1, 0), 1);
+}
+
+// Tiles are independent, so how the threads share them cannot change an image: a dense adaptive
+// frame on one thread and on two (the OpenMP hand-out of tile_chunk()) has the same bits.
+TEST(Renderer, TheImageDoesNotDependOnTheThreads) {
+  const GridGeometry grid{{32, 48, 24}, {0, 0, 0}, {1, 1, 1}};
+  const DenseWaveScene waves = dense_wave_scene(grid);
+  const FieldView view = FieldView::whole(grid, waves.p.data());
+  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1.0))};
+  const camera::Camera cam({70, -40, 50}, {16, 24, 12}, {0, 0, 1}, 30, 230, 224);  // 15 x 14 tiles
+  RenderOptions opt;
+  opt.adaptive = true;
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const std::vector<PartialImage> one = render_whole(cam, view, tasks, opt);
+  omp_set_num_threads(2);
+  const std::vector<PartialImage> two = render_whole(cam, view, tasks, opt);
+  omp_set_num_threads(threads);
+  ASSERT_EQ(one[0].rgba.size(), two[0].rgba.size());
+  EXPECT_EQ(one[0].rgba, two[0].rgba);
+  EXPECT_EQ(one[0].depth, two[0].depth);
+  double sum = 0;
+  for (float v : one[0].rgba) sum += v;
+  EXPECT_GT(sum, 100.0) << "the frame shows the field";
 }
