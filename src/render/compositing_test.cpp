@@ -471,8 +471,9 @@ TEST(Compositing, CamerasInsideTheDomainMatchTheSingleBrickImage) {
           render_brick(cam, fields, sc.tasks, a);
           render_brick(cam, fields, sc.tasks, d, full);
           for (std::size_t t = 0; t < sc.tasks.size(); ++t)
-            if (blend_of(sc.tasks[t].kind) == Blend::over)
+            if (blend_of(sc.tasks[t].kind) == Blend::over) {
               ASSERT_TRUE(a[t].depth == d[t].depth) << "camera " << ci << ", axis " << axis << ", " << n << " bricks, task " << t;
+            }
         }
       }
   }

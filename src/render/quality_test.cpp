@@ -198,7 +198,9 @@ TEST(Quality, IsosurfaceSweepMatchesTheReferencePathWithin45dB) {
       EXPECT_GE(p, 45.0) << "camera " << c << " isovalue " << t;
       double alpha = 0;  // not two blank frames
       for (std::size_t i = 3; i < ref[t].rgba.size(); i += 4) alpha += ref[t].rgba[i];
-      if (t == 0) EXPECT_GT(alpha / double(ref[t].rgba.size() / 4), 0.05) << "camera " << c;
+      if (t == 0) {
+        EXPECT_GT(alpha / double(ref[t].rgba.size() / 4), 0.05) << "camera " << c;
+      }
     }
   }
   RecordProperty("worst_psnr_db", std::to_string(worst));
