@@ -1,11 +1,11 @@
 #pragma once
 // How the OpenMP threads of one frame share its tiles (render_brick()). Tiles handed out one at a
-// time put neighbouring tiles on different threads, and a 16-pixel tile's row of depths (64 bytes)
-// straddles two cache lines wherever the image's row is not a multiple of 16 pixels (920: every
-// other row), so both threads write the same lines at every tile border; their rays also leave each
-// other's volume data in different caches. On the ParaView anchor (920×896, 2 threads) one tile per
-// hand-out cost 0.107 CPU-s per image, 8 tiles 0.092, a row of tiles 0.089, one thread alone 0.085
-// (docs/rendering.md, Round 16). The images do not change: tiles are independent.
+// time put neighbouring tiles on different threads. The rays of neighbouring tiles read overlapping
+// parts of the volume, and each core's cache then sees only every other tile of it. On the ParaView
+// anchor (920×896, 2 threads) one tile per hand-out cost 0.107 CPU-s per image, 8 tiles 0.092, a
+// row of tiles 0.089, and one thread alone 0.085. At 928 pixels wide, where a tile's depths fill whole
+// cache lines, the costs were the same, so it is not false sharing of the output (docs/rendering.md,
+// Round 16). The images do not change: tiles are independent.
 #include <algorithm>
 
 namespace panoptes::render {
