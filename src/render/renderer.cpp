@@ -19,10 +19,11 @@
 #include <bit>
 #include <chrono>
 #include <limits>
-#include <omp.h>
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include <omp.h>
 
 #include "core/error.hpp"
 

@@ -287,6 +287,10 @@ function onScreen(w) {
 /// display frame and, when an input changed the picture and its frame is decoded, at once from the
 /// input's handler: the change then reaches the next display frame instead of waiting a frame for
 /// the next rAF callback to draw it.
+// A frame the database marks damaged: its placeholder, never its decoded pixels.
+function drawDamaged(st, frame) {
+  drawPlaceholder(S.camera, S.task, "damaged", `${st.url}: frame ${frame} fails its frame checks (checksum, movie identity or position)`);
+}
 function render(now) {
   // Until the first frame is on the screen the clock stands at the start frame: fetching the index and
   // decoding the first frame is not time played (the desktop window: Engine::restart_clock()).
@@ -317,7 +321,7 @@ function render(now) {
     const vf = cache.get(key);
     if (st.status === "ok" && st.damaged && st.damaged.has(frame)) {
       status = "damaged";
-      drawPlaceholder(S.camera, S.task, status, `${st.url}: frame ${frame} fails its frame checks (checksum, movie identity or position)`);
+      drawDamaged(st, frame);
       drawn = true;
     } else if (vf) {
       drawFrame(vf);
@@ -343,7 +347,7 @@ function render(now) {
         });
         if (late && late.damaged) {
           status = "damaged";
-          drawPlaceholder(S.camera, S.task, status, `${st.url}: frame ${late.frame} fails its frame checks (checksum, movie identity or position)`);
+          drawDamaged(st, late.frame);
         } else if (late) {
           drawFrame(cache.get(`${S.camera}/${S.task}/${late.frame}`));
         }
