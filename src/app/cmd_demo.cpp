@@ -18,7 +18,7 @@ const char* kDemoConfig = R"TOML(# `panoptes demo`: the paper's demonstration, s
 # (both together first, then p-waves phi_p = div v in orange, s-waves phi_s = |curl v| in green) = 390 movies.
 # Run:  panoptes run examples/demo.toml          (or: mpirun -np 2 panoptes run examples/demo.toml)
 # Full paper setting: examples/paper.toml.
-# Measured: 115 s wall for the whole demo (40 snapshots at 400x390) as scripts/demo runs it (OpenMP waiting passively), 2026-11-27 10:32 UTC on the shared 2-core machine (AMD EPYC) with nothing else running (load 2.0, its own); 221 CPU-seconds (user + system), of which render 79 %, encode 14 %, composite 5 %, simulation 1.5 %.
+# Measured: 129 s wall for the whole demo (48 snapshots at 528x512) with OpenMP waiting passively as scripts/demo runs it, 2026-11-30 04:49 UTC on the shared 2-core machine (AMD EPYC) with nothing else running (load 1.0 at start); 243 CPU-seconds (user + system); of the wall time render 76 %, encode 16 %, composite 7 %, simulation 1 %.
 
 [grid]                 # 25.6 x 51.2 x 16 km, like the paper's domain, at h = 400 m (1/4 of its resolution)
 nx = 64
@@ -65,9 +65,9 @@ duration = 4.0
 dir = "panoptes_demo"
 title = "Seismic waves from a thrust earthquake (panoptes demo)"
 
-[image]                # the paper's 920x896 aspect at 390 pixels high: 2.5-3 pixels per voxel of this grid. 528x512
-width = 400            # showed the same picture (smooth fields, no finer detail) for 1.5x the CPU: 12 of the 48
-height = 390           # snapshots took 115 CPU-s against 77 at 400x390 (2026-11-27, load 15, panoptes run)
+[image]                # the paper's 920x896 aspect at 512 pixels high: 3.5-4 pixels per voxel of this grid
+width = 528            # (issue 45 brought it back from 400x390 once the march had got faster)
+height = 512
 
 [rig]
 spec = "yinyang"       # the paper's 130 cameras: 5 x 13 cells per patch
@@ -79,13 +79,13 @@ up_axis = "z_down"     # z is depth: the sky is -z (poles, latitudes, image up a
 # projection = "equirectangular"
 
 [schedule]
-every_steps = 12       # 40 snapshots
+every_steps = 10       # 48 snapshots
 
 [video]                # intra-only: the player's fastest random access, ~1 MB per open writer (P-frames keep a
 gop = 1                # 3 MB encoder per writer; their size gain is unmeasured: docs/measurements/insitu.md); crf 23: -14 %, 45 dB
 crf = 23
 preset = "superfast"
-playback_fps = 10      # the player shows the 40 snapshots in 4 s (the movies themselves are 30 fps)
+playback_fps = 10      # the player shows the 48 snapshots in 4.8 s (the movies themselves are 30 fps)
 
 [render]               # 1.0 voxel: the largest step whose frames look like 0.5 voxel's. Measured on the demo's
 sample_distance = 1.0  # mid-run frames (6 cameras x 3 tasks, lossless movies) against 0.5, with the windows below
@@ -100,7 +100,7 @@ adaptive = true        # 3-4 px per voxel: interpolate smooth cells of every 4th
 # the default [render] reference = "running" (issue 41): the scale never shrinks, so a colour keeps its
 # value in 1/s along the movie and the waves darken as they spread (the legend shows the window in 1/s).
 # Per snapshot (the former default) camera 0's p-wave movie brightened by +70 % at frame 20 while the
-# field weakened. The references peak near the source at frame 5 (phi_s 6.4e-4 1/s) and the waves fall to
+# field weakened. The references peak near the source at frame 6 (phi_s 6.3e-4 1/s) and the waves fall to
 # about 0.1 of that by the end, so the windows end at 0.15 of the reference: the near-source frames
 # saturate, the rings stay readable to the last frame.
 [[task]]               # first: the paper's two-colour picture is what the player opens on
@@ -151,7 +151,7 @@ const char* kOverheadNote =
     "  (the demo's grid, 64x128x40, is small so that the demo runs in minutes: its simulation is cheap and this\n"
     "  ratio large. At the paper's 256x512x160 grid, panoptes run examples/paper.toml (60 snapshots, 390 movies\n"
     "  of 920x896) took 18-19 min on 2 cores, visualization 3.4x the simulation in wall time: docs/rendering.md, round 14.)\n"
-    "  Why the movies outweigh the raw fields here: movies grow with cameras x pixels (390 pictures of 400x390\n"
+    "  Why the movies outweigh the raw fields here: movies grow with cameras x pixels (390 pictures of 528x512\n"
     "  per snapshot), raw fields with the grid (2 x 0.33 M voxels here). At the paper's size the same 390\n"
     "  movies took 580 MB against 10.1 GB of raw phi_p, phi_s: 5.8 % (measured 2026-11-29, docs/rendering.md);\n"
     "  the larger the simulation, the smaller that share.";
@@ -164,7 +164,7 @@ CommandRegistration reg([](CLI::App& root) {
       "Run the built-in seismic demo with in-situ visualization: a thrust earthquake in a layered crust seen "
       "by the paper's 130 Yin-Yang cameras x 3 tasks (p+s: p-waves orange and s-waves green together, then "
       "each alone) = 390 movies, "
-      "40 snapshots of 400x390 pixels (also under mpirun -np N). Measured: " + measured_time() +
+      "48 snapshots of 528x512 pixels (also under mpirun -np N). Measured: " + measured_time() +
       " Then: panoptes play DIR.");
   sub->add_option("--out", opt->out, "Database directory")->capture_default_str();
   opt->out = "panoptes_demo";

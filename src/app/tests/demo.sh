@@ -24,8 +24,8 @@ example=$(dirname "$0")/../../../examples/demo.toml
 if [ -f "$example" ]; then
   diff -u "$example" demo.toml || { echo "FAIL: examples/demo.toml differs from panoptes demo --print-config"; exit 1; }
 fi
-sed -e 's/^steps = 480 .*/steps = 30/' -e 's/^every_steps = 12 .*/every_steps = 15/' \
-    -e 's/^spec = "yinyang" .*/spec = "yinyang:2x3"/' -e 's/^width = 400/width = 48/' -e 's/^height = 390/height = 40/' \
+sed -e 's/^steps = 480 .*/steps = 30/' -e 's/^every_steps = 10 .*/every_steps = 15/' \
+    -e 's/^spec = "yinyang" .*/spec = "yinyang:2x3"/' -e 's/^width = 528/width = 48/' -e 's/^height = 512/height = 40/' \
     -e 's/^nx = 64/nx = 24/' -e 's/^ny = 128/ny = 48/' -e 's/^nz = 40/nz = 16/' -e 's/^h = 400.0/h = 1066.6667/' \
     -e 's/^pml_cells = 10/pml_cells = 4/' demo.toml > short.toml
 # Every substitution must have applied (the demo configuration changed otherwise).

@@ -11,7 +11,7 @@ trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
 export OMP_NUM_THREADS=2
 "$bin" demo --print-config |
-  sed -e 's/^steps = 480 .*/steps = 240/' -e 's/^every_steps = 12 .*/every_steps = 120/' \
+  sed -e 's/^steps = 480 .*/steps = 240/' -e 's/^every_steps = 10 .*/every_steps = 120/' \
       -e 's/^spec = "yinyang" .*/spec = "yinyang:1x3"/' > mid.toml
 for line in 'steps = 240' 'every_steps = 120' 'spec = "yinyang:1x3"'; do
   grep -q "^$line" mid.toml || { echo "FAIL: the mid-run demo config lacks '$line'"; exit 1; }

@@ -17,7 +17,7 @@ trap 'rm -rf "$tmp"' EXIT
 export OMP_NUM_THREADS=1
 # 40 snapshots of 12 cameras x 3 tasks at 96x92: the demo's rig shape, windows and tasks, in seconds.
 "$bin" demo --print-config |
-  sed -e 's/^steps = 480 .*/steps = 200/' -e 's/^every_steps = 12 .*/every_steps = 5/' \
+  sed -e 's/^steps = 480 .*/steps = 200/' -e 's/^every_steps = 10 .*/every_steps = 5/' \
       -e 's/^spec = "yinyang" .*/spec = "yinyang:2x3"/' -e 's/^width = [0-9]*/width = 96/' -e 's/^height = [0-9]*/height = 92/' \
       > "$tmp/short.toml"
 for line in 'steps = 200' 'every_steps = 5' 'spec = "yinyang:2x3"' 'width = 96' 'height = 92'; do

@@ -142,7 +142,7 @@ def prepare(work, panoptes, repo, env):
     config = subprocess.run([panoptes, "demo", "--print-config"], stdout=subprocess.PIPE, text=True, check=True).stdout
     small = config
     for old, new in [("nx = 64", "nx = 24"), ("ny = 128", "ny = 48"), ("nz = 40", "nz = 16"), ("h = 400.0", "h = 1066.6667"),
-                     ("pml_cells = 10", "pml_cells = 4"), ("width = 400", "width = 48"), ("height = 390", "height = 40"),
+                     ("pml_cells = 10", "pml_cells = 4"), ("width = 528", "width = 48"), ("height = 512", "height = 40"),
                      ('spec = "yinyang"', 'spec = "yinyang:2x4"')]:
         small, n = re.subn("^" + re.escape(old) + r"(?=\s|$)", new, small, flags=re.M)
         if n != 1:
