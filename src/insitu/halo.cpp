@@ -147,7 +147,7 @@ void copy_box(const LocalBlock& block, const FieldInput& in, const Box& x, const
 }  // namespace
 
 void Exchange::load(const std::vector<const FieldInput*>& inputs, const Box& region,
-                    std::vector<std::vector<float>>& out) const {
+                    std::vector<std::vector<float>>& out) {
   const std::vector<BlockInfo>& all = *blocks;
   const BlockInfo& me = all[std::size_t(rank)];
   const std::size_t nf = inputs.size();
@@ -166,35 +166,36 @@ void Exchange::load(const std::vector<const FieldInput*>& inputs, const Box& reg
   // Rank s sends rank r the points it owns in r's required range whenever r does not trust them.
   // Everyone knows every block, so the pattern needs no handshake.
   std::vector<MPI_Request> reqs;
-  std::vector<std::vector<float>> sends;
-  sends.reserve(std::size_t(size));
+  sends_.resize(std::size_t(size));
+  receives_.resize(std::size_t(size));
   for (int r = 0; r < size; ++r) {
     if (!fetches(all, r, rank)) continue;
     const Box x = intersect(me.owned, all[std::size_t(r)].required);
-    std::vector<float> pack(std::size_t(x.size()) * nf);
+    std::vector<float>& pack = sends_[std::size_t(r)];
+    pack.resize(std::size_t(x.size()) * nf);  // every element written below
     for (std::size_t f = 0; f < nf; ++f) copy_box(me.block, *inputs[f], x, x, pack.data() + std::size_t(x.size()) * f);
-    sends.push_back(std::move(pack));
     reqs.emplace_back();
-    MPI_Isend(sends.back().data(), int(sends.back().size()), MPI_FLOAT, r, 7, comm, &reqs.back());
+    MPI_Isend(pack.data(), int(pack.size()), MPI_FLOAT, r, 7, comm, &reqs.back());
   }
-  std::vector<std::pair<Box, std::vector<float>>> incoming;
-  incoming.reserve(std::size_t(size));
   for (int s = 0; s < size; ++s) {
     if (!fetches(all, rank, s)) continue;
     const Box x = intersect(all[std::size_t(s)].owned, me.required);
-    incoming.emplace_back(x, std::vector<float>(std::size_t(x.size()) * nf));
+    std::vector<float>& data = receives_[std::size_t(s)];
+    data.resize(std::size_t(x.size()) * nf);
     reqs.emplace_back();
-    MPI_Irecv(incoming.back().second.data(), int(incoming.back().second.size()), MPI_FLOAT, s, 7, comm, &reqs.back());
+    MPI_Irecv(data.data(), int(data.size()), MPI_FLOAT, s, 7, comm, &reqs.back());
   }
   MPI_Waitall(int(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
   const std::int64_t rx = region.hi[0] - region.lo[0], ry = region.hi[1] - region.lo[1];
-  for (const auto& [x, data] : incoming) {
-    const float* p = data.data();
+  for (int s = 0; s < size; ++s) {
+    if (!fetches(all, rank, s)) continue;
+    const Box x = intersect(all[std::size_t(s)].owned, me.required);
+    const float* p = receives_[std::size_t(s)].data();
+    const std::size_t row = std::size_t(x.hi[0] - x.lo[0]);
     for (std::size_t f = 0; f < nf; ++f)
       for (int k = x.lo[2]; k < x.hi[2]; ++k)
-        for (int j = x.lo[1]; j < x.hi[1]; ++j)
-          for (int i = x.lo[0]; i < x.hi[0]; ++i)
-            out[f][std::size_t((std::int64_t(k - region.lo[2]) * ry + (j - region.lo[1])) * rx + (i - region.lo[0]))] = *p++;
+        for (int j = x.lo[1]; j < x.hi[1]; ++j, p += row)
+          std::copy_n(p, row, &out[f][std::size_t((std::int64_t(k - region.lo[2]) * ry + (j - region.lo[1])) * rx + (x.lo[0] - region.lo[0]))]);
   }
 #endif
 }
