@@ -274,7 +274,7 @@ SessionConfig parse_session_config(const toml::table& root, const std::string& s
     s.render.termination_alpha = float(num(c, *r, "termination_alpha", "render.", s.render.termination_alpha));
     if (!(s.render.termination_alpha > 0.5f && s.render.termination_alpha <= 1.0f))
       c.fail("render.termination_alpha", "expected a value in (0.5, 1]");
-    s.render.adaptive = boolean(c, *r, "adaptive", "render.", false);
+    s.render.adaptive = boolean(c, *r, "adaptive", "render.", s.render.adaptive);
     s.render.equirect_adaptive = boolean(c, *r, "equirect_adaptive", "render.", true);
     // The coarse lattice's spacing: where a voxel covers several pixels (the demo: 3.5-4 px per voxel at
     // 528x512) a wider lattice still samples every voxel's change; refinement halves it where corners differ.
@@ -395,10 +395,10 @@ const char* config_keys_help() {
             [render.field.NAME] reference = "fixed", value = V (a physical reference in the field's
             units); share_scale = "units" (two-field pictures of fields with the same unit on one scale)
             | "none"; skip_empty = true; termination_alpha = 0.998;
-            adaptive = false (image-space adaptive sampling: march every 4th pixel, interpolate where the
+            adaptive = true (image-space adaptive sampling: march every 4th pixel, interpolate where the
             corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere, and stop
             refining where the first split's new points lie within adaptive_linear_tolerance = 2 of
-            the bilinear image of its corners; 0 = off);
+            the bilinear image of its corners, 0 = never; false = march every pixel);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
             apart whose columns widen toward the poles, whatever adaptive says; false = every pixel);
             equirect_tolerance = 10 (360° frames: the largest corner range interpolated, units of 1/255)

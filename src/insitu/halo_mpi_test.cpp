@@ -47,6 +47,8 @@ spec = "fibonacci:4"
 every_steps = 1
 [video]
 crf = 10
+[render]
+adaptive = false  # compared pixel for pixel with direct renders of each task alone (adaptive sampling refines where any task of the march does)
 [[task]]
 name = "hot"
 type = "volume"

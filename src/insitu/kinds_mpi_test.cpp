@@ -57,7 +57,7 @@ std::string task_table(render::TaskKind k) {
 std::string config_text() {
   std::string s = "[output]\ntitle = \"every kind\"\nmode = \"overwrite\"\n[image]\nwidth = 48\nheight = 40\n"
                   "[rig]\nspec = \"fibonacci:6\"\n[schedule]\nevery_steps = 1\n[video]\ncrf = 10\n"
-                  "[render]\niso_antialias = true\n";
+                  "[render]\niso_antialias = true\nadaptive = false\n";  // compared pixel for pixel with direct renders
   for (render::TaskKind k : render::kTaskKinds) {
     const std::string t = task_table(k);
     if (t.empty()) throw Error(std::string("no table for kind ") + render::to_string(k) + " in kinds_mpi_test.cpp");

@@ -51,6 +51,8 @@ spec = "fibonacci:5"
 every_steps = 2
 [video]
 crf = 10
+[render]
+adaptive = false  # compared pixel for pixel with direct renders of each task alone (adaptive sampling refines where any task of the march does)
 [[task]]
 name = "a hot"
 type = "volume"

@@ -101,6 +101,16 @@ TEST(InsituConfig, EquirectToleranceIsItsOwnKey) {
             std::string::npos);
 }
 
+// Issue 45: sessions sample adaptively unless told otherwise (with or without a [render] table), as
+// panoptes render does; anti-aliased isosurfaces likewise.
+TEST(InsituConfig, AdaptiveSamplingIsTheDefault) {
+  const auto bare = insitu::parse_session_config_text(std::string(kTask), "t");
+  EXPECT_TRUE(bare.render.adaptive);
+  EXPECT_TRUE(bare.render.iso_antialias);
+  EXPECT_TRUE(insitu::parse_session_config_text(std::string(kTask) + "[render]\nsample_distance = 1.0\n", "t").render.adaptive);
+  EXPECT_FALSE(insitu::parse_session_config_text(std::string(kTask) + "[render]\nadaptive = false\n", "t").render.adaptive);
+}
+
 // The adaptive lattice's spacing: 4 pixels by default, a power of two up to 32 (cells split at midpoints).
 TEST(InsituConfig, AdaptiveStrideIsAPowerOfTwo) {
   EXPECT_EQ(insitu::parse_session_config_text(std::string(kTask), "t").render.adaptive_stride, 4);
