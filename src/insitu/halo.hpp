@@ -81,8 +81,8 @@ struct Exchange {
 
  private:
   // The messages' buffers, one per peer, kept from one snapshot to the next: fresh ones cost a page fault
-  // per 4 KiB and a zero fill each snapshot (issue 45: ~6 % of Panoptes' CPU in situ when the cameras are
-  // split and every rank gathers the whole grid).
+  // per 4 KiB and a zero fill each snapshot (issue 45, the cameras split so that every rank gathers the
+  // whole grid: memset 0.74 -> 0.53 % and clear_page 0.26 -> 0.15 % of the run's samples, Panoptes ~25 %).
   std::vector<std::vector<float>> sends_, receives_;
 };
 
