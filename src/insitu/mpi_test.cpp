@@ -3,14 +3,21 @@
 //       one field, float data with 2 ghost layers for the other) and checks every finished frame on its
 //       owner rank against the same field rendered directly on the whole grid (max difference ≤ 1/255).
 //   insitu_mpi_test refusals DIR — one rank's bad fields are refused by every rank, without a hang.
+//   insitu_mpi_test waits DIR — a rank arriving late at every step's agreement leaves the waiting ranks'
+//       timer slack as it was (the wait sleeps with a fine slack, rank_agreement.cpp).
 //   insitu_mpi_test compare DIR1 DIR2...  — every database is complete and every frame of every stream
 //       matches the first database's with PSNR ≥ 45 dB (rank independence).
 #include <mpi.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/error.hpp"
@@ -241,6 +248,54 @@ int refusals(const std::string& dir) {
   return all ? 1 : 0;
 }
 
+// The agreement's wait sleeps with a 1 us timer slack and must hand the simulation's thread back its
+// own: rank 1 comes 5 ms late to each step's process(), so rank 0 waits past the spin into the sleeps.
+int waits(const std::string& dir) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const render::GridGeometry g = test_grid();
+  insitu::SessionConfig cfg = insitu::parse_session_config_text(kConfig, "mpi waits");
+  cfg.output_dir = dir;
+  const insitu::LocalBlock block = insitu::LocalBlock::slab(g, 2, size, rank, 2);
+  const std::int64_t nz = block.extent[2] + block.ghost_lo[2] + block.ghost_hi[2];
+  std::vector<float> a(std::size_t(g.dims[0] * g.dims[1] * nz), 0.5f), b(a.size(), 0.25f);
+  const std::int64_t first = block.ghost_lo[2] * g.dims[0] * g.dims[1];
+  const std::vector<insitu::FieldInput> fields{{"a", a.data() + first, insitu::ScalarType::f32, {0, 0, 0}},
+                                               {"b", b.data() + first, insitu::ScalarType::f32, {0, 0, 0}}};
+  int failures = 0;
+#ifdef __linux__
+  const unsigned long mine = 77000;  // ns: not the default, not the wait's own
+  prctl(PR_SET_TIMERSLACK, mine, 0, 0, 0);
+#endif
+  insitu::Session s(cfg, g, block, MPI_COMM_WORLD);
+  double waited = 0;
+  for (int step = 0; step < 6; ++step) {
+    if (rank == 1) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    const auto t0 = std::chrono::steady_clock::now();
+    s.process(step, 0.1 * step, fields);
+    waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+#ifdef __linux__
+    const long now = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
+    if (now != long(mine)) {
+      std::fprintf(stderr, "rank %d: FAIL: timer slack %ld ns after step %d's process(); expected %lu ns (the caller's)\n",
+                   rank, now, step, mine);
+      ++failures;
+    }
+#endif
+  }
+  s.finalize();
+  // Rank 0 did wait (else the test saw no sleep): ~5 ms per step, less the steps' own work.
+  if (rank == 0 && size > 1 && waited < 6 * 0.002) {
+    std::fprintf(stderr, "rank 0: FAIL: waited only %.4f s in 6 process() calls behind a rank 5 ms late\n", waited);
+    ++failures;
+  }
+  int all = failures;
+  MPI_Allreduce(&failures, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  if (rank == 0) std::printf("waits: %s (rank 0 waited %.3f s)\n", all ? "FAILED" : "every rank's timer slack is its own after waiting", waited);
+  return all ? 1 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -250,8 +305,9 @@ int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "";
     if (mode == "write" && (argc == 3 || argc == 4)) rc = write(argv[2], argc == 4 ? argv[3] : "auto");
     else if (mode == "refusals" && argc == 3) rc = refusals(argv[2]);
+    else if (mode == "waits" && argc == 3) rc = waits(argv[2]);
     else if (mode == "compare" && argc >= 4) rc = compare(std::vector<std::string>(argv + 2, argv + argc));
-    else std::fprintf(stderr, "usage: insitu_mpi_test write DIR [auto|cameras|bricks] | compare DIR1 DIR2...\n");
+    else std::fprintf(stderr, "usage: insitu_mpi_test write DIR [auto|cameras|bricks] | refusals DIR | waits DIR | compare DIR1 DIR2...\n");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "insitu_mpi_test: %s\n", e.what());
     rc = 1;

@@ -8,6 +8,10 @@
 #include <utility>
 #include <vector>
 
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
+
 namespace panoptes::insitu {
 
 const char* to_string(Call call) {
@@ -74,27 +78,59 @@ struct RankAgreement::Pending {
 #ifdef PANOPTES_HAVE_MPI
 namespace {
 
-// Waits for `request` at most `timeout_s`: true when it completed. Spins briefly first (ranks in step
-// arrive within microseconds), then sleeps in growing steps so that a rank waiting long costs no core.
+// While a waiting thread sleeps, its sleeps end when asked: Linux lets a sleep overrun by the thread's
+// timer slack (50 us by default), so a 20 us sleep took ~70 us, and the rank that woke late was the
+// late rank at the next step, where the other one waited in turn: the ranks took turns waiting at every
+// step (below). Restored when the wait ends: the slack is the simulation thread's own setting.
+class FineTimerSlack {
+ public:
+  FineTimerSlack() = default;
+  FineTimerSlack(const FineTimerSlack&) = delete;
+  FineTimerSlack& operator=(const FineTimerSlack&) = delete;
+  void engage() {
+#ifdef __linux__
+    if (old_ >= 0) return;
+    old_ = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
+    if (old_ >= 0) prctl(PR_SET_TIMERSLACK, 1000UL, 0, 0, 0);  // 1 us (0 would mean "the default")
+#endif
+  }
+  ~FineTimerSlack() {
+#ifdef __linux__
+    if (old_ > 0) prctl(PR_SET_TIMERSLACK, static_cast<unsigned long>(old_), 0, 0, 0);
+#endif
+  }
+
+ private:
+  long old_ = -1;
+};
+
+// Waits for `request` at most `timeout_s`: true when it completed. Spins first (ranks in step arrive
+// within microseconds; ranks that drift apart, within a step's jitter), then sleeps in growing steps
+// so that a rank waiting long costs no core.
 bool wait_for(MPI_Request& request, double timeout_s) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   int done = 0;
   auto pause = std::chrono::microseconds(0);
+  FineTimerSlack slack;
   for (;;) {
     MPI_Test(&request, &done, MPI_STATUS_IGNORE);
     if (done) return true;
     const double waited = std::chrono::duration<double>(Clock::now() - start).count();
     if (waited > timeout_s) return false;
     // A non-blocking collective advances only inside MPI calls: poll without giving the core away for
-    // the first 20 us (ranks in step arrive within microseconds), then sleep: 20 us at a time for the
-    // first 2 ms, then in growing steps. The agreement runs at every step's process() call, so when
-    // the ranks drift apart (a loaded node: a rank descheduled for a time slice) the early rank waits
-    // at every step; it used to spin for 0.2 ms and yield up to 2 ms, burning a core for the whole
-    // wait — measured in insitu_overhead_bench's setting (2 ranks, 8,000 steps, 2 shared cores): the
-    // session's own CPU 7.0–17.7 s in six runs (median 14.1), 7.2–9.4 s (median 8.7) with sleeps
-    // (docs/rendering.md, Round 13).
-    if (waited < 0.00002) continue;
+    // the first 100 us, then sleep: 20 us at a time (with a fine timer slack) for the first 2 ms, then
+    // in growing steps. The agreement runs at every step's process() call, and ranks that exchange
+    // nothing between snapshots drift apart by a step's jitter, so the early rank waits at every step.
+    // Measured in insitu_overhead_bench's setting (2 ranks, 8,000 steps, 2 shared cores; Panoptes' CPU
+    // by the OS over the code's own, three alternations; docs/rendering.md, Round 18): spinning 20 us
+    // and sleeping with the default slack 0.30-0.35x; spinning 100 us 0.24-0.30x; spinning 100 us and
+    // sleeping with a fine slack 0.25-0.26x (the wall time 11.9 s against 13.2-13.9 s; the code alone
+    // 9.5 s). Round 13 spun 0.2 ms and then yielded up to 2 ms, burning a core for a descheduled
+    // rank's whole time slice (the session's own CPU a median of 14.1 s against 8.7 s with sleeps):
+    // past the short spin it sleeps.
+    if (waited < 0.0001) continue;
+    slack.engage();
     if (waited < 0.002) {
       std::this_thread::sleep_for(std::chrono::microseconds(20));
       continue;
