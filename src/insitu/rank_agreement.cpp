@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <thread>
 #include <utility>
@@ -75,6 +76,10 @@ struct RankAgreement::Pending {
   bool abandoned = false;  ///< a wait timed out: the request is still posted
 };
 
+double wait_spin_seconds(long local_ranks, unsigned cores) {
+  return local_ranks > 0 && cores > 0 && local_ranks > long(cores) ? 20e-6 : 100e-6;
+}
+
 #ifdef PANOPTES_HAVE_MPI
 namespace {
 
@@ -104,6 +109,20 @@ class FineTimerSlack {
   long old_ = -1;
 };
 
+// The spin of wait_for(), chosen once per process from what the MPI launcher says about this node.
+double node_spin_seconds() {
+  static const double spin = [] {
+    long local = 0;
+    for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "PMI_LOCAL_SIZE"})
+      if (const char* v = std::getenv(name)) {
+        local = std::atol(v);
+        break;
+      }
+    return wait_spin_seconds(local, std::thread::hardware_concurrency());
+  }();
+  return spin;
+}
+
 // Waits for `request` at most `timeout_s`: true when it completed. Spins first (ranks in step arrive
 // within microseconds; ranks that drift apart, within a step's jitter), then sleeps in growing steps
 // so that a rank waiting long costs no core.
@@ -113,13 +132,14 @@ bool wait_for(MPI_Request& request, double timeout_s) {
   int done = 0;
   auto pause = std::chrono::microseconds(0);
   FineTimerSlack slack;
+  const double spin = node_spin_seconds();
   for (;;) {
     MPI_Test(&request, &done, MPI_STATUS_IGNORE);
     if (done) return true;
     const double waited = std::chrono::duration<double>(Clock::now() - start).count();
     if (waited > timeout_s) return false;
     // A non-blocking collective advances only inside MPI calls: poll without giving the core away for
-    // the first 100 us, then sleep: 20 us at a time (with a fine timer slack) for the first 2 ms, then
+    // the first 100 us (20 us where ranks outnumber cores: wait_spin_seconds()), then sleep: 20 us at a time (with a fine timer slack) for the first 2 ms, then
     // in growing steps. The agreement runs at every step's process() call, and ranks that exchange
     // nothing between snapshots drift apart by a step's jitter, so the early rank waits at every step.
     // Measured in insitu_overhead_bench's setting (2 ranks, 8,000 steps, 2 shared cores; Panoptes' CPU
@@ -129,7 +149,7 @@ bool wait_for(MPI_Request& request, double timeout_s) {
     // 9.5 s). Round 13 spun 0.2 ms and then yielded up to 2 ms, burning a core for a descheduled
     // rank's whole time slice (the session's own CPU a median of 14.1 s against 8.7 s with sleeps):
     // past the short spin it sleeps.
-    if (waited < 0.0001) continue;
+    if (waited < spin) continue;
     slack.engage();
     if (waited < 0.002) {
       std::this_thread::sleep_for(std::chrono::microseconds(20));

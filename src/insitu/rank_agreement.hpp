@@ -108,6 +108,11 @@ class RankAgreement {
   Pending* pending_ = nullptr;
 };
 
+/// How long a rank waiting for the others polls before it sleeps: 100 us, or 20 us when this node runs
+/// more ranks than it has cores (`local_ranks` as the MPI launcher says, 0 = unknown), where the rank
+/// waited for may need this very core.
+double wait_spin_seconds(long local_ranks, unsigned cores);
+
 /// The message of an exception (for records and reports).
 std::string exception_message(const std::exception_ptr& e);
 
