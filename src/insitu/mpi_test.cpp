@@ -188,27 +188,41 @@ int write(const std::string& dir, const std::string& split) {
 
 int compare(const std::vector<std::string>& dirs) { return insitu_test::compare_databases(dirs, "in situ"); }
 
+// This rank's slab (along z, 2 ghost layers) of the test grid with constant fields a (0.5) and b (0.25),
+// for the tests of the calls rather than the pictures.
+struct ConstantSlab {
+  int rank = 0, size = 1;
+  render::GridGeometry g = test_grid();
+  insitu::SessionConfig cfg;
+  insitu::LocalBlock block;
+  std::vector<float> a, b;
+  std::int64_t first = 0;  // the first owned point
+  ConstantSlab(const std::string& dir, const char* name) {
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    cfg = insitu::parse_session_config_text(kConfig, name);
+    cfg.output_dir = dir;
+    block = insitu::LocalBlock::slab(g, 2, size, rank, 2);
+    const std::int64_t nz = block.extent[2] + block.ghost_lo[2] + block.ghost_hi[2];
+    a.assign(std::size_t(g.dims[0] * g.dims[1] * nz), 0.5f);
+    b.assign(a.size(), 0.25f);
+    first = block.ghost_lo[2] * g.dims[0] * g.dims[1];
+  }
+  insitu::FieldInput field_a() const { return {"a", a.data() + first, insitu::ScalarType::f32, {0, 0, 0}}; }
+  insitu::FieldInput field_b() const { return {"b", b.data() + first, insitu::ScalarType::f32, {0, 0, 0}}; }
+};
+
 // Refusals of one rank's own arguments (issue 42): rank 1 hands a field whose stride of 2^62 floats
 // overflows 64-bit offsets, then omits a field, then gives a NaN time to process() on a due step, then
 // a time that does not increase; every rank must refuse each snapshot (before, the refusing rank left
 // and the others waited for it in the snapshot's collectives: this test timed out), nothing is
 // written, and the same session then takes good snapshots.
 int refusals(const std::string& dir) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  const render::GridGeometry g = test_grid();
-  insitu::SessionConfig cfg = insitu::parse_session_config_text(kConfig, "mpi refusals");
-  cfg.output_dir = dir;
-  const insitu::LocalBlock block = insitu::LocalBlock::slab(g, 2, size, rank, 2);
-  const std::int64_t nx = g.dims[0], ny = g.dims[1];
-  const std::int64_t nz = block.extent[2] + block.ghost_lo[2] + block.ghost_hi[2];
-  std::vector<float> a(std::size_t(nx * ny * nz), 0.5f), b(a.size(), 0.25f);
-  const std::int64_t first = block.ghost_lo[2] * nx * ny;  // the first owned point
-  const insitu::FieldInput good_a{"a", a.data() + first, insitu::ScalarType::f32, {0, 0, 0}};
-  const insitu::FieldInput good_b{"b", b.data() + first, insitu::ScalarType::f32, {0, 0, 0}};
-  const insitu::FieldInput huge_b{"b", b.data() + first, insitu::ScalarType::f32, {1, nx, std::int64_t(1) << 62}};
-  insitu::Session s(cfg, g, block, MPI_COMM_WORLD);
+  const ConstantSlab c(dir, "mpi refusals");
+  const int rank = c.rank, size = c.size;
+  const insitu::FieldInput good_a = c.field_a(), good_b = c.field_b();
+  const insitu::FieldInput huge_b{"b", c.b.data() + c.first, insitu::ScalarType::f32, {1, c.g.dims[0], std::int64_t(1) << 62}};
+  insitu::Session s(c.cfg, c.g, c.block, MPI_COMM_WORLD);
   int failures = 0;
   auto expect_refused = [&](const std::vector<insitu::FieldInput>& fields, const std::string& want, double t,
                             bool process = false) {
@@ -251,24 +265,15 @@ int refusals(const std::string& dir) {
 // The agreement's wait sleeps with a 1 us timer slack and must hand the simulation's thread back its
 // own: rank 1 comes 5 ms late to each step's process(), so rank 0 waits past the spin into the sleeps.
 int waits(const std::string& dir) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  const render::GridGeometry g = test_grid();
-  insitu::SessionConfig cfg = insitu::parse_session_config_text(kConfig, "mpi waits");
-  cfg.output_dir = dir;
-  const insitu::LocalBlock block = insitu::LocalBlock::slab(g, 2, size, rank, 2);
-  const std::int64_t nz = block.extent[2] + block.ghost_lo[2] + block.ghost_hi[2];
-  std::vector<float> a(std::size_t(g.dims[0] * g.dims[1] * nz), 0.5f), b(a.size(), 0.25f);
-  const std::int64_t first = block.ghost_lo[2] * g.dims[0] * g.dims[1];
-  const std::vector<insitu::FieldInput> fields{{"a", a.data() + first, insitu::ScalarType::f32, {0, 0, 0}},
-                                               {"b", b.data() + first, insitu::ScalarType::f32, {0, 0, 0}}};
+  const ConstantSlab c(dir, "mpi waits");
+  const int rank = c.rank, size = c.size;
+  const std::vector<insitu::FieldInput> fields{c.field_a(), c.field_b()};
   int failures = 0;
 #ifdef __linux__
   const unsigned long mine = 77000;  // ns: not the default, not the wait's own
   prctl(PR_SET_TIMERSLACK, mine, 0, 0, 0);
 #endif
-  insitu::Session s(cfg, g, block, MPI_COMM_WORLD);
+  insitu::Session s(c.cfg, c.g, c.block, MPI_COMM_WORLD);
   double waited = 0;
   for (int step = 0; step < 6; ++step) {
     if (rank == 1) std::this_thread::sleep_for(std::chrono::milliseconds(5));
