@@ -1,5 +1,5 @@
 // The agreement's wait: how long a waiting rank polls before it sleeps (rank_agreement.hpp). The wait
-// itself runs under MPI: insitu.mpi_waits (mpi_test.cpp), capi.misuse_*.
+// itself runs under MPI: insitu.mpi_waits_{1,2,4} (mpi_test.cpp), capi.misuse_*.
 #include "insitu/rank_agreement.hpp"
 
 #include <gtest/gtest.h>
