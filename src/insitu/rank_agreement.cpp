@@ -139,8 +139,9 @@ bool wait_for(MPI_Request& request, double timeout_s) {
     const double waited = std::chrono::duration<double>(Clock::now() - start).count();
     if (waited > timeout_s) return false;
     // A non-blocking collective advances only inside MPI calls: poll without giving the core away for
-    // the first 100 us (20 us where ranks outnumber cores: wait_spin_seconds()), then sleep: 20 us at a time (with a fine timer slack) for the first 2 ms, then
-    // in growing steps. The agreement runs at every step's process() call, and ranks that exchange
+    // the first 100 us (20 us where ranks outnumber cores: wait_spin_seconds()), then sleep: 20 us at a
+    // time (with a fine timer slack) for the first 2 ms, then in growing steps. The agreement runs at
+    // every step's process() call, and ranks that exchange
     // nothing between snapshots drift apart by a step's jitter, so the early rank waits at every step.
     // Measured in insitu_overhead_bench's setting (2 ranks, 8,000 steps, 2 shared cores; Panoptes' CPU
     // by the OS over the code's own, three alternations; docs/rendering.md, Round 18): spinning 20 us
