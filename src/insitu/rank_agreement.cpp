@@ -138,18 +138,17 @@ bool wait_for(MPI_Request& request, double timeout_s) {
     if (done) return true;
     const double waited = std::chrono::duration<double>(Clock::now() - start).count();
     if (waited > timeout_s) return false;
-    // A non-blocking collective advances only inside MPI calls: poll without giving the core away for
-    // the first 100 us (20 us where ranks outnumber cores: wait_spin_seconds()), then sleep: 20 us at a
-    // time (with a fine timer slack) for the first 2 ms, then in growing steps. The agreement runs at
-    // every step's process() call, and ranks that exchange
-    // nothing between snapshots drift apart by a step's jitter, so the early rank waits at every step.
-    // Measured in insitu_overhead_bench's setting (2 ranks, 8,000 steps, 2 shared cores; Panoptes' CPU
-    // by the OS over the code's own, three alternations; docs/rendering.md, Round 18): spinning 20 us
-    // and sleeping with the default slack 0.31-0.36x; spinning 100 us 0.22-0.30x; spinning 100 us and
-    // sleeping with a fine slack 0.23-0.27x (the wall time 11.8-12.0 s against 13.2-13.9 s; the code alone
-    // 9.5 s). Round 13 spun 0.2 ms and then yielded up to 2 ms, burning a core for a descheduled
-    // rank's whole time slice (the session's own CPU a median of 14.1 s against 8.7 s with sleeps):
-    // past the short spin it sleeps.
+    // A non-blocking collective advances only inside MPI calls: poll without giving the core away for the
+    // first 100 us (20 us where ranks outnumber cores: wait_spin_seconds()), then sleep: 20 us at a time
+    // (with a fine timer slack) for the first 2 ms, then in growing steps. The agreement runs at every
+    // step's process() call, and ranks that exchange nothing between snapshots drift apart by a step's
+    // jitter, so the early rank waits at every step. Measured in insitu_overhead_bench's setting (2 ranks,
+    // 8,000 steps, 2 shared cores; Panoptes' CPU by the OS over the code's own, three alternations;
+    // docs/rendering.md, Round 18): spinning 20 us and sleeping with the default slack 0.31-0.36x; spinning
+    // 100 us 0.22-0.30x; spinning 100 us and sleeping with a fine slack 0.23-0.27x (the wall time 11.8-12.0
+    // s against 13.2-13.9 s; the code alone 9.5 s). Round 13 spun 0.2 ms and then yielded up to 2 ms,
+    // burning a core for a descheduled rank's whole time slice (the session's own CPU a median of 14.1 s
+    // against 8.7 s with sleeps): past the short spin it sleeps.
     if (waited < spin) continue;
     slack.engage();
     if (waited < 0.002) {
