@@ -11,6 +11,8 @@
 // everywhere, render::dense_wave_scene) with a volume of p, one of s and an isosurface of p, at the
 // options of `panoptes render`; the full march in the same run for the PSNR and the speed-up.
 //   frames_core_s (target >= 2), full_frames_core_s, speedup, psnr_db (target >= 45), marched_pct
+//   iso_ref_psnr_db, iso_ref_speckles (and full_*: the full march's): the isosurface against the
+//                   surface supersampled 4x4 (issue 41's speckle measure on this scene)
 // BM_WalkLatency: switch latency when walking through a 4x4x3 lattice of 1920x960 360° streams (stamped
 // synthetic database, gop 1 as in situ) at 30 fps with prefetch, 120 walks (one every 5th frame) along a
 // pseudo-random route, paused or playing; the window draws the cut-out from the cached frame, so the
@@ -118,6 +120,63 @@ struct DenseInside {
   }
 };
 
+// Issue 41's speckle measure on BM_DenseInside's isosurface (task 2): the surface supersampled 4x4
+// (anti-aliasing off, 0.125-voxel steps, every sub-pixel marched; ~30 CPU-s, once per process),
+// box-filtered to 1920x960 and rounded to 8 bits over black, as IsoEdges.SpecklesAgainstTheSupersampledSurface
+// builds its reference. A speckle: a pixel the reference covers whose colour lies more than 30 levels
+// outside the reference's range over the pixel and its eight neighbours in some channel.
+struct SupersampledIso {
+  Image rgb;                        // the box-filtered reference over black
+  std::vector<std::uint8_t> cover;  // some sub-pixel meets the surface
+  // The camera of BM_DenseInside (eye, look-at point, up) at W x H.
+  SupersampledIso(const DenseInside& sc, const Vec3& eye, const Vec3& at, const Vec3& up, int W, int H) {
+    constexpr int S = 4;
+    const camera::Camera fine(eye, at, up, 60, W * S, H * S, camera::Projection::equirectangular);
+    RenderOptions o;
+    o.equirect_adaptive = false;
+    o.sample_distance = 0.125;
+    const std::vector<TaskSpec> iso{sc.tasks[2]};
+    std::vector<PartialImage> out(1);
+    render_brick(fine, sc.fields, iso, out, o);
+    rgb = Image(W, H, 4);
+    cover.assign(std::size_t(W) * std::size_t(H), 0);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        double sum[3] = {0, 0, 0};
+        bool any = false;
+        for (int j = 0; j < S; ++j)
+          for (int i = 0; i < S; ++i) {
+            const float* p = out[0].rgba_at(S * x + i, S * y + j);
+            for (int c = 0; c < 3; ++c) sum[c] += p[c];
+            any = any || p[3] > 0;
+          }
+        for (int c = 0; c < 3; ++c) rgb.at(x, y)[c] = std::uint8_t(std::clamp(std::lround(255 * sum[c] / (S * S)), 0L, 255L));
+        rgb.at(x, y)[3] = 255;
+        cover[std::size_t(y) * std::size_t(W) + std::size_t(x)] = any;
+      }
+  }
+  int speckles(const Image& img) const {
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        if (!cover[std::size_t(y) * std::size_t(img.width) + std::size_t(x)]) continue;
+        bool off = false;
+        for (int c = 0; c < 3 && !off; ++c) {
+          int lo = 255, hi = 0;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int v = rgb.at(std::clamp(x + dx, 0, img.width - 1), std::clamp(y + dy, 0, img.height - 1))[c];
+              lo = std::min(lo, v), hi = std::max(hi, v);
+            }
+          const int v = img.at(x, y)[c];
+          off = v < lo - 30 || v > hi + 30;
+        }
+        n += off;
+      }
+    return n;
+  }
+};
+
 void BM_DenseInside(benchmark::State& state) {
   static const DenseInside sc;
   const Vec3 c = sc.grid.centre();
@@ -163,6 +222,12 @@ void BM_DenseInside(benchmark::State& state) {
   state.counters["psnr_db"] = std::min(worst, 999.0);  // target >= 45
   state.counters["marched_pct"] = 100.0 * double(st_fast.rays) / double(st_fast.rays + st_fast.interpolated_pixels);
   state.counters["marched_per_ray"] = double(st_fast.marched_samples) / double(std::max<std::uint64_t>(1, st_fast.rays));
+  // The isosurface against the supersampled surface (not timed): the fast frame and the full march.
+  static const SupersampledIso ref(sc, c, c + Vec3{0, 1, 0}, {0, 0, 1}, cam.width(), cam.height());
+  state.counters["iso_ref_psnr_db"] = psnr(images[2], ref.rgb);
+  state.counters["iso_ref_speckles"] = ref.speckles(images[2]);
+  state.counters["full_iso_ref_psnr_db"] = psnr(full_images[2], ref.rgb);
+  state.counters["full_iso_ref_speckles"] = ref.speckles(full_images[2]);
 }
 BENCHMARK(BM_DenseInside)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
