@@ -52,8 +52,8 @@ inline unsigned iso_aa_candidates(const float* v, const float* range, int n, boo
 #ifdef PANOPTES_RENDER_AVX2
   {
     const __m256 isov = _mm256_set1_ps(iso), sign = _mm256_set1_ps(-0.0f);
-    const __m256 a0 = _mm256_sub_ps(_mm256_loadu_ps(v), isov), b0 = _mm256_sub_ps(_mm256_loadu_ps(v + 1), isov),
-                 c0 = _mm256_sub_ps(_mm256_loadu_ps(v + 2), isov);
+    const BlockNeighbours w = block_neighbours(v);
+    const __m256 a0 = _mm256_sub_ps(w.before, isov), b0 = _mm256_sub_ps(w.at, isov), c0 = _mm256_sub_ps(w.after, isov);
     const __m256 aa = _mm256_andnot_ps(sign, a0), ab = _mm256_andnot_ps(sign, b0), ac = _mm256_andnot_ps(sign, c0);
     const __m256 zero = _mm256_setzero_ps();
     const __m256 na = _mm256_cmp_ps(a0, zero, _CMP_LT_OQ), nb = _mm256_cmp_ps(b0, zero, _CMP_LT_OQ),

@@ -58,24 +58,37 @@ void shade_hit_scalar(const FieldAcc& f, const Index3& dims, const Vec3& spacing
   shade_from_gradient(g, dir, colour, false, a);
 }
 
+#ifdef PANOPTES_RENDER_AVX2
+namespace {
+// Coordinate `ax` of the eight points q as float lanes, converted and assembled in registers. Written as
+// eight floats and read back as one 32-byte load, the load could not be forwarded from the eight
+// stores and waited for all of them to reach the cache, three times per gather evaluation (Round 19).
+// The conversion rounds as float(q[l][ax]) does, so the lanes hold the same bits.
+inline __m256 axis_lanes(const double (*q)[3], int ax) {
+  const __m128 lo = _mm256_cvtpd_ps(_mm256_setr_pd(q[0][ax], q[1][ax], q[2][ax], q[3][ax]));
+  const __m128 hi = _mm256_cvtpd_ps(_mm256_setr_pd(q[4][ax], q[5][ax], q[6][ax], q[7][ax]));
+  return _mm256_set_m128(hi, lo);
+}
+}  // namespace
+#endif
+
 // The renderer's gradient: the six interpolations of the central differences (float positions, clamps
 // and lerps of interp_clamped(), so the same values) as lanes of one 8-lane gather evaluation.
 void field_gradient(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double p[3], double g[3],
                     float* samples) {
-  double q[6][3], h[3];
+  double q[8][3], h[3];
   gradient_points(p, dims, spacing, q, h);
 #ifdef PANOPTES_RENDER_AVX2
   if (f.gather32) {
-    alignas(32) float x[8], y[8], z[8], v[8];
-    for (int l = 0; l < 6; ++l) x[l] = float(q[l][0]), y[l] = float(q[l][1]), z[l] = float(q[l][2]);
+    alignas(32) float v[8];
     // Lane 6: the field at p itself (the footprint filter's cheap look, cheap_bends()); lane 7 unused.
-    x[6] = x[7] = float(p[0]), y[6] = y[7] = float(p[1]), z[6] = z[7] = float(p[2]);
+    for (int c = 0; c < 3; ++c) q[6][c] = q[7][c] = p[c];
     // interp_clamped(): positions clamped into the data (std::clamp = max then min for numbers),
     // then the cell index clamped to [ilo, ihi].
-    auto pos = [&](const float* c, int ax) {
-      return _mm256_min_ps(_mm256_max_ps(_mm256_load_ps(c), _mm256_set1_ps(f.plo[ax])), _mm256_set1_ps(f.phi[ax]));
+    auto pos = [&](int ax) {
+      return _mm256_min_ps(_mm256_max_ps(axis_lanes(q, ax), _mm256_set1_ps(f.plo[ax])), _mm256_set1_ps(f.phi[ax]));
     };
-    const __m256 px = pos(x, 0), py = pos(y, 1), pz = pos(z, 2);
+    const __m256 px = pos(0), py = pos(1), pz = pos(2);
     _mm256_store_ps(v, trilinear8(f, px, py, pz));
     if (samples) std::copy_n(v, 8, samples);
     for (int ax = 0; ax < 3; ++ax) g[ax] = h[ax] > 0 ? (double(v[2 * ax + 1]) - double(v[2 * ax])) / h[ax] : 0.0;
@@ -128,12 +141,11 @@ inline double dot3(const double* a, const Vec3& b) { return a[0] * b[0] + a[1] *
 void field_values8(const FieldAcc& f, const double (*q)[3], float v[8]) {
 #ifdef PANOPTES_RENDER_AVX2
   if (f.gather32) {
-    alignas(32) float x[8], y[8], z[8], out[8];
-    for (int l = 0; l < 8; ++l) x[l] = float(q[l][0]), y[l] = float(q[l][1]), z[l] = float(q[l][2]);
-    auto pos = [&](const float* c, int ax) {
-      return _mm256_min_ps(_mm256_max_ps(_mm256_load_ps(c), _mm256_set1_ps(f.plo[ax])), _mm256_set1_ps(f.phi[ax]));
+    alignas(32) float out[8];
+    auto pos = [&](int ax) {
+      return _mm256_min_ps(_mm256_max_ps(axis_lanes(q, ax), _mm256_set1_ps(f.plo[ax])), _mm256_set1_ps(f.phi[ax]));
     };
-    _mm256_store_ps(out, trilinear8(f, pos(x, 0), pos(y, 1), pos(z, 2)));
+    _mm256_store_ps(out, trilinear8(f, pos(0), pos(1), pos(2)));
     std::copy_n(out, 8, v);
     return;
   }

@@ -474,8 +474,9 @@ class RayMarch {
 #ifdef PANOPTES_RENDER_AVX2
           {
             const __m256 iso = _mm256_set1_ps(T.iso), zero = _mm256_setzero_ps();
-            const __m256 sp = _mm256_cmp_ps(_mm256_sub_ps(_mm256_loadu_ps(v), iso), zero, _CMP_LT_OQ);
-            const __m256 sn = _mm256_cmp_ps(_mm256_sub_ps(_mm256_loadu_ps(v + 1), iso), zero, _CMP_LT_OQ);
+            const BlockNeighbours w = block_neighbours(v);
+            const __m256 sp = _mm256_cmp_ps(_mm256_sub_ps(w.before, iso), zero, _CMP_LT_OQ);
+            const __m256 sn = _mm256_cmp_ps(_mm256_sub_ps(w.at, iso), zero, _CMP_LT_OQ);
             cross = unsigned(_mm256_movemask_ps(_mm256_xor_ps(sp, sn)));
           }
 #else

@@ -61,6 +61,25 @@ inline __m256 trilinear8(const FieldAcc& f, __m256 x, __m256 y, __m256 z, __m256
 }
 #endif
 
+#ifdef PANOPTES_RENDER_AVX2
+// A block's values v[1 … 8] (one 32-byte store, interp_block()) and the sample before it, v[0] (a scalar
+// store), as the lanes of samples l − 1, l and l + 1: `at` = v[1 … 8], `before` = v[0 … 7], `after` =
+// v[2 … 8] and, in lane 7, v[8] again (callers do not use that lane: its successor lies past the
+// block). Built from one load of `at`: loads at v and v + 2 would each span two stores in flight, which
+// the store buffer cannot forward, and wait until both reach the cache (Round 19). Same values, so
+// the same bits.
+struct BlockNeighbours {
+  __m256 before, at, after;
+};
+inline BlockNeighbours block_neighbours(const float* v) {
+  const __m256 at = _mm256_loadu_ps(v + 1);
+  const __m256 before =
+      _mm256_blend_ps(_mm256_permutevar8x32_ps(at, _mm256_setr_epi32(0, 0, 1, 2, 3, 4, 5, 6)), _mm256_set1_ps(v[0]), 0x01);
+  const __m256 after = _mm256_permutevar8x32_ps(at, _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 7));
+  return {before, at, after};
+}
+#endif
+
 // Sample positions are computed from the sample index alone, p_k = base + k·step in float (one
 // multiply-add, no loop-carried chain): every path, run and brick evaluates sample k at the same
 // bits, whatever the macro-cell walk did before it.

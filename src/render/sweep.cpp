@@ -406,8 +406,13 @@ std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const Is
       }
 #ifdef PANOPTES_RENDER_AVX2
       if (f.gather32) {
+        // The lanes read element by element (a gather): each element forwards from its own scalar
+        // store above, where one 32-byte load of the eight would wait for all of them to reach the
+        // cache (Round 19). Same values, same bits.
+        const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
         auto pos = [&](const float* c, int ax) {
-          return _mm256_min_ps(_mm256_max_ps(_mm256_load_ps(c), _mm256_set1_ps(f.plo[ax])), _mm256_set1_ps(f.phi[ax]));
+          return _mm256_min_ps(_mm256_max_ps(_mm256_i32gather_ps(c, lane, 4), _mm256_set1_ps(f.plo[ax])),
+                               _mm256_set1_ps(f.phi[ax]));
         };
         _mm256_store_ps(vh, march::trilinear8(f, pos(x, 0), pos(y, 1), pos(z, 2)));
       } else
