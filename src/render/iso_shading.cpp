@@ -1,6 +1,7 @@
 #include "render/iso_shading.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "render/sample_blocks.hpp"
@@ -153,19 +154,6 @@ void field_values8(const FieldAcc& f, const double (*q)[3], float v[8]) {
   for (int l = 0; l < 8; ++l) v[l] = interp_clamped(f, q[l][0], q[l][1], q[l][2]);
 }
 
-// field_gradient() (the same positions and differences) and the field itself at index-space position
-// q, as one gather evaluation.
-void gradient_and_value(const FieldAcc& f, const Index3& dims, const Vec3& spacing, const double q[3], double G[3],
-                        double& value) {
-  double pts[8][3], h[3];
-  gradient_points(q, dims, spacing, pts, h);
-  for (int c = 0; c < 3; ++c) pts[6][c] = pts[7][c] = q[c];
-  float v[8];
-  field_values8(f, pts, v);
-  for (int a = 0; a < 3; ++a) G[a] = h[a] > 0 ? (double(v[2 * a + 1]) - double(v[2 * a])) / h[a] : 0.0;
-  value = v[6];
-}
-
 // The surface's frame at a hit: unit normal n, t1 = d on the tangent plane (the direction the
 // footprint stretches in, 1 / |n·d|; any tangent head-on), t2 = n × t1 (across the ray: d lies in
 // span(n, t1)).
@@ -298,58 +286,99 @@ struct Patch {
     }
     return std::abs(mean - centre) > kBends || std::abs(beside - centre) > kBends;
   }
-  // One sub-ray at image offset (α, β) that meets the patch at (x, y): one Newton step on the field
-  // along p + α·e1 + β·t2 + λ·d (e1 = s1·n − n·d·t1, the image of t1; s1 = t1·d) from the patch's
-  // meeting point, the gradient at the point it lands on; the patch's gradient where a point would
-  // lie beyond `reach` of p on some axis or the sub-ray runs along the surface.
-  void sub_ray_gradient(double alpha, double beta, double x, double y, double m[3]) const {
-    const double s1 = dot3(H.t1, dir);
-    double o[3];
-    for (int c = 0; c < 3; ++c) o[c] = alpha * (s1 * H.n[c] - H.nd * H.t1[c]) + beta * H.t2[c];
-    double lam = x * s1, fv = 0;
-    for (int it = 0; it < 2; ++it) {
-      double q[3], far = 0;
-      for (int c = 0; c < 3; ++c) {
-        const double off = (o[c] + lam * dir[c]) / spacing[c];
-        far = std::max(far, std::abs(off));
-        q[c] = p[c] + off;
-      }
-      if (far > reach_index) break;
-      double Gq[3];
-      gradient_and_value(f, dims, spacing, q, Gq, fv);
-      if (it == 1) {
-        std::copy_n(Gq, 3, m);
-        return;
-      }
-      const double gd = dot3(Gq, dir);
-      if (!(std::abs(gd) > 1e-3 * gn)) break;
-      lam -= (fv - iso) / gd;
-    }
-    model_gradient(x, y, m);
-  }
   // The box filter over the footprint: 4 × 4 sub-rays, the reference's pattern, the centre ray at
   // image offset (alpha0, 0). `hits_only`: the mean of the sub-rays that meet the surface (a near
-  // miss, whose coverage is counted apart); false when none does.
+  // miss, whose coverage is counted apart); false when none does. A sub-ray that meets the patch at
+  // (x, y) is moved onto the surface by one Newton step on the field along p + α·e1 + β·t2 + λ·d
+  // (e1 = s1·n − n·d·t1, the image of t1; s1 = t1·d) from the patch's meeting point and shaded with
+  // the gradient where it lands; the patch's gradient stands in where a point would lie beyond
+  // `reach` of p on some axis or the sub-ray runs along the surface. The sub-rays' interpolations
+  // are packed eight to a gather evaluation (7 per sub-ray for the step, 6 for the gradient: 26
+  // evaluations for 16 sub-rays instead of 32 half-empty ones, Round 20), each lane as before.
   bool filter(double span, float* a, double alpha0 = 0, bool hits_only = false) const {
-    float sum[3] = {0, 0, 0};
-    double wsum = 0;
+    const double s1 = dot3(H.t1, dir);
+    double m[16][3], w[16], lam[16], o[16][3], q[16][3];
+    int idx[16], n = 0, steps = 0;  // idx: the sub-ray (of n) of each Newton step
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j) {
         const double alpha = alpha0 + span * ((i + 0.5) / 4 - 0.5), beta = span * ((j + 0.5) / 4 - 0.5);
-        double x, y, m[3];
+        double x, y;
         const bool hit = meet(alpha, beta, x, y);
         if (!hit && hits_only) continue;
-        const double w = hit ? 1.0 : kBeyondRim;
-        if (hit) sub_ray_gradient(alpha, beta, x, y, m);
-        else model_gradient(x, y, m);
-        float rgb[4];
-        shade_from_gradient(m, dir, colour, true, rgb);
-        for (int c = 0; c < 3; ++c) sum[c] += float(w) * rgb[c];
-        wsum += w;
+        w[n] = hit ? 1.0 : kBeyondRim;
+        model_gradient(x, y, m[n]);
+        if (hit) {
+          for (int c = 0; c < 3; ++c) o[steps][c] = alpha * (s1 * H.n[c] - H.nd * H.t1[c]) + beta * H.t2[c];
+          lam[steps] = x * s1;
+          if (place(o[steps], lam[steps], q[steps])) idx[steps++] = n;
+        }
+        ++n;
       }
-    if (!(wsum > 0)) return false;
+    if (n == 0) return false;
+    // The Newton step: the field and its gradient at each meeting point.
+    int landed = 0;
+    {
+      double pts[16 * 7][3], h[16][3];
+      float v[16 * 7];
+      for (int k = 0; k < steps; ++k) {
+        gradient_points(q[k], dims, spacing, pts + 7 * k, h[k]);
+        std::copy_n(q[k], 3, pts[7 * k + 6]);
+      }
+      values(pts, 7 * steps, v);
+      for (int k = 0; k < steps; ++k) {
+        const double gd = dot3(central_difference(v + 7 * k, h[k]).data(), dir);
+        if (!(std::abs(gd) > 1e-3 * gn)) continue;
+        if (place(o[k], lam[k] - (double(v[7 * k + 6]) - iso) / gd, q[landed])) idx[landed++] = idx[k];
+      }
+    }
+    // The gradient where each step lands.
+    {
+      double pts[16 * 6][3], h[16][3];
+      float v[16 * 6];
+      for (int k = 0; k < landed; ++k) gradient_points(q[k], dims, spacing, pts + 6 * k, h[k]);
+      values(pts, 6 * landed, v);
+      for (int k = 0; k < landed; ++k) std::ranges::copy(central_difference(v + 6 * k, h[k]), m[idx[k]]);
+    }
+    float sum[3] = {0, 0, 0};
+    double wsum = 0;
+    for (int k = 0; k < n; ++k) {
+      float rgb[4];
+      shade_from_gradient(m[k], dir, colour, true, rgb);
+      for (int c = 0; c < 3; ++c) sum[c] += float(w[k]) * rgb[c];
+      wsum += w[k];
+    }
     for (int c = 0; c < 3; ++c) a[c] = sum[c] / float(wsum);
     return true;
+  }
+  // The index-space point p + o + λ·d; false where it lies beyond `reach` of p on some axis.
+  bool place(const double o[3], double l, double q[3]) const {
+    double far = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double off = (o[c] + l * dir[c]) / spacing[c];
+      far = std::max(far, std::abs(off));
+      q[c] = p[c] + off;
+    }
+    return !(far > reach_index);
+  }
+  // The gradient from the six values at gradient_points() (h: their distances).
+  static std::array<double, 3> central_difference(const float* v, const double h[3]) {
+    std::array<double, 3> g;
+    for (int a = 0; a < 3; ++a) g[a] = h[a] > 0 ? (double(v[2 * a + 1]) - double(v[2 * a])) / h[a] : 0.0;
+    return g;
+  }
+  // The field at `count` index-space points, eight per gather evaluation (the last one padded).
+  void values(const double (*pts)[3], int count, float* v) const {
+    for (int b = 0; b < count; b += 8) {
+      if (count - b >= 8) {
+        field_values8(f, pts + b, v + b);
+        continue;
+      }
+      double tail[8][3];
+      float tv[8];
+      for (int l = 0; l < 8; ++l) std::copy_n(pts[std::min(b + l, count - 1)], 3, tail[l]);
+      field_values8(f, tail, tv);
+      std::copy_n(tv, count - b, v + b);
+    }
   }
 };
 
