@@ -316,8 +316,15 @@ class AdaptiveTile {
       const PartialImage& o = out_[i];
       corners[i] = {o.rgba_at(x0, y0), o.rgba_at(x1, y0), o.rgba_at(x0, y1), o.rgba_at(x1, y1)};
     }
+    // Per row, each image's pixel (x0, y) and depth there, so a pixel costs an offset, not an index.
+    std::array<float*, 64> row, drow;
     for (int y = y0; y <= y1; ++y) {
       const float v = float(y - y0) * sy;
+      for (std::uint64_t m = mask; m; m &= m - 1) {
+        const std::size_t i = std::size_t(std::countr_zero(m));
+        row[i] = out_[i].rgba_at(x0, y);
+      }
+      for (std::size_t i = 0; i < out_.size(); ++i) drow[i] = &out_[i].depth[out_[i].index(x0, y)];
       for (int x = x0; x <= x1; ++x) {
         const std::size_t p = at(x, y);
         const std::uint64_t pending = mask & ~marched_for_[p];
@@ -328,14 +335,18 @@ class AdaptiveTile {
           continue;
         }
         filled_[p] = 1;
+        const std::size_t dx = std::size_t(x - x0);
         if (hit) {
           const float u = float(x - x0) * sx;
           const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
           for (std::uint64_t m = pending; m; m &= m - 1) {
             const std::size_t i = std::size_t(std::countr_zero(m));
             const auto& [a, b, c, e] = corners[i];
-            float* q = out_[i].rgba_at(x, y);
-            for (int k = 0; k < 4; ++k) q[k] = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k];
+            // Into a local first: the corners may be this image's pixels, so the compiler could not
+            // take the four channels at once.
+            float t[4];
+            for (int k = 0; k < 4; ++k) t[k] = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k];
+            std::copy_n(t, 4, row[i] + 4 * dx);
             if (PartialImage& o = out_[i]; o.slivers) {  // the corners' end state agrees (rough())
               const float *oa = &o.rgba_open[4 * o.index(x0, y0)], *ob = &o.rgba_open[4 * o.index(x1, y0)],
                           *oc = &o.rgba_open[4 * o.index(x0, y1)], *od = &o.rgba_open[4 * o.index(x1, y1)];
@@ -346,9 +357,9 @@ class AdaptiveTile {
           }
         } else {
           for (std::uint64_t m = pending; m; m &= m - 1) {
-            PartialImage& o = out_[std::size_t(std::countr_zero(m))];
-            float* q = o.rgba_at(x, y);
-            q[0] = q[1] = q[2] = q[3] = 0.0f;
+            const std::size_t i = std::size_t(std::countr_zero(m));
+            PartialImage& o = out_[i];
+            std::fill_n(row[i] + 4 * dx, 4, 0.0f);
             if (o.slivers) {
               std::fill_n(&o.rgba_open[4 * o.index(x, y)], 4, 0.0f);
               o.sliver_end[o.index(x, y)] = SliverEnd::pass;
@@ -356,11 +367,11 @@ class AdaptiveTile {
           }
         }
         for (std::size_t i = 0; i < out_.size(); ++i) {  // the same exact depth for every image but keyed ones
-          PartialImage& o = out_[i];
-          float& dst = o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)];
+          float& dst = drow[i][dx];
           if (!(keyed_ >> i & 1)) {
             dst = d;
           } else if (pending >> i & 1) {
+            const PartialImage& o = out_[i];
             dst = !hit ? PartialImage::kNoDepth
                        : std::min(std::min(depth(o, x0, y0), depth(o, x1, y0)), std::min(depth(o, x0, y1), depth(o, x1, y1)));
           }
