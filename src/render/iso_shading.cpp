@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "render/sample_blocks.hpp"
 
@@ -138,6 +139,82 @@ constexpr double kNearMissRim = 0.3;
 inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 inline double dot3(const double* a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+// The test of Patch::bends() and cheap_bends(): whether the shading can change non-linearly across a
+// footprint 2h wide. The model's gradient g + x·D1 + y·D2 at the footprint's four corners (image
+// offsets (±h, ±h): y = β, x where α = −(n·d·x + ½ k·x² + k2·x·y), both within ±xmax) and the four
+// gradients `beside` the hit, each set's mean shading against the centre's (n·d); a corner beyond the
+// rim bends too. `c`: the colour's largest channel (it changes most). The four corners are the four
+// lanes of one vector: a hit pays its divisions and square roots once, not four times (Round 20).
+struct CornerTest {
+  double nd, k, k2, xmax;
+  const double *g, *D1, *D2;
+  const double (*beside)[3];
+};
+
+inline double shade_channel(double c, double ndl) {  // one channel of shade_from_gradient()
+  double p32 = ndl;
+  for (int i = 0; i < 5; ++i) p32 *= p32;
+  return std::min(1.0, c * (0.15 + 0.85 * ndl) + 0.25 * p32);
+}
+
+bool corners_bend(const CornerTest& T, const Vec3& dir, double c, double h) {
+  const double centre = shade_channel(c, std::abs(T.nd));
+#ifdef PANOPTES_RENDER_AVX2
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), sign = _mm256_set1_pd(-0.0);
+  const __m256d alpha = _mm256_setr_pd(-h, h, -h, h);
+  const __m256d xmax = _mm256_set1_pd(T.xmax), nxmax = _mm256_set1_pd(-T.xmax);
+  const __m256d y = _mm256_min_pd(_mm256_max_pd(_mm256_setr_pd(-h, -h, h, h), nxmax), xmax);
+  const __m256d nd1 = _mm256_add_pd(_mm256_set1_pd(T.nd), _mm256_mul_pd(_mm256_set1_pd(T.k2), y));
+  const __m256d disc = _mm256_sub_pd(_mm256_mul_pd(nd1, nd1), _mm256_mul_pd(_mm256_set1_pd(2 * T.k), alpha));
+  if (_mm256_movemask_pd(_mm256_cmp_pd(disc, zero, _CMP_NGE_UQ))) return true;  // a corner beyond the rim
+  const __m256d den = _mm256_add_pd(nd1, _mm256_or_pd(_mm256_sqrt_pd(disc), _mm256_and_pd(nd1, sign)));
+  __m256d x = _mm256_blendv_pd(zero, _mm256_div_pd(_mm256_mul_pd(_mm256_set1_pd(-2.0), alpha), den),
+                               _mm256_cmp_pd(den, zero, _CMP_NEQ_OQ));
+  x = _mm256_min_pd(_mm256_max_pd(x, nxmax), xmax);
+  const __m256d dx = _mm256_set1_pd(dir[0]), dy = _mm256_set1_pd(dir[1]), dz = _mm256_set1_pd(dir[2]);
+  const __m256d cc = _mm256_set1_pd(c);
+  // The shading of |m·d| / |m| per lane (1 where m = 0), summed over the lanes.
+  const auto mean_shade = [&](__m256d m0, __m256d m1, __m256d m2) {
+    const __m256d mm = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m0, m0), _mm256_mul_pd(m1, m1)), _mm256_mul_pd(m2, m2));
+    const __m256d md = _mm256_andnot_pd(sign, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m0, dx), _mm256_mul_pd(m1, dy)),
+                                                            _mm256_mul_pd(m2, dz)));
+    const __m256d cs = _mm256_blendv_pd(one, _mm256_min_pd(one, _mm256_div_pd(md, _mm256_sqrt_pd(mm))),
+                                        _mm256_cmp_pd(mm, zero, _CMP_GT_OQ));
+    __m256d p32 = cs;
+    for (int i = 0; i < 5; ++i) p32 = _mm256_mul_pd(p32, p32);
+    const __m256d sh = _mm256_min_pd(one, _mm256_add_pd(_mm256_mul_pd(cc, _mm256_add_pd(_mm256_set1_pd(0.15), _mm256_mul_pd(_mm256_set1_pd(0.85), cs))),
+                                                         _mm256_mul_pd(_mm256_set1_pd(0.25), p32)));
+    alignas(32) double l[4];
+    _mm256_store_pd(l, sh);
+    return 0.25 * (l[0] + l[1] + l[2] + l[3]);
+  };
+  const auto model = [&](int a) {
+    return _mm256_add_pd(_mm256_set1_pd(T.g[a]), _mm256_add_pd(_mm256_mul_pd(x, _mm256_set1_pd(T.D1[a])),
+                                                               _mm256_mul_pd(y, _mm256_set1_pd(T.D2[a]))));
+  };
+  const auto beside = [&](int a) { return _mm256_setr_pd(T.beside[0][a], T.beside[1][a], T.beside[2][a], T.beside[3][a]); };
+  const double mean = mean_shade(model(0), model(1), model(2)), near = mean_shade(beside(0), beside(1), beside(2));
+#else
+  const auto abs_cos = [&](const double* m) {
+    const double mm = dot3(m, m);
+    return mm > 0 ? std::min(1.0, std::abs(dot3(m, dir)) / std::sqrt(mm)) : 1.0;
+  };
+  double mean = 0, near = 0;
+  for (int i = 0; i < 4; ++i) {
+    const double alpha = i & 1 ? h : -h, y = std::clamp(i & 2 ? h : -h, -T.xmax, T.xmax);
+    const double nd1 = T.nd + T.k2 * y, disc = nd1 * nd1 - 2 * T.k * alpha;
+    if (!(disc >= 0)) return true;
+    const double den = nd1 + std::copysign(std::sqrt(disc), nd1);
+    const double x = std::clamp(den != 0 ? -2 * alpha / den : 0.0, -T.xmax, T.xmax);
+    double m[3];
+    for (int a = 0; a < 3; ++a) m[a] = T.g[a] + x * T.D1[a] + y * T.D2[a];
+    mean += 0.25 * shade_channel(c, abs_cos(m));
+    near += 0.25 * shade_channel(c, abs_cos(T.beside[i]));
+  }
+#endif
+  return std::abs(mean - centre) > kBends || std::abs(near - centre) > kBends;
+}
+
 // The field at eight index-space positions (interp_clamped()'s values) as one gather evaluation.
 void field_values8(const FieldAcc& f, const double (*q)[3], float v[8]) {
 #ifdef PANOPTES_RENDER_AVX2
@@ -259,32 +336,13 @@ struct Patch {
   void model_gradient(double x, double y, double m[3]) const {
     for (int c = 0; c < 3; ++c) m[c] = g0[c] + x * D1[c] + y * D2[c];
   }
-  static double shade1(double c, double ndl) {  // one channel's shading (shade_from_gradient())
-    double p32 = ndl;
-    for (int i = 0; i < 5; ++i) p32 *= p32;
-    return std::min(1.0, c * (0.15 + 0.85 * ndl) + 0.25 * p32);
-  }
-  static double abs_cos(const double* m, const Vec3& d) {
-    const double mm = dot3(m, m);
-    return mm > 0 ? std::min(1.0, std::abs(dot3(m, d)) / std::sqrt(mm)) : 1.0;
-  }
   // Whether the shading can change non-linearly across a footprint `span` wide (a box filter of a
   // linear change is the centre's value, so only a bend matters: a highlight narrower than the pixel,
   // a rim, a crease): the model's four footprint corners against the centre, or a corner beyond the
   // rim, or the four gradients read beside the hit against it (a crease bends them unlike the model).
   bool bends(double span) const {
-    const double h = 0.5 * span;
-    const double c = std::max({colour[0], colour[1], colour[2]});  // the channel that changes most
-    const double centre = shade1(c, std::abs(H.nd));
-    double mean = 0, beside = 0;
-    for (int i = 0; i < 4; ++i) {
-      double x, y, m[3];
-      if (!meet(i & 1 ? h : -h, i & 2 ? h : -h, x, y)) return true;
-      model_gradient(x, y, m);
-      mean += 0.25 * shade1(c, abs_cos(m, dir));
-      beside += 0.25 * shade1(c, abs_cos(G[i], dir));
-    }
-    return std::abs(mean - centre) > kBends || std::abs(beside - centre) > kBends;
+    const CornerTest T{H.nd, k, k2, xmax, g0, D1, D2, G};
+    return corners_bend(T, dir, std::max({colour[0], colour[1], colour[2]}), 0.5 * span);
   }
   // The box filter over the footprint: 4 × 4 sub-rays, the reference's pattern, the centre ray at
   // image offset (alpha0, 0). `hits_only`: the mean of the sub-rays that meet the surface (a near
@@ -466,31 +524,8 @@ bool cheap_bends(const FieldAcc& f, const Index3& dims, const Vec3& spacing, con
     G[2][c] = g[c] + r2 * D2[c], G[3][c] = g[c] - r2 * D2[c];
   }
   const double k = (dot3(D1, dir) - dot3(H.n, D1) * H.nd) / gn, k2 = (dot3(D2, dir) - dot3(H.n, D2) * H.nd) / gn;
-  const double h = 0.5 * span;
-  const double cc = std::max({colour[0], colour[1], colour[2]});
-  const auto shade1 = [&](double ndl) {
-    double p32 = ndl;
-    for (int i = 0; i < 5; ++i) p32 *= p32;
-    return std::min(1.0, cc * (0.15 + 0.85 * ndl) + 0.25 * p32);
-  };
-  const auto abs_cos = [&](const double* mm) {
-    const double q2 = dot3(mm, mm);
-    return q2 > 0 ? std::min(1.0, std::abs(dot3(mm, dir)) / std::sqrt(q2)) : 1.0;
-  };
-  const double centre = shade1(std::abs(H.nd));
-  double mean = 0, beside = 0;
-  for (int i = 0; i < 4; ++i) {
-    const double al = i & 1 ? h : -h, be = i & 2 ? h : -h;
-    const double nd1 = H.nd + k2 * be, disc = nd1 * nd1 - 2 * k * al;
-    if (disc < 0) return true;
-    const double den = nd1 + std::copysign(std::sqrt(disc), nd1);
-    const double x = den != 0 ? -2 * al / den : 0.0;
-    double mm[3];
-    for (int c = 0; c < 3; ++c) mm[c] = g[c] + x * D1[c] + be * D2[c];
-    mean += 0.25 * shade1(abs_cos(mm));
-    beside += 0.25 * shade1(abs_cos(G[i]));
-  }
-  return std::abs(mean - centre) > kBends || std::abs(beside - centre) > kBends;
+  const CornerTest T{H.nd, k, k2, std::numeric_limits<double>::infinity(), g, D1, D2, G};
+  return corners_bend(T, dir, std::max({colour[0], colour[1], colour[2]}), 0.5 * span);
 }
 
 }  // namespace
