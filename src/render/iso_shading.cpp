@@ -272,7 +272,7 @@ struct Patch {
   const HitFrame& H;
   const Vec3& dir;
   const float* colour;
-  double iso, gn, reach_index;
+  double iso, gn, reach_index, inv_spacing[3];
   double g0[3], D1[3], D2[3], G[4][3];
   double k = 0, k2 = 0, xmax = 0;
   Patch(const FieldAcc& f_, const Index3& dims_, const Vec3& spacing_, const double p_[3], const Vec3& d,
@@ -280,6 +280,7 @@ struct Patch {
       : f(f_), dims(dims_), spacing(spacing_), p(p_), H(frame), dir(d), colour(col), iso(iso_), gn(gnorm) {
     const double hmin = std::min({spacing[0], spacing[1], spacing[2]});
     reach_index = reach / hmin;
+    for (int c = 0; c < 3; ++c) inv_spacing[c] = 1.0 / spacing[c];
     const auto radius = [&](const double* t) {  // within `reach` on every axis
       double r = kRadiusCap * reach;
       for (int c = 0; c < 3; ++c)
@@ -357,21 +358,23 @@ struct Patch {
     const double s1 = dot3(H.t1, dir);
     double m[16][3], w[16], lam[16], o[16][3], q[16][3];
     int idx[16], n = 0, steps = 0;  // idx: the sub-ray (of n) of each Newton step
+    double al[16], be[16], xs[16], ys[16];
+    bool hits[16];
     for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) {
-        const double alpha = alpha0 + span * ((i + 0.5) / 4 - 0.5), beta = span * ((j + 0.5) / 4 - 0.5);
-        double x, y;
-        const bool hit = meet(alpha, beta, x, y);
-        if (!hit && hits_only) continue;
-        w[n] = hit ? 1.0 : kBeyondRim;
-        model_gradient(x, y, m[n]);
-        if (hit) {
-          for (int c = 0; c < 3; ++c) o[steps][c] = alpha * (s1 * H.n[c] - H.nd * H.t1[c]) + beta * H.t2[c];
-          lam[steps] = x * s1;
-          if (place(o[steps], lam[steps], q[steps])) idx[steps++] = n;
-        }
-        ++n;
+      for (int j = 0; j < 4; ++j)
+        al[4 * i + j] = alpha0 + span * ((i + 0.5) / 4 - 0.5), be[4 * i + j] = span * ((j + 0.5) / 4 - 0.5);
+    for (int b = 0; b < 16; b += 4) meet4(al + b, be + b, xs + b, ys + b, hits + b);
+    for (int l = 0; l < 16; ++l) {
+      if (!hits[l] && hits_only) continue;
+      w[n] = hits[l] ? 1.0 : kBeyondRim;
+      model_gradient(xs[l], ys[l], m[n]);
+      if (hits[l]) {
+        for (int c = 0; c < 3; ++c) o[steps][c] = al[l] * (s1 * H.n[c] - H.nd * H.t1[c]) + be[l] * H.t2[c];
+        lam[steps] = xs[l] * s1;
+        if (place(o[steps], lam[steps], q[steps])) idx[steps++] = n;
       }
+      ++n;
+    }
     if (n == 0) return false;
     // The Newton step needs the field and its slope along the sub-ray at each meeting point: the
     // field there and at ±½ voxel along the ray (one-sided where that leaves the domain), three
@@ -385,13 +388,13 @@ struct Patch {
       for (int k = 0; k < steps; ++k) {
         bool lo_in = true, hi_in = true;
         for (int c = 0; c < 3; ++c) {
-          const double dc = e * dir[c] / spacing[c], top = double(dims[c] - 1);
+          const double dc = e * dir[c] * inv_spacing[c], top = double(dims[c] - 1);
           lo_in = lo_in && q[k][c] - dc >= 0 && q[k][c] - dc <= top;
           hi_in = hi_in && q[k][c] + dc >= 0 && q[k][c] + dc <= top;
         }
         span_e[k] = (lo_in ? e : 0.0) + (hi_in ? e : 0.0);
         for (int c = 0; c < 3; ++c) {
-          const double dc = e * dir[c] / spacing[c];
+          const double dc = e * dir[c] * inv_spacing[c];
           pts[3 * k][c] = q[k][c];
           pts[3 * k + 1][c] = lo_in ? q[k][c] - dc : q[k][c];
           pts[3 * k + 2][c] = hi_in ? q[k][c] + dc : q[k][c];
@@ -413,22 +416,75 @@ struct Patch {
       values(pts, 6 * landed, v);
       for (int k = 0; k < landed; ++k) std::ranges::copy(central_difference(v + 6 * k, h[k]), m[idx[k]]);
     }
+    double ndl[16];
+    abs_cos16(m, n, ndl);
     float sum[3] = {0, 0, 0};
     double wsum = 0;
     for (int k = 0; k < n; ++k) {
-      float rgb[4];
-      shade_from_gradient(m[k], dir, colour, true, rgb);
-      for (int c = 0; c < 3; ++c) sum[c] += float(w[k]) * rgb[c];
+      double p32 = ndl[k];
+      for (int i = 0; i < 5; ++i) p32 *= p32;
+      const float diffuse = float(0.15 + 0.85 * ndl[k]), spec = float(0.25 * p32);
+      for (int c = 0; c < 3; ++c) sum[c] += float(w[k]) * std::min(1.0f, colour[c] * diffuse + spec);
       wsum += w[k];
     }
     for (int c = 0; c < 3; ++c) a[c] = sum[c] / float(wsum);
     return true;
   }
+  // meet() for four sub-rays at once (the lanes of one vector where the renderer has AVX2).
+  void meet4(const double* alpha, const double* beta, double* x, double* y, bool* hit) const {
+#ifdef PANOPTES_RENDER_AVX2
+    const __m256d zero = _mm256_setzero_pd(), sign = _mm256_set1_pd(-0.0);
+    const __m256d hi = _mm256_set1_pd(xmax), lo = _mm256_set1_pd(-xmax);
+    const __m256d a = _mm256_loadu_pd(alpha), vk = _mm256_set1_pd(k);
+    const __m256d yy = _mm256_min_pd(_mm256_max_pd(_mm256_loadu_pd(beta), lo), hi);
+    const __m256d nd1 = _mm256_add_pd(_mm256_set1_pd(H.nd), _mm256_mul_pd(_mm256_set1_pd(k2), yy));
+    const __m256d disc = _mm256_sub_pd(_mm256_mul_pd(nd1, nd1), _mm256_mul_pd(_mm256_add_pd(vk, vk), a));
+    const __m256d in = _mm256_cmp_pd(disc, zero, _CMP_GE_OQ);
+    const __m256d den = _mm256_add_pd(nd1, _mm256_or_pd(_mm256_sqrt_pd(_mm256_max_pd(disc, zero)), _mm256_and_pd(nd1, sign)));
+    const __m256d xin = _mm256_blendv_pd(zero, _mm256_div_pd(_mm256_mul_pd(_mm256_set1_pd(-2.0), a), den),
+                                         _mm256_cmp_pd(den, zero, _CMP_NEQ_OQ));
+    // Beyond the rim: the rim's point, x = −n·d / k (0 where k = 0).
+    const __m256d xout = k != 0 ? _mm256_div_pd(_mm256_xor_pd(nd1, sign), vk) : zero;
+    _mm256_storeu_pd(x, _mm256_min_pd(_mm256_max_pd(_mm256_blendv_pd(xout, xin, in), lo), hi));
+    _mm256_storeu_pd(y, yy);
+    const int mask = _mm256_movemask_pd(in);
+    for (int l = 0; l < 4; ++l) hit[l] = mask >> l & 1;
+#else
+    for (int l = 0; l < 4; ++l) hit[l] = meet(alpha[l], beta[l], x[l], y[l]);
+#endif
+  }
+  // |m·d| / |m| (at most 1; 1 where m = 0: facing the camera, as shade_from_gradient()) of n gradients.
+  void abs_cos16(const double (*m)[3], int n, double* out) const {
+#ifdef PANOPTES_RENDER_AVX2
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), sign = _mm256_set1_pd(-0.0);
+    const __m256d dx = _mm256_set1_pd(dir[0]), dy = _mm256_set1_pd(dir[1]), dz = _mm256_set1_pd(dir[2]);
+    for (int b = 0; b < n; b += 4) {
+      const int r = std::min(4, n - b);
+      const auto lane = [&](int a) {
+        return _mm256_setr_pd(m[b][a], m[b + std::min(1, r - 1)][a], m[b + std::min(2, r - 1)][a], m[b + std::min(3, r - 1)][a]);
+      };
+      const __m256d m0 = lane(0), m1 = lane(1), m2 = lane(2);
+      const __m256d mm = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m0, m0), _mm256_mul_pd(m1, m1)), _mm256_mul_pd(m2, m2));
+      const __m256d md = _mm256_andnot_pd(sign, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m0, dx), _mm256_mul_pd(m1, dy)),
+                                                              _mm256_mul_pd(m2, dz)));
+      const __m256d cs = _mm256_blendv_pd(one, _mm256_min_pd(one, _mm256_div_pd(md, _mm256_sqrt_pd(mm))),
+                                          _mm256_cmp_pd(mm, zero, _CMP_GT_OQ));
+      alignas(32) double l[4];
+      _mm256_store_pd(l, cs);
+      std::copy_n(l, r, out + b);
+    }
+#else
+    for (int i = 0; i < n; ++i) {
+      const double mm = dot3(m[i], m[i]);
+      out[i] = mm > 0 ? std::min(1.0, std::abs(dot3(m[i], dir)) / std::sqrt(mm)) : 1.0;
+    }
+#endif
+  }
   // The index-space point p + o + λ·d; false where it lies beyond `reach` of p on some axis.
   bool place(const double o[3], double l, double q[3]) const {
     double far = 0;
     for (int c = 0; c < 3; ++c) {
-      const double off = (o[c] + l * dir[c]) / spacing[c];
+      const double off = (o[c] + l * dir[c]) * inv_spacing[c];
       far = std::max(far, std::abs(off));
       q[c] = p[c] + off;
     }
