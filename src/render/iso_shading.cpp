@@ -352,20 +352,60 @@ struct Patch {
   // (e1 = s1·n − n·d·t1, the image of t1; s1 = t1·d) from the patch's meeting point and shaded with
   // the gradient where it lands; the patch's gradient stands in where a point would lie beyond
   // `reach` of p on some axis or the sub-ray runs along the surface. The sub-rays' interpolations
-  // are packed eight to a gather evaluation (3 per sub-ray for the step, 6 for the gradient: 18
-  // evaluations for 16 sub-rays instead of 32 half-empty ones, Round 20).
+  // are packed eight to a gather evaluation (3 per sub-ray for the step, 6 for the gradient: 19
+  // evaluations for the corners and the rest instead of 32 half-empty ones, Round 20).
   bool filter(double span, float* a, double alpha0 = 0, bool hits_only = false) const {
+    // The pattern's four corner sub-rays first: where all four meet the surface and their shadings
+    // agree within kBends, the footprint's shading is their mean (37 % of the filtered pixels in
+    // BM_DenseInside: -2 % of its frame, its speckles and PSNR unchanged; Round 20), else the other
+    // twelve too.
+    static constexpr int kCorners[4] = {0, 3, 12, 15}, kRest[12] = {1, 2, 4, 5, 6, 7, 8, 9, 10, 11, 13, 14};
+    float rgb[16][3];
+    double wc[16];
+    sub_rays(span, alpha0, hits_only, kCorners, 4, rgb, wc);
+    bool agree = true;
+    for (int c = 0; c < 3 && agree; ++c) {
+      float lo = rgb[0][c], hi = rgb[0][c];
+      for (const int k : kCorners) {
+        agree = agree && wc[k] == 1.0;
+        lo = std::min(lo, rgb[k][c]), hi = std::max(hi, rgb[k][c]);
+      }
+      agree = agree && hi - lo <= kBends;
+    }
+    if (agree) {
+      for (int c = 0; c < 3; ++c) a[c] = 0.25f * (rgb[0][c] + rgb[3][c] + rgb[12][c] + rgb[15][c]);
+      return true;
+    }
+    sub_rays(span, alpha0, hits_only, kRest, 12, rgb, wc);
+    float sum[3] = {0, 0, 0};
+    double wsum = 0;
+    for (int k = 0; k < 16; ++k) {
+      if (!(wc[k] > 0)) continue;
+      for (int c = 0; c < 3; ++c) sum[c] += float(wc[k]) * rgb[k][c];
+      wsum += wc[k];
+    }
+    if (!(wsum > 0)) return false;
+    for (int c = 0; c < 3; ++c) a[c] = sum[c] / float(wsum);
+    return true;
+  }
+  // Shades the sub-rays `cells` (4·i + j of the 4 × 4 pattern): rgb[cell], wc[cell] (0: not counted).
+  void sub_rays(double span, double alpha0, bool hits_only, const int* cells, int count, float (*rgb)[3], double* wc) const {
     const double s1 = dot3(H.t1, dir);
     double m[16][3], w[16], lam[16], o[16][3], q[16][3];
-    int idx[16], n = 0, steps = 0;  // idx: the sub-ray (of n) of each Newton step
+    int idx[16], cell[16], n = 0, steps = 0;  // idx: the sub-ray (of n) of each Newton step
     double al[16], be[16], xs[16], ys[16];
     bool hits[16];
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        al[4 * i + j] = alpha0 + span * ((i + 0.5) / 4 - 0.5), be[4 * i + j] = span * ((j + 0.5) / 4 - 0.5);
-    for (int b = 0; b < 16; b += 4) meet4(al + b, be + b, xs + b, ys + b, hits + b);
-    for (int l = 0; l < 16; ++l) {
-      if (!hits[l] && hits_only) continue;
+    for (int l = 0; l < count; ++l) {
+      const int i = cells[l] / 4, j = cells[l] % 4;
+      al[l] = alpha0 + span * ((i + 0.5) / 4 - 0.5), be[l] = span * ((j + 0.5) / 4 - 0.5);
+    }
+    for (int b = 0; b < count; b += 4) meet4(al + b, be + b, xs + b, ys + b, hits + b);
+    for (int l = 0; l < count; ++l) {
+      if (!hits[l] && hits_only) {
+        wc[cells[l]] = 0;
+        continue;
+      }
+      cell[n] = cells[l];
       w[n] = hits[l] ? 1.0 : kBeyondRim;
       model_gradient(xs[l], ys[l], m[n]);
       if (hits[l]) {
@@ -375,7 +415,6 @@ struct Patch {
       }
       ++n;
     }
-    if (n == 0) return false;
     // The Newton step needs the field and its slope along the sub-ray at each meeting point: the
     // field there and at ±½ voxel along the ray (one-sided where that leaves the domain), three
     // interpolations, 48 for 16 sub-rays in six gather evaluations. (The gradient's six, dotted with
@@ -418,17 +457,13 @@ struct Patch {
     }
     double ndl[16];
     abs_cos16(m, n, ndl);
-    float sum[3] = {0, 0, 0};
-    double wsum = 0;
     for (int k = 0; k < n; ++k) {
       double p32 = ndl[k];
       for (int i = 0; i < 5; ++i) p32 *= p32;
       const float diffuse = float(0.15 + 0.85 * ndl[k]), spec = float(0.25 * p32);
-      for (int c = 0; c < 3; ++c) sum[c] += float(w[k]) * std::min(1.0f, colour[c] * diffuse + spec);
-      wsum += w[k];
+      for (int c = 0; c < 3; ++c) rgb[cell[k]][c] = std::min(1.0f, colour[c] * diffuse + spec);
+      wc[cell[k]] = w[k];
     }
-    for (int c = 0; c < 3; ++c) a[c] = sum[c] / float(wsum);
-    return true;
   }
   // meet() for four sub-rays at once (the lanes of one vector where the renderer has AVX2).
   void meet4(const double* alpha, const double* beta, double* x, double* y, bool* hit) const {
