@@ -40,10 +40,29 @@ inline __m256 trilinear8(const FieldAcc& f, __m256 x, __m256 y, __m256 z, __m256
                        _mm256_mullo_epi32(_mm256_sub_epi32(j, _mm256_set1_epi32(f.ilo[1])), _mm256_set1_epi32(sy))),
       _mm256_mullo_epi32(_mm256_sub_epi32(k, _mm256_set1_epi32(f.ilo[2])), _mm256_set1_epi32(sz)));
   const float* d = f.data;
-  const __m256 c000 = _mm256_i32gather_ps(d, off, 4), c100 = _mm256_i32gather_ps(d + sx, off, 4);
-  const __m256 c010 = _mm256_i32gather_ps(d + sy, off, 4), c110 = _mm256_i32gather_ps(d + sy + sx, off, 4);
-  const __m256 c001 = _mm256_i32gather_ps(d + sz, off, 4), c101 = _mm256_i32gather_ps(d + sz + sx, off, 4);
-  const __m256 c011 = _mm256_i32gather_ps(d + sz + sy, off, 4), c111 = _mm256_i32gather_ps(d + sz + sy + sx, off, 4);
+  __m256 c000, c100, c010, c110, c001, c101, c011, c111;
+  if (sx == 1) {
+    // Neighbours along x are adjacent: each pair (x, x + 1) is one 64-bit element, so a corner pair
+    // is two gathers of four elements instead of two of eight (the same values; Round 20).
+    const __m128i off_lo = _mm256_castsi256_si128(off), off_hi = _mm256_extracti128_si256(off, 1);
+    const auto pairs = [&](const float* base, __m256& c0, __m256& c1) {
+      const double* b = reinterpret_cast<const double*>(base);
+      const __m256 lo = _mm256_castpd_ps(_mm256_i32gather_pd(b, off_lo, 4));  // x0 x1 of lanes 0-3
+      const __m256 hi = _mm256_castpd_ps(_mm256_i32gather_pd(b, off_hi, 4));  // of lanes 4-7
+      // [0 1 4 5 | 2 3 6 7] per 128-bit half, then the 64-bit quarters into order.
+      c0 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0x88)), 0xD8));
+      c1 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0xDD)), 0xD8));
+    };
+    pairs(d, c000, c100);
+    pairs(d + sy, c010, c110);
+    pairs(d + sz, c001, c101);
+    pairs(d + sz + sy, c011, c111);
+  } else {
+    c000 = _mm256_i32gather_ps(d, off, 4), c100 = _mm256_i32gather_ps(d + sx, off, 4);
+    c010 = _mm256_i32gather_ps(d + sy, off, 4), c110 = _mm256_i32gather_ps(d + sy + sx, off, 4);
+    c001 = _mm256_i32gather_ps(d + sz, off, 4), c101 = _mm256_i32gather_ps(d + sz + sx, off, 4);
+    c011 = _mm256_i32gather_ps(d + sz + sy, off, 4), c111 = _mm256_i32gather_ps(d + sz + sy + sx, off, 4);
+  }
   if (range) {
     const __m256 lo = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(c000, c100), _mm256_min_ps(c010, c110)),
                                     _mm256_min_ps(_mm256_min_ps(c001, c101), _mm256_min_ps(c011, c111)));
