@@ -239,6 +239,13 @@ int march_iso_block_aa(const MarchPlan& S, const MarchTask& T, const FieldAcc& f
     // Up to three parabolic steps on the bracket (u = −1, 0, 1 around sample k) towards the minimum
     // of |s|; a value of the other sign is a sliver, whose entry lies between the last point
     // before it (same sign) and it.
+    // Between samples dt apart, |s| falls at most dt/2 · √3·r / h below the nearest of them (r: the
+    // cell's range, as the near-miss test above): where even that bound stays away from zero and
+    // beyond the near-miss test's reach below, the search can find neither a sliver nor a near miss.
+    if (!cross && cell_range > 0) {
+      const double floor_s = std::abs(double(sc)) - 0.87 * double(cell_range) * dt / double(hmin);
+      if (floor_s > 0 && floor_s * hmin > 0.87 * cell_range * (t0 + (double(k) + 1) * dt) * pitch) continue;
+    }
     double ua = -1, ub = 0, uz = 1, fa = sp, fb = sc, fz = sn;
     bool pierced = false;
     double u_in = 0, s_in = 0, u_out = 0, s_out = 0;
