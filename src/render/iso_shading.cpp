@@ -160,40 +160,41 @@ inline double shade_channel(double c, double ndl) {  // one channel of shade_fro
 bool corners_bend(const CornerTest& T, const Vec3& dir, double c, double h) {
   const double centre = shade_channel(c, std::abs(T.nd));
 #ifdef PANOPTES_RENDER_AVX2
-  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), sign = _mm256_set1_pd(-0.0);
-  const __m256d alpha = _mm256_setr_pd(-h, h, -h, h);
-  const __m256d xmax = _mm256_set1_pd(T.xmax), nxmax = _mm256_set1_pd(-T.xmax);
-  const __m256d y = _mm256_min_pd(_mm256_max_pd(_mm256_setr_pd(-h, -h, h, h), nxmax), xmax);
-  const __m256d nd1 = _mm256_add_pd(_mm256_set1_pd(T.nd), _mm256_mul_pd(_mm256_set1_pd(T.k2), y));
-  const __m256d disc = _mm256_sub_pd(_mm256_mul_pd(nd1, nd1), _mm256_mul_pd(_mm256_set1_pd(2 * T.k), alpha));
-  if (_mm256_movemask_pd(_mm256_cmp_pd(disc, zero, _CMP_NGE_UQ))) return true;  // a corner beyond the rim
-  const __m256d den = _mm256_add_pd(nd1, _mm256_or_pd(_mm256_sqrt_pd(disc), _mm256_and_pd(nd1, sign)));
-  __m256d x = _mm256_blendv_pd(zero, _mm256_div_pd(_mm256_mul_pd(_mm256_set1_pd(-2.0), alpha), den),
-                               _mm256_cmp_pd(den, zero, _CMP_NEQ_OQ));
-  x = _mm256_min_pd(_mm256_max_pd(x, nxmax), xmax);
-  const __m256d dx = _mm256_set1_pd(dir[0]), dy = _mm256_set1_pd(dir[1]), dz = _mm256_set1_pd(dir[2]);
-  const __m256d cc = _mm256_set1_pd(c);
-  // The shading of |m·d| / |m| per lane (1 where m = 0), summed over the lanes.
-  const auto mean_shade = [&](__m256d m0, __m256d m1, __m256d m2) {
-    const __m256d mm = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m0, m0), _mm256_mul_pd(m1, m1)), _mm256_mul_pd(m2, m2));
-    const __m256d md = _mm256_andnot_pd(sign, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m0, dx), _mm256_mul_pd(m1, dy)),
-                                                            _mm256_mul_pd(m2, dz)));
-    const __m256d cs = _mm256_blendv_pd(one, _mm256_min_pd(one, _mm256_div_pd(md, _mm256_sqrt_pd(mm))),
-                                        _mm256_cmp_pd(mm, zero, _CMP_GT_OQ));
-    __m256d p32 = cs;
-    for (int i = 0; i < 5; ++i) p32 = _mm256_mul_pd(p32, p32);
-    const __m256d sh = _mm256_min_pd(one, _mm256_add_pd(_mm256_mul_pd(cc, _mm256_add_pd(_mm256_set1_pd(0.15), _mm256_mul_pd(_mm256_set1_pd(0.85), cs))),
-                                                         _mm256_mul_pd(_mm256_set1_pd(0.25), p32)));
-    alignas(32) double l[4];
-    _mm256_store_pd(l, sh);
-    return 0.25 * (l[0] + l[1] + l[2] + l[3]);
+  // In float: the test compares shadings with an 8/255 bar, far above float's rounding, and the
+  // model's corners and the four gradients beside the hit then fit one 8-lane vector.
+  const __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
+  const float hf = float(h), xm = float(T.xmax);
+  const __m128 alpha = _mm_setr_ps(-hf, hf, -hf, hf);
+  const __m128 xmax = _mm_set1_ps(xm), nxmax = _mm_set1_ps(-xm);
+  const __m128 y = _mm_min_ps(_mm_max_ps(_mm_setr_ps(-hf, -hf, hf, hf), nxmax), xmax);
+  const __m128 nd1 = _mm_add_ps(_mm_set1_ps(float(T.nd)), _mm_mul_ps(_mm_set1_ps(float(T.k2)), y));
+  const __m128 disc = _mm_sub_ps(_mm_mul_ps(nd1, nd1), _mm_mul_ps(_mm_set1_ps(float(2 * T.k)), alpha));
+  if (_mm_movemask_ps(_mm_cmp_ps(disc, zero, _CMP_NGE_UQ))) return true;  // a corner beyond the rim
+  const __m128 den = _mm_add_ps(nd1, _mm_or_ps(_mm_sqrt_ps(disc), _mm_and_ps(nd1, sign)));
+  __m128 x = _mm_blendv_ps(zero, _mm_div_ps(_mm_mul_ps(_mm_set1_ps(-2.0f), alpha), den), _mm_cmp_ps(den, zero, _CMP_NEQ_OQ));
+  x = _mm_min_ps(_mm_max_ps(x, nxmax), xmax);
+  // Lanes 0-3: the model at the four corners; 4-7: the four gradients beside the hit.
+  const auto lanes = [&](int a) {
+    const __m128 m = _mm_add_ps(_mm_set1_ps(float(T.g[a])), _mm_add_ps(_mm_mul_ps(x, _mm_set1_ps(float(T.D1[a]))),
+                                                                       _mm_mul_ps(y, _mm_set1_ps(float(T.D2[a])))));
+    const __m128 b = _mm_setr_ps(float(T.beside[0][a]), float(T.beside[1][a]), float(T.beside[2][a]), float(T.beside[3][a]));
+    return _mm256_set_m128(b, m);
   };
-  const auto model = [&](int a) {
-    return _mm256_add_pd(_mm256_set1_pd(T.g[a]), _mm256_add_pd(_mm256_mul_pd(x, _mm256_set1_pd(T.D1[a])),
-                                                               _mm256_mul_pd(y, _mm256_set1_pd(T.D2[a]))));
-  };
-  const auto beside = [&](int a) { return _mm256_setr_pd(T.beside[0][a], T.beside[1][a], T.beside[2][a], T.beside[3][a]); };
-  const double mean = mean_shade(model(0), model(1), model(2)), near = mean_shade(beside(0), beside(1), beside(2));
+  const __m256 m0 = lanes(0), m1 = lanes(1), m2 = lanes(2);
+  const __m256 one = _mm256_set1_ps(1.0f), zero8 = _mm256_setzero_ps();
+  const __m256 mm = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m0, m0), _mm256_mul_ps(m1, m1)), _mm256_mul_ps(m2, m2));
+  const __m256 md = _mm256_andnot_ps(_mm256_set1_ps(-0.0f),
+                                     _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m0, _mm256_set1_ps(float(dir[0]))),
+                                                                 _mm256_mul_ps(m1, _mm256_set1_ps(float(dir[1])))),
+                                                   _mm256_mul_ps(m2, _mm256_set1_ps(float(dir[2])))));
+  const __m256 cs = _mm256_blendv_ps(one, _mm256_min_ps(one, _mm256_div_ps(md, _mm256_sqrt_ps(mm))), _mm256_cmp_ps(mm, zero8, _CMP_GT_OQ));
+  __m256 p32 = cs;
+  for (int i = 0; i < 5; ++i) p32 = _mm256_mul_ps(p32, p32);
+  const __m256 sh = _mm256_min_ps(one, _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(float(c)), _mm256_add_ps(_mm256_set1_ps(0.15f), _mm256_mul_ps(_mm256_set1_ps(0.85f), cs))),
+                                                     _mm256_mul_ps(_mm256_set1_ps(0.25f), p32)));
+  alignas(32) float l[8];
+  _mm256_store_ps(l, sh);
+  const double mean = 0.25 * (double(l[0]) + l[1] + l[2] + l[3]), near = 0.25 * (double(l[4]) + l[5] + l[6] + l[7]);
 #else
   const auto abs_cos = [&](const double* m) {
     const double mm = dot3(m, m);

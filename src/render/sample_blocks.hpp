@@ -47,8 +47,11 @@ inline __m256 trilinear8(const FieldAcc& f, __m256 x, __m256 y, __m256 z, __m256
     const __m128i off_lo = _mm256_castsi256_si128(off), off_hi = _mm256_extracti128_si256(off, 1);
     const auto pairs = [&](const float* base, __m256& c0, __m256& c1) {
       const double* b = reinterpret_cast<const double*>(base);
-      const __m256 lo = _mm256_castpd_ps(_mm256_i32gather_pd(b, off_lo, 4));  // x0 x1 of lanes 0-3
-      const __m256 hi = _mm256_castpd_ps(_mm256_i32gather_pd(b, off_hi, 4));  // of lanes 4-7
+      // The masked form with a zero source: the unmasked one leaves its source undefined, which GCC 12
+      // reports as a maybe-uninitialized read in every file that inlines this.
+      const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), none = _mm256_setzero_pd();
+      const __m256 lo = _mm256_castpd_ps(_mm256_mask_i32gather_pd(none, b, off_lo, all, 4));  // x0 x1 of lanes 0-3
+      const __m256 hi = _mm256_castpd_ps(_mm256_mask_i32gather_pd(none, b, off_hi, all, 4));  // of lanes 4-7
       // [0 1 4 5 | 2 3 6 7] per 128-bit half, then the 64-bit quarters into order.
       c0 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0x88)), 0xD8));
       c1 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0xDD)), 0xD8));
