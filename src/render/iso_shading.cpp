@@ -364,14 +364,12 @@ struct Patch {
     float rgb[16][3];
     double wc[16];
     sub_rays(span, alpha0, hits_only, kCorners, 4, rgb, wc);
-    bool agree = true;
+    // (A corner skipped as a near miss's non-hit has no colour: the weights are looked at first.)
+    bool agree = wc[0] == 1.0 && wc[3] == 1.0 && wc[12] == 1.0 && wc[15] == 1.0;
     for (int c = 0; c < 3 && agree; ++c) {
       float lo = rgb[0][c], hi = rgb[0][c];
-      for (const int k : kCorners) {
-        agree = agree && wc[k] == 1.0;
-        lo = std::min(lo, rgb[k][c]), hi = std::max(hi, rgb[k][c]);
-      }
-      agree = agree && hi - lo <= kBends;
+      for (const int k : kCorners) lo = std::min(lo, rgb[k][c]), hi = std::max(hi, rgb[k][c]);
+      agree = hi - lo <= kBends;
     }
     if (agree) {
       for (int c = 0; c < 3; ++c) a[c] = 0.25f * (rgb[0][c] + rgb[3][c] + rgb[12][c] + rgb[15][c]);
