@@ -394,30 +394,30 @@ std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const Is
     alignas(32) float vh[8];
     for (int h0 = 0; h0 < nh; h0 += 8) {
       const int m = std::min(8, nh - h0);
-      alignas(32) float x[8], y[8], z[8];
+      alignas(32) float fk[8];  // the linear estimates' positions in samples
       for (int q = 0; q < 8; ++q) {
         const int h = h0 + std::min(q, m - 1);
         const int l = sc.hl[std::size_t(h)];
         const float va = vb[l], vc = vb[l + 1], is = iso[sc.hj[std::size_t(h)]];
         const float s = (va - is) / (va - vc);
-        const float fk = float(k0 + l - 1) + s;
+        fk[q] = float(k0 + l - 1) + s;
         sc.hs[std::size_t(h)] = s;
-        x[q] = P.bx + fk * P.sx, y[q] = P.by + fk * P.sy, z[q] = P.bz + fk * P.sz;
       }
 #ifdef PANOPTES_RENDER_AVX2
       if (f.gather32) {
-        // The lanes read element by element (a gather): each element forwards from its own scalar
+        // The positions read element by element (a gather): each element forwards from its own scalar
         // store above, where one 32-byte load of the eight would wait for all of them to reach the
-        // cache (Round 19). Same values, same bits.
-        const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        auto pos = [&](const float* c, int ax) {
-          return _mm256_min_ps(_mm256_max_ps(_mm256_i32gather_ps(c, lane, 4), _mm256_set1_ps(f.plo[ax])),
+        // cache (Round 19); one gather of the positions along the ray, the three coordinates from it
+        // (Round 20: three gathers before). Same values, same bits.
+        const __m256 k8 = _mm256_i32gather_ps(fk, _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), 4);
+        auto pos = [&](float b, float st, int ax) {
+          return _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k8, _mm256_set1_ps(st), _mm256_set1_ps(b)), _mm256_set1_ps(f.plo[ax])),
                                _mm256_set1_ps(f.phi[ax]));
         };
-        _mm256_store_ps(vh, march::trilinear8(f, pos(x, 0), pos(y, 1), pos(z, 2)));
+        _mm256_store_ps(vh, march::trilinear8(f, pos(P.bx, P.sx, 0), pos(P.by, P.sy, 1), pos(P.bz, P.sz, 2)));
       } else
 #endif
-        for (int q = 0; q < m; ++q) vh[q] = march::interp_clamped(f, x[q], y[q], z[q]);
+        for (int q = 0; q < m; ++q) vh[q] = march::interp_clamped(f, P.bx + fk[q] * P.sx, P.by + fk[q] * P.sy, P.bz + fk[q] * P.sz);
       for (int q = 0; q < m; ++q) {
         const int h = h0 + q, l = sc.hl[std::size_t(h)];
         const float is = iso[sc.hj[std::size_t(h)]];
