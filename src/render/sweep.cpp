@@ -270,57 +270,19 @@ struct IsoIndex {
 // Per-thread scratch of the isosurface ray: hit bits per sorted isovalue, and a block's hits.
 struct IsoScratch {
   std::vector<std::uint64_t> hit;
-  std::vector<int> hj;     // sorted index of each hit
-  std::vector<float> hs;   // position in units of samples (k − 1 + s, s the segment's fraction)
-  std::vector<std::uint8_t> hl;  // segment lane
-  std::vector<float> gx, gy, gz;  // gradient at each hit
-  explicit IsoScratch(int K)
-      : hit(std::size_t((K + 63) / 64)), hj(std::size_t(K) + 8), hs(std::size_t(K) + 8), hl(std::size_t(K) + 8),
-        gx(std::size_t(K) + 8), gy(std::size_t(K) + 8), gz(std::size_t(K) + 8) {}
+  std::vector<int> hj;  // sorted index of each hit, segment by segment
+  explicit IsoScratch(int K) : hit(std::size_t((K + 63) / 64)), hj(std::size_t(K) + 8) {}
 };
 
-// |n·l| of hits 0 … nh − 1 of a block from their gradients (a zero gradient faces the camera), written
-// as SweepFrames' 2-byte code 1 + |n·l|·65534 to slot px + 2·j.
-void shade_hits(const IsoScratch& sc, int nh, const float dir[3], std::uint8_t* px) {
-  int h = 0;
-#ifdef PANOPTES_RENDER_AVX2
-  const __m256 dx = _mm256_set1_ps(dir[0]), dy = _mm256_set1_ps(dir[1]), dz = _mm256_set1_ps(dir[2]);
-  const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
-  for (; h + 8 <= nh; h += 8) {
-    const __m256 gx = _mm256_loadu_ps(&sc.gx[std::size_t(h)]), gy = _mm256_loadu_ps(&sc.gy[std::size_t(h)]),
-                 gz = _mm256_loadu_ps(&sc.gz[std::size_t(h)]);
-    const __m256 nn = _mm256_fmadd_ps(gx, gx, _mm256_fmadd_ps(gy, gy, _mm256_mul_ps(gz, gz)));
-    const __m256 d = _mm256_fmadd_ps(gx, dx, _mm256_fmadd_ps(gy, dy, _mm256_mul_ps(gz, dz)));
-    __m256 ndl = _mm256_min_ps(one, _mm256_div_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), d), _mm256_sqrt_ps(nn)));
-    ndl = _mm256_blendv_ps(one, ndl, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
-    const __m256i code = _mm256_add_epi32(
-        _mm256_cvttps_epi32(_mm256_fmadd_ps(ndl, _mm256_set1_ps(65534.0f), _mm256_set1_ps(0.5f))), _mm256_set1_epi32(1));
-    alignas(32) std::uint32_t out[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(out), code);
-    for (int q = 0; q < 8; ++q) {
-      const std::uint16_t c = std::uint16_t(out[q]);
-      std::memcpy(px + 2 * std::size_t(sc.hj[std::size_t(h + q)]), &c, 2);
-    }
-  }
-#endif
-  for (; h < nh; ++h) {
-    const float gx = sc.gx[std::size_t(h)], gy = sc.gy[std::size_t(h)], gz = sc.gz[std::size_t(h)];
-    const float nn = gx * gx + gy * gy + gz * gz;
-    const float ndl = nn > 0 ? std::min(1.0f, std::fabs(gx * dir[0] + gy * dir[1] + gz * dir[2]) / std::sqrt(nn)) : 1.0f;
-    const std::uint16_t c = std::uint16_t(int(ndl * 65534.0f + 0.5f) + 1);
-    std::memcpy(px + 2 * std::size_t(sc.hj[std::size_t(h)]), &c, 2);
-  }
-}
-
 // Marks the isovalues sorted[j0 … j1) not hit yet as hit and appends them to the block's hits
-// (sc.hj, sc.hl from index nh; both sized for every isovalue). Returns the new count.
-inline int take_hits(IsoScratch& sc, int nh, int j0, int j1, int lane) {
+// (sc.hj from index nh; sized for every isovalue). Returns the new count.
+inline int take_hits(IsoScratch& sc, int nh, int j0, int j1) {
   for (int w = j0 >> 6; w <= (j1 - 1) >> 6; ++w) {
     std::uint64_t m = ~sc.hit[std::size_t(w)];
     if (w == j0 >> 6) m &= ~std::uint64_t(0) << (j0 & 63);
     if (w == (j1 - 1) >> 6 && ((j1 - 1) & 63) != 63) m &= (std::uint64_t(1) << (((j1 - 1) & 63) + 1)) - 1;
     sc.hit[std::size_t(w)] |= m;
-    for (; m; m &= m - 1, ++nh) sc.hj[std::size_t(nh)] = w * 64 + std::countr_zero(m), sc.hl[std::size_t(nh)] = std::uint8_t(lane);
+    for (; m; m &= m - 1, ++nh) sc.hj[std::size_t(nh)] = w * 64 + std::countr_zero(m);
   }
   return nh;
 }
@@ -334,14 +296,129 @@ inline bool any_unhit(const std::vector<std::uint64_t>& hit, int j0, int j1) {
   return false;
 }
 
+// The segment count from which a segment's hits take the field from its cubic (iso_ray()).
+constexpr int kCubicHits = 3;
+
+// v[q] = the field at positions k[q] (in samples along the ray P) for q < m ≤ 16, eight at a time.
+inline void interp_at(const march::FieldAcc& f, const march::RayPos& P, const float* k, int m, float* v) {
+#ifdef PANOPTES_RENDER_AVX2
+  if (f.gather32) {
+    for (int q0 = 0; q0 < m; q0 += 8) {
+      // The positions read element by element (a gather): each element forwards from its own scalar
+      // store, where one 32-byte load of the eight would wait for all of them to reach the cache
+      // (Round 19). Lanes past m repeat position m − 1.
+      const __m256i idx = _mm256_min_epi32(_mm256_setr_epi32(q0, q0 + 1, q0 + 2, q0 + 3, q0 + 4, q0 + 5, q0 + 6, q0 + 7),
+                                           _mm256_set1_epi32(m - 1));
+      const __m256 k8 = _mm256_i32gather_ps(k, idx, 4);
+      auto pos = [&](float b, float st, int ax) {
+        return _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k8, _mm256_set1_ps(st), _mm256_set1_ps(b)), _mm256_set1_ps(f.plo[ax])),
+                             _mm256_set1_ps(f.phi[ax]));
+      };
+      _mm256_storeu_ps(v + q0, march::trilinear8(f, pos(P.bx, P.sx, 0), pos(P.by, P.sy, 1), pos(P.bz, P.sz, 2)));
+    }
+    return;
+  }
+#endif
+  for (int q = 0; q < m; ++q) v[q] = march::interp_clamped(f, P.bx + k[q] * P.sx, P.by + k[q] * P.sy, P.bz + k[q] * P.sz);
+}
+
+// Hits hj[0 … m) of one segment (samples k_a = k_seg and k_a + 1 of the ray P, values va and vc):
+// each placed as render_brick() places a hit — the linear estimate, one regula-falsi step with the
+// field there (from the segment's cubic, or interpolated where cubic is null) — shaded with the
+// gradient of the segment's Catmull–Rom spline cr (per axis c0 + s·(c1 + s·(c2 + s·c3))) and written
+// as SweepFrames' 2-byte code 1 + |n·l|·65534 (a zero gradient faces the camera) to slot px + 2·j.
+void place_hits(const march::FieldAcc& f, const march::RayPos& P, float k_seg, float va, float vc, const float* cubic,
+                const float (*cr)[4], const float* iso, const int* hj, int m, const float dir[3], std::uint8_t* px) {
+  int h = 0;
+#ifdef PANOPTES_RENDER_AVX2
+  if (f.gather32) {
+    const __m256 Va = _mm256_set1_ps(va), Vd = _mm256_set1_ps(va - vc), one = _mm256_set1_ps(1.0f),
+                 zero = _mm256_setzero_ps(), sign = _mm256_set1_ps(-0.0f);
+    for (; h < m; h += 8) {
+      // Lanes past m read the isovalues of whatever hj holds there (the scratch is sized for K + 8
+      // hits and holds isovalue indices only); their results are not written.
+      const __m256 is = _mm256_i32gather_ps(iso, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(hj + h)), 4);
+      const __m256 s1 = _mm256_div_ps(_mm256_sub_ps(Va, is), Vd);
+      __m256 v;
+      if (cubic) {
+        const __m256 t = _mm256_mul_ps(s1, _mm256_set1_ps(3.0f));
+        v = _mm256_fmadd_ps(_mm256_sub_ps(t, _mm256_set1_ps(2.0f)), _mm256_set1_ps(cubic[3]), _mm256_set1_ps(cubic[2]));
+        v = _mm256_fmadd_ps(_mm256_sub_ps(t, one), v, _mm256_set1_ps(cubic[1]));
+        v = _mm256_fmadd_ps(t, v, _mm256_set1_ps(cubic[0]));
+      } else {
+        const __m256 k8 = _mm256_add_ps(_mm256_set1_ps(k_seg), s1);
+        auto pos = [&](float b, float st, int ax) {
+          return _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k8, _mm256_set1_ps(st), _mm256_set1_ps(b)), _mm256_set1_ps(f.plo[ax])),
+                               _mm256_set1_ps(f.phi[ax]));
+        };
+        v = march::trilinear8(f, pos(P.bx, P.sx, 0), pos(P.by, P.sy, 1), pos(P.bz, P.sz, 2));
+      }
+      // The regula-falsi step: the sub-segment whose ends straddle the isovalue, its secant.
+      const __m256 v1 = _mm256_sub_ps(v, is), fa0 = _mm256_sub_ps(Va, is), fb0 = _mm256_sub_ps(_mm256_set1_ps(vc), is);
+      // (v1 < 0) != (fa0 < 0): the root lies in [0, s1] (else in [s1, 1]), as the scalar form tests.
+      const __m256 diff = _mm256_xor_ps(_mm256_cmp_ps(v1, zero, _CMP_LT_OQ), _mm256_cmp_ps(fa0, zero, _CMP_LT_OQ));
+      const __m256 sa = _mm256_andnot_ps(diff, s1), sb = _mm256_blendv_ps(one, s1, diff);
+      const __m256 fa = _mm256_blendv_ps(v1, fa0, diff), fb = _mm256_blendv_ps(fb0, v1, diff);
+      const __m256 den = _mm256_sub_ps(fa, fb);
+      const __m256 s = _mm256_blendv_ps(s1, _mm256_fmadd_ps(_mm256_sub_ps(sb, sa), _mm256_div_ps(fa, den), sa),
+                                        _mm256_cmp_ps(den, zero, _CMP_NEQ_OQ));
+      auto spline = [&](int a) {
+        __m256 g = _mm256_fmadd_ps(s, _mm256_set1_ps(cr[a][3]), _mm256_set1_ps(cr[a][2]));
+        g = _mm256_fmadd_ps(s, g, _mm256_set1_ps(cr[a][1]));
+        return _mm256_fmadd_ps(s, g, _mm256_set1_ps(cr[a][0]));
+      };
+      const __m256 gx = spline(0), gy = spline(1), gz = spline(2);
+      const __m256 nn = _mm256_fmadd_ps(gx, gx, _mm256_fmadd_ps(gy, gy, _mm256_mul_ps(gz, gz)));
+      const __m256 d = _mm256_fmadd_ps(gx, _mm256_set1_ps(dir[0]), _mm256_fmadd_ps(gy, _mm256_set1_ps(dir[1]), _mm256_mul_ps(gz, _mm256_set1_ps(dir[2]))));
+      __m256 ndl = _mm256_min_ps(one, _mm256_div_ps(_mm256_andnot_ps(sign, d), _mm256_sqrt_ps(nn)));
+      ndl = _mm256_blendv_ps(one, ndl, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
+      const __m256i code = _mm256_add_epi32(
+          _mm256_cvttps_epi32(_mm256_fmadd_ps(ndl, _mm256_set1_ps(65534.0f), _mm256_set1_ps(0.5f))), _mm256_set1_epi32(1));
+      alignas(32) std::uint32_t out[8];
+      _mm256_store_si256(reinterpret_cast<__m256i*>(out), code);
+      for (int q = 0; q < std::min(8, m - h); ++q) {
+        const std::uint16_t c = std::uint16_t(out[q]);
+        std::memcpy(px + 2 * std::size_t(hj[h + q]), &c, 2);
+      }
+    }
+    return;
+  }
+#endif
+  for (; h < m; ++h) {
+    const float is = iso[hj[h]];
+    const float s1 = (va - is) / (va - vc);
+    float v;
+    if (cubic) {
+      const float t = 3.0f * s1;
+      v = cubic[0] + t * (cubic[1] + (t - 1.0f) * (cubic[2] + (t - 2.0f) * cubic[3]));
+    } else {
+      const float k = k_seg + s1;
+      v = march::interp_clamped(f, P.bx + k * P.sx, P.by + k * P.sy, P.bz + k * P.sz);
+    }
+    const float dpa = va - is, dpb = vc - is, v1 = v - is;
+    float sa = 0, sb = 1, fa = dpa, fb = dpb;
+    if ((v1 < 0) == (dpa < 0)) sa = s1, fa = v1;
+    else sb = s1, fb = v1;
+    const float s = fa != fb ? sa + (sb - sa) * (fa / (fa - fb)) : s1;
+    float gv[3];
+    for (int a = 0; a < 3; ++a) gv[a] = cr[a][0] + s * (cr[a][1] + s * (cr[a][2] + s * cr[a][3]));
+    const float nn = gv[0] * gv[0] + gv[1] * gv[1] + gv[2] * gv[2];
+    const float ndl = nn > 0 ? std::min(1.0f, std::fabs(gv[0] * dir[0] + gv[1] * dir[1] + gv[2] * dir[2]) / std::sqrt(nn)) : 1.0f;
+    const std::uint16_t c = std::uint16_t(int(ndl * 65534.0f + 0.5f) + 1);
+    std::memcpy(px + 2 * std::size_t(hj[h]), &c, 2);
+  }
+}
+
 // One isosurface-sweep ray: writes slot j's code (px + 2·j) for every sorted isovalue j it hits.
 // Returns the samples interpolated.
 //
 // A hit is found and placed as render_brick() places one: the first segment (samples k − 1, k)
 // whose values straddle the isovalue, the linear estimate in it, one regula-falsi step with the
-// field evaluated there (batched: eight hits per 8-lane interpolation). It is shaded with the
-// gradient of the Catmull–Rom spline through the gradients at samples k − 2 … k + 1 (shade_hit()
-// evaluates six interpolations per hit; a 1,000-value sweep makes hundreds of hits per ray).
+// field there — interpolated where the segment crosses one or two isovalues, from the segment's
+// cubic where it crosses more (a 1,000-value sweep crosses 12.5 per segment with hits on
+// sweep_bench's scene). It is shaded with the gradient of the Catmull–Rom spline through the
+// gradients at samples k − 2 … k + 1 (shade_hit() evaluates six interpolations per hit; such a
+// sweep makes hundreds of hits per ray).
 std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const IsoIndex& X, const Ray& r,
                       IsoScratch& sc, std::uint8_t* px) {
   const march::MarchPlan& S = SP.base;
@@ -379,10 +456,13 @@ std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const Is
       continue;
     }
     int nh = 0;
+    int seg_first[kBlock], seg_count[kBlock];  // the block's hits of segment l: seg_first[l] … + seg_count[l]
     for (int l = l0; l < n; ++l) {
+      seg_first[l] = nh, seg_count[l] = 0;
       const int ia = ib[l], ic = ib[l + 1];
       if (ia < 0 || ic < 0 || ia == ic) continue;  // no sign change (a NaN sample crosses nothing)
-      nh = take_hits(sc, nh, std::min(ia, ic), std::max(ia, ic), l);
+      nh = take_hits(sc, nh, std::min(ia, ic), std::max(ia, ic));
+      seg_count[l] = nh - seg_first[l];
     }
     if (nh == 0) {
       vb[0] = vb[n], ib[0] = ib[n];
@@ -390,42 +470,27 @@ std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const Is
       continue;
     }
     remaining -= nh;
-    // The regula-falsi step's field values at the linear estimates, eight hits at a time.
-    alignas(32) float vh[8];
-    for (int h0 = 0; h0 < nh; h0 += 8) {
-      const int m = std::min(8, nh - h0);
-      alignas(32) float fk[8];  // the linear estimates' positions in samples
-      for (int q = 0; q < 8; ++q) {
-        const int h = h0 + std::min(q, m - 1);
-        const int l = sc.hl[std::size_t(h)];
-        const float va = vb[l], vc = vb[l + 1], is = iso[sc.hj[std::size_t(h)]];
-        const float s = (va - is) / (va - vc);
-        fk[q] = float(k0 + l - 1) + s;
-        sc.hs[std::size_t(h)] = s;
-      }
-#ifdef PANOPTES_RENDER_AVX2
-      if (f.gather32) {
-        // The positions read element by element (a gather): each element forwards from its own scalar
-        // store above, where one 32-byte load of the eight would wait for all of them to reach the
-        // cache (Round 19); one gather of the positions along the ray, the three coordinates from it
-        // (Round 20: three gathers before). Same values, same bits.
-        const __m256 k8 = _mm256_i32gather_ps(fk, _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), 4);
-        auto pos = [&](float b, float st, int ax) {
-          return _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k8, _mm256_set1_ps(st), _mm256_set1_ps(b)), _mm256_set1_ps(f.plo[ax])),
-                               _mm256_set1_ps(f.phi[ax]));
-        };
-        _mm256_store_ps(vh, march::trilinear8(f, pos(P.bx, P.sx, 0), pos(P.by, P.sy, 1), pos(P.bz, P.sz, 2)));
-      } else
-#endif
-        for (int q = 0; q < m; ++q) vh[q] = march::interp_clamped(f, P.bx + fk[q] * P.sx, P.by + fk[q] * P.sy, P.bz + fk[q] * P.sz);
-      for (int q = 0; q < m; ++q) {
-        const int h = h0 + q, l = sc.hl[std::size_t(h)];
-        const float is = iso[sc.hj[std::size_t(h)]];
-        const float dpa = vb[l] - is, dpb = vb[l + 1] - is, s1 = sc.hs[std::size_t(h)], v1 = vh[q] - is;
-        float sa = 0, sb = 1, fa = dpa, fb = dpb;
-        if ((v1 < 0) == (dpa < 0)) sa = s1, fa = v1;
-        else sb = s1, fb = v1;
-        sc.hs[std::size_t(h)] = fa != fb ? sa + (sb - sa) * (fa / (fa - fb)) : s1;
+    // The regula-falsi step needs the field at each hit's linear estimate. A segment that crosses
+    // kCubicHits isovalues or more takes it from the cubic through the field at the segment's ends and
+    // at its thirds (two interpolations for the segment: the trilinear field along a line within one
+    // cell is a cubic in the ray parameter, piecewise across the cells' faces); the others' hits
+    // interpolate it at the estimate itself.
+    alignas(32) float cubic[kBlock][4];  // per cubic segment: y0, Δy0, ½Δ²y0, ⅙Δ³y0 on the nodes t = 0 … 3 (t = 3s)
+    {
+      alignas(32) float sp[16];  // positions (in samples) of the cubic segments' thirds
+      int cl[kBlock], nc = 0;
+      for (int l = l0; l < n; ++l)
+        if (seg_count[l] >= kCubicHits) {
+          sp[2 * nc] = float(k0 + l - 1) + (1.0f / 3.0f), sp[2 * nc + 1] = float(k0 + l - 1) + (2.0f / 3.0f);
+          cl[nc++] = l;
+        }
+      alignas(32) float st[16];
+      interp_at(f, P, sp, 2 * nc, st);
+      for (int c = 0; c < nc; ++c) {
+        const int l = cl[c];
+        const float y0 = vb[l], y1 = st[2 * c], y2 = st[2 * c + 1], y3 = vb[l + 1];
+        cubic[l][0] = y0, cubic[l][1] = y1 - y0, cubic[l][2] = 0.5f * (y2 - 2 * y1 + y0),
+        cubic[l][3] = (y3 - 3 * y2 + 3 * y1 - y0) * (1.0f / 6.0f);
       }
     }
     // Gradients of the block's samples (and two on either side) for the splines.
@@ -444,16 +509,12 @@ std::uint64_t iso_ray(const SweepPlan& SP, const StaggeredGradients& G, const Is
         cr[l][a][2] = p0 - 2.5f * p1 + 2.0f * p2 - 0.5f * p3;
         cr[l][a][3] = 0.5f * (p3 - p0) + 1.5f * (p1 - p2);
       }
-    // The gradient at each hit (scalar: a segment's coefficients stay in registers), then the
-    // shading eight hits at a time.
-    for (int h = 0; h < nh; ++h) {
-      const float (*c)[4] = cr[sc.hl[std::size_t(h)]];
-      const float s = sc.hs[std::size_t(h)];
-      sc.gx[std::size_t(h)] = c[0][0] + s * (c[0][1] + s * (c[0][2] + s * c[0][3]));
-      sc.gy[std::size_t(h)] = c[1][0] + s * (c[1][1] + s * (c[1][2] + s * c[1][3]));
-      sc.gz[std::size_t(h)] = c[2][0] + s * (c[2][1] + s * (c[2][2] + s * c[2][3]));
-    }
-    shade_hits(sc, nh, dir, px);
+    // Each segment's hits placed, shaded and written (eight at a time: a segment's values,
+    // cubic and spline are the same for all its hits).
+    for (int l = l0; l < n; ++l)
+      if (seg_count[l] > 0)
+        place_hits(f, P, float(k0 + l - 1), vb[l], vb[l + 1], seg_count[l] >= kCubicHits ? cubic[l] : nullptr, cr[l],
+                   iso, &sc.hj[std::size_t(seg_first[l])], seg_count[l], dir, px);
     vb[0] = vb[n], ib[0] = ib[n];
     for (int a = 0; a < 3; ++a) g[a][0] = g[a][8], g[a][1] = g[a][9], g[a][2] = g[a][10];
     g_valid = true;

@@ -59,6 +59,16 @@ TEST(Sweep, IsovaluesMatchEachIsosurfaceAlone) {
   frames_against_alone(s, fields, tasks, 45, 64);
 }
 
+TEST(Sweep, ManyIsovaluesPerSegmentMatchEachIsosurfaceAlone) {
+  // 300 isovalues: a segment between two samples crosses several (up to dozens at the fronts), so
+  // their regula-falsi step takes the field from the segment's cubic, not from an interpolation per hit.
+  const SmallScene s;
+  std::vector<TaskSpec> tasks;
+  for (int j = 0; j < 300; ++j) tasks.push_back(TaskSpec::isosurface(0, float((-0.9 + 1.8 * j / 299) * s.ref)));
+  const std::vector<PreparedField> fields{PreparedField(s.view, MacroCells::kDefaultSize, FieldCopy::none)};
+  frames_against_alone(s, fields, tasks, 45, 64);
+}
+
 TEST(Sweep, WindowsMatchEachVolumeTaskAlone) {
   const SmallScene s;
   std::vector<TaskSpec> tasks;
