@@ -7,7 +7,9 @@
 // channel error and the pixels per image off by more than 8/255. Environment: PROBE_SPARSE=1 (two
 // fronts 2 voxels wide) or =thin (0.7 voxel) instead of the dense scene; PROBE_STEP (sample distance,
 // voxels); PROBE_LIN (RenderOptions::adaptive_linear_tolerance in 1/255); PROBE_ISO (an isosurface
-// task at 0.3 of the window as well: the hash then covers both images); PROBE_STRIDE (adaptive_stride). docs/rendering.md, Round 13.
+// task at 0.3 of the window as well: the hash then covers both images); PROBE_STRIDE (adaptive_stride);
+// PROBE_TOL (adaptive_tolerance in 1/255); PROBE_MC (macro-cell size).
+// docs/rendering.md, Rounds 13 and 21.
 
 #include <cmath>
 #include <cstdio>
@@ -43,7 +45,8 @@ int main(int argc, char** argv) {
   if (const char* s = std::getenv("PROBE_STRIDE")) opt_stride = std::atoi(s);
   if (std::getenv("PROBE_ISO")) tasks.push_back(TaskSpec::isosurface(0, float(0.3 * w)));  // a mixed march
   const std::vector<FieldView> views{view};
-  const std::vector<PreparedField> fields = prepare_fields(views, tasks);
+  const char* mc = std::getenv("PROBE_MC");
+  const std::vector<PreparedField> fields = prepare_fields(views, tasks, mc ? std::atoi(mc) : MacroCells::kDefaultSize);
   std::vector<PartialImage> out(tasks.size());
   RenderOptions opt;
   opt.sample_distance = 1.0;
@@ -51,6 +54,7 @@ int main(int argc, char** argv) {
   opt.adaptive_stride = opt_stride;
   if (const char* s = std::getenv("PROBE_STEP")) opt.sample_distance = std::atof(s);
   if (const char* s = std::getenv("PROBE_LIN")) opt.adaptive_linear_tolerance = float(std::atof(s) / 255);
+  if (const char* s = std::getenv("PROBE_TOL")) opt.adaptive_tolerance = float(std::atof(s) / 255);
   Image image;
   std::uint64_t hash = 1469598103934665603ull, rays = 0, marched = 0, samples = 0, interp = 0;
   double worst = 1e9, sum = 0;
