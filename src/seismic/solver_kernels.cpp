@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "seismic/denormals.hpp"
 #include "seismic/solver_impl.hpp"
 
 namespace panoptes::seismic {
@@ -438,11 +439,17 @@ void Solver::Impl::finish_exchange() {
 // arithmetic (and its order) is that of separate passes, so results do not depend on the order
 // of planes or on the decomposition.
 void Solver::Impl::step() {
+  // Subnormal values flushed to zero on every thread of the step (denormals.hpp: 2.2x faster early
+  // steps of the paper's run), the callers' modes restored after.
+  const FlushSubnormals flush;
   const double tv = nsteps * dt;          // σ^n: body forces act at t_n
   const double ts = (nsteps + 0.5) * dt;  // v^{n+½}: moment rates act at t_{n+½}
   if (size == 1) {
 #pragma omp parallel
-    sweep(0, nzl, 0, nzl, tv, ts);
+    {
+      const FlushSubnormals team;
+      sweep(0, nzl, 0, nzl, tv, ts);
+    }
   } else {
     // Rank-boundary velocity planes first; their halos travel while the interior is swept (the
     // interior stress planes 2 … nzl−3 need no velocity halo). The stress halos (6 fields × 2 planes)
@@ -452,15 +459,24 @@ void Solver::Impl::step() {
     for (int k : {0, 1, nzl - 2, nzl - 1})
       if (k >= 0 && k < nzl && std::find(edge.begin(), edge.end(), k) == edge.end()) edge.push_back(k);
 #pragma omp parallel
-    for (int k : edge) velocity_plane(k, tv);
+    {
+      const FlushSubnormals team;
+      for (int k : edge) velocity_plane(k, tv);
+    }
     start_exchange({&vx, &vy, &vz});
     if (nzl > 4) {
 #pragma omp parallel
-      sweep(2, nzl - 2, 2, nzl - 2, tv, ts);
+      {
+        const FlushSubnormals team;
+        sweep(2, nzl - 2, 2, nzl - 2, tv, ts);
+      }
     }
     finish_exchange();
 #pragma omp parallel
-    for (int k : edge) stress_plane(k, ts);
+    {
+      const FlushSubnormals team;
+      for (int k : edge) stress_plane(k, ts);
+    }
     start_exchange({&sxx, &syy, &szz, &sxy, &sxz, &syz});
     finish_exchange();
   }

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "seismic/denormals.hpp"
 #include "seismic/solver_impl.hpp"
 
 namespace panoptes::seismic {
@@ -88,52 +89,56 @@ void Solver::compute_derived() {
   const long Y = s.sy, Z = s.sz;
   const float ih = float(1.0 / s.h);
   const int nx = s.nx, ny = s.ny, nzl = s.nzl;
-#pragma omp parallel for collapse(2) schedule(static)
-  for (int k = 0; k < nzl; ++k)
-    for (int j = 0; j < ny; ++j) {
-      const std::size_t b = s.idx(0, j, k);
-      const float* __restrict ux = s.vx.data() + b;
-      const float* __restrict uy = s.vy.data() + b;
-      const float* __restrict uz = s.vz.data() + b;
-      float* __restrict pp = s.phip.data() + b;
-      float* __restrict ps = s.phis.data() + b;
-      // Only the rank owning the global planes 0 and 1 (slabs have >= 2 planes) has surface rows.
-      const int g = k + s.kb;
-      if (s.free_surface && g <= 1) {
-        const std::size_t r = std::size_t(k) * ny + j;
-        if (g == 1) derived_surface_row<2>(UniformMat{nullptr}, nx, Y, Z, ih, ux, uy, uz, pp, ps);
-        else if (const int u = s.row_mat[r]; u >= 0)
-          derived_surface_row<1>(UniformMat{s.mat_tuples.data() + std::size_t(u) * s.K}, nx, Y, Z, ih, ux, uy, uz, pp, ps);
-        else if (s.mat_table) derived_surface_row<1>(s.table_mat().row(b), nx, Y, Z, ih, ux, uy, uz, pp, ps);
-        else derived_surface_row<1>(s.dense_mat().row(b), nx, Y, Z, ih, ux, uy, uz, pp, ps);
-        continue;
-      }
-      auto d = [](const float* f, long i, long st) {  // forward staggered derivative at i + ½·st
-        return C1 * (f[i + st] - f[i]) + C2 * (f[i + 2 * st] - f[i - st]);
-      };
+#pragma omp parallel
+  {
+    const FlushSubnormals flush;  // as in step(): derivatives of tiny velocities can underflow
+#pragma omp for collapse(2) schedule(static)
+    for (int k = 0; k < nzl; ++k)
+      for (int j = 0; j < ny; ++j) {
+        const std::size_t b = s.idx(0, j, k);
+        const float* __restrict ux = s.vx.data() + b;
+        const float* __restrict uy = s.vy.data() + b;
+        const float* __restrict uz = s.vz.data() + b;
+        float* __restrict pp = s.phip.data() + b;
+        float* __restrict ps = s.phis.data() + b;
+        // Only the rank owning the global planes 0 and 1 (slabs have >= 2 planes) has surface rows.
+        const int g = k + s.kb;
+        if (s.free_surface && g <= 1) {
+          const std::size_t r = std::size_t(k) * ny + j;
+          if (g == 1) derived_surface_row<2>(UniformMat{nullptr}, nx, Y, Z, ih, ux, uy, uz, pp, ps);
+          else if (const int u = s.row_mat[r]; u >= 0)
+            derived_surface_row<1>(UniformMat{s.mat_tuples.data() + std::size_t(u) * s.K}, nx, Y, Z, ih, ux, uy, uz, pp, ps);
+          else if (s.mat_table) derived_surface_row<1>(s.table_mat().row(b), nx, Y, Z, ih, ux, uy, uz, pp, ps);
+          else derived_surface_row<1>(s.dense_mat().row(b), nx, Y, Z, ih, ux, uy, uz, pp, ps);
+          continue;
+        }
+        auto d = [](const float* f, long i, long st) {  // forward staggered derivative at i + ½·st
+          return C1 * (f[i + st] - f[i]) + C2 * (f[i + 2 * st] - f[i - st]);
+        };
 #pragma omp simd
-      for (int i = 0; i < nx; ++i) {
-        pp[i] = ih * (C1 * (ux[i] - ux[i - 1]) + C2 * (ux[i + 1] - ux[i - 2]) + C1 * (uy[i] - uy[i - Y]) +
-                      C2 * (uy[i + Y] - uy[i - 2 * Y]) + C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]));
-        // ωx = ∂y vz − ∂z vy on (0, ½, ½) edges, ωy = ∂z vx − ∂x vz on (½, 0, ½), ωz = ∂x vy − ∂y vx on (½, ½, 0);
-        // each averaged over the four edges around the node.
-        // Written out (not loops over offset lists) so that the i loop vectorizes; same terms, same order.
-        float wx = 0, wy = 0, wz = 0;
-        wx += d(uz, i, Y) - d(uy, i, Z);
-        wx += d(uz, i - Z, Y) - d(uy, i - Z, Z);
-        wx += d(uz, i - Y, Y) - d(uy, i - Y, Z);
-        wx += d(uz, i - Y - Z, Y) - d(uy, i - Y - Z, Z);
-        wy += d(ux, i, Z) - d(uz, i, 1);
-        wy += d(ux, i - Z, Z) - d(uz, i - Z, 1);
-        wy += d(ux, i - 1, Z) - d(uz, i - 1, 1);
-        wy += d(ux, i - 1 - Z, Z) - d(uz, i - 1 - Z, 1);
-        wz += d(uy, i, 1) - d(ux, i, Y);
-        wz += d(uy, i - Y, 1) - d(ux, i - Y, Y);
-        wz += d(uy, i - 1, 1) - d(ux, i - 1, Y);
-        wz += d(uy, i - 1 - Y, 1) - d(ux, i - 1 - Y, Y);
-        ps[i] = 0.25f * ih * std::sqrt(wx * wx + wy * wy + wz * wz);
+        for (int i = 0; i < nx; ++i) {
+          pp[i] = ih * (C1 * (ux[i] - ux[i - 1]) + C2 * (ux[i + 1] - ux[i - 2]) + C1 * (uy[i] - uy[i - Y]) +
+                        C2 * (uy[i + Y] - uy[i - 2 * Y]) + C1 * (uz[i] - uz[i - Z]) + C2 * (uz[i + Z] - uz[i - 2 * Z]));
+          // ωx = ∂y vz − ∂z vy on (0, ½, ½) edges, ωy = ∂z vx − ∂x vz on (½, 0, ½), ωz = ∂x vy − ∂y vx on (½, ½, 0);
+          // each averaged over the four edges around the node.
+          // Written out (not loops over offset lists) so that the i loop vectorizes; same terms, same order.
+          float wx = 0, wy = 0, wz = 0;
+          wx += d(uz, i, Y) - d(uy, i, Z);
+          wx += d(uz, i - Z, Y) - d(uy, i - Z, Z);
+          wx += d(uz, i - Y, Y) - d(uy, i - Y, Z);
+          wx += d(uz, i - Y - Z, Y) - d(uy, i - Y - Z, Z);
+          wy += d(ux, i, Z) - d(uz, i, 1);
+          wy += d(ux, i - Z, Z) - d(uz, i - Z, 1);
+          wy += d(ux, i - 1, Z) - d(uz, i - 1, 1);
+          wy += d(ux, i - 1 - Z, Z) - d(uz, i - 1 - Z, 1);
+          wz += d(uy, i, 1) - d(ux, i, Y);
+          wz += d(uy, i - Y, 1) - d(ux, i - Y, Y);
+          wz += d(uy, i - 1, 1) - d(ux, i - 1, Y);
+          wz += d(uy, i - 1 - Y, 1) - d(ux, i - 1 - Y, Y);
+          ps[i] = 0.25f * ih * std::sqrt(wx * wx + wy * wy + wz * wz);
+        }
       }
-    }
+  }
 }
 
 const std::vector<std::string>& Solver::field_names() {
