@@ -61,7 +61,10 @@ double cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-// Arg 0: 0 = examples/paper.toml, 1 = examples/demo.toml; arg 1: OpenMP threads.
+// Arg 0: 0 = examples/paper.toml, 1 = examples/demo.toml; arg 1: OpenMP threads; arg 2 (optional):
+// steps run before the timed ones (default 2). From the start the fields are zero and every step is
+// cheap; at step 200 of the paper's run the front has spread over half the grid and the values ahead of
+// it shrink through the subnormal range (seismic/denormals.hpp): the hard case of the run's first third.
 void BM_Run(benchmark::State& state) {
   const char* name = state.range(0) == 0 ? "paper" : "demo";
   const std::string path = std::string(PANOPTES_SOURCE_DIR) + "/examples/" + name + ".toml";
@@ -76,7 +79,7 @@ void BM_Run(benchmark::State& state) {
   const int threads = int(state.range(1));
   omp_set_num_threads(threads);
   Solver s(rc.solver);
-  s.run(2);  // first touch of the arrays
+  s.run(state.range(2) > 0 ? int(state.range(2)) : 2);  // first touch of the arrays (and the wavefield's start)
   s.compute_derived();  // and of phi_p, phi_s (allocated by the first call)
   const int steps = state.range(0) == 0 ? 4 : 40;
   double step_cpu = 0, step_wall = 0, der_cpu = 0, der_wall = 0;
@@ -100,11 +103,12 @@ void BM_Run(benchmark::State& state) {
   const int every = session.schedule.every_steps;
   state.counters["sim_cpu_s_per_snapshot"] = every * step_cpu / it / steps + der_cpu / it;
   state.counters["sim_wall_s_per_snapshot"] = every * step_wall / it / steps + der_wall / it;
-  state.SetLabel(std::string(name) + ".toml, " + std::to_string(threads) + " OpenMP thread(s)");
+  state.SetLabel(std::string(name) + ".toml, " + std::to_string(threads) + " OpenMP thread(s), timed from step " +
+                 std::to_string(s.steps_done() - int(it) * steps));
 }
 
 }  // namespace
 
-BENCHMARK(BM_Run)->Args({0, 2})->Args({0, 1})->Args({1, 2})->Args({1, 1})->Iterations(3)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_Run)->Args({0, 2, 0})->Args({0, 1, 0})->Args({1, 2, 0})->Args({1, 1, 0})->Args({0, 2, 200})->Iterations(3)->Unit(benchmark::kSecond)->UseRealTime();
 BENCHMARK(BM_Step)->Args({0, 1})->Args({0, 2})->Args({1, 1})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK_MAIN();
