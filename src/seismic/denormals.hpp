@@ -17,10 +17,11 @@ namespace panoptes::seismic {
 /// (the exception flags raised meanwhile are kept).
 /// Why: ahead of every wavefront the stencils spread values that shrink through the subnormal range
 /// (|x| < 1.2e-38), and on x86 each operation on one takes a microcode assist of ~100 cycles; early in
-/// the paper's run most of the grid is in that state (2.2x slower steps). Such values are far below
-/// what a float field resolves beside its signal (relative 1e-7); flushing them changes the fields only
-/// by rounding noise (docs/seismic.md, "Subnormal values"). Scoped, not process-wide: the solver is a library and the caller's own code keeps
-/// its mode. Construct one per thread (in each OpenMP parallel region), as the mode is per thread.
+/// the paper's run most of the grid is in that state (steps up to 3x slower). Such values are far
+/// below what a float field resolves beside its signal (relative 1e-7); flushing them changes the
+/// fields only by rounding noise (docs/seismic.md, "Subnormal values"). Scoped, not process-wide: the
+/// solver is a library and the caller's own code keeps its mode. Construct one per thread (in each
+/// OpenMP parallel region), as the mode is per thread.
 class FlushSubnormals {
  public:
   FlushSubnormals() noexcept {
