@@ -16,10 +16,12 @@ inline double process_cpu_seconds() {
 }
 
 /// Anchor camera i of 8: on the diagonals at 1.1x the domain diagonal, 30° view angle, 920x896.
-inline camera::Camera anchor_camera(const render::GridGeometry& g, int i) {
+/// `scale` shrinks the image (march_probe's PROBE_SCALE: fewer pixels per voxel).
+inline camera::Camera anchor_camera(const render::GridGeometry& g, int i, double scale = 1) {
   const Vec3 ext = g.domain_hi() - g.domain_lo();
   const Vec3 dir = normalize(Vec3{i & 1 ? 1.0 : -1.0, i & 2 ? 1.0 : -1.0, i & 4 ? 0.6 : -0.6});
-  return camera::Camera(g.centre() + dir * (1.1 * norm(ext)), g.centre(), {0, 0, 1}, 30, 920, 896);
+  return camera::Camera(g.centre() + dir * (1.1 * norm(ext)), g.centre(), {0, 0, 1}, 30, int(920 * scale),
+                        int(896 * scale));
 }
 
 }  // namespace panoptes::bench

@@ -8,7 +8,8 @@
 // fronts 2 voxels wide) or =thin (0.7 voxel) instead of the dense scene; PROBE_STEP (sample distance,
 // voxels); PROBE_LIN (RenderOptions::adaptive_linear_tolerance in 1/255); PROBE_ISO (an isosurface
 // task at 0.3 of the window as well: the hash then covers both images); PROBE_STRIDE (adaptive_stride);
-// PROBE_TOL (adaptive_tolerance in 1/255); PROBE_MC (macro-cell size).
+// PROBE_TOL (adaptive_tolerance in 1/255); PROBE_MC (macro-cell size); PROBE_TILE (adaptive_tile);
+// PROBE_SCALE (image size relative to 920x896).
 // docs/rendering.md, Rounds 13 and 21.
 
 #include <cmath>
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
   const FieldView view = FieldView::whole(grid, waves.p.data());
   const double w = abs_percentile(view, 0.999);
   int opt_stride = 4;
+  const double scale = std::getenv("PROBE_SCALE") ? std::atof(std::getenv("PROBE_SCALE")) : 1.0;
   std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, w))};
   if (const char* s = std::getenv("PROBE_STRIDE")) opt_stride = std::atoi(s);
   if (std::getenv("PROBE_ISO")) tasks.push_back(TaskSpec::isosurface(0, float(0.3 * w)));  // a mixed march
@@ -55,13 +57,14 @@ int main(int argc, char** argv) {
   if (const char* s = std::getenv("PROBE_STEP")) opt.sample_distance = std::atof(s);
   if (const char* s = std::getenv("PROBE_LIN")) opt.adaptive_linear_tolerance = float(std::atof(s) / 255);
   if (const char* s = std::getenv("PROBE_TOL")) opt.adaptive_tolerance = float(std::atof(s) / 255);
+  if (const char* s = std::getenv("PROBE_TILE")) opt.adaptive_tile = std::atoi(s);
   Image image;
   std::uint64_t hash = 1469598103934665603ull, rays = 0, marched = 0, samples = 0, interp = 0;
   double worst = 1e9, sum = 0;
   int maxerr = 0;
   long over8 = 0;
   for (int i = 0; i < 8; ++i) {
-    const camera::Camera cam = bench::anchor_camera(grid, i);
+    const camera::Camera cam = bench::anchor_camera(grid, i, scale);
     const RenderStats st = render_brick(cam, fields, tasks, out, opt);
     rays += st.rays, marched += st.marched_samples, samples += st.samples, interp += st.interpolated_pixels;
     for (const PartialImage& o : out)
@@ -93,7 +96,7 @@ int main(int argc, char** argv) {
   const double c0 = bench::process_cpu_seconds();
   for (int r = 0; r < rounds; ++r)
     for (int i = 0; i < 8; ++i) {
-      const camera::Camera cam = bench::anchor_camera(grid, i);
+      const camera::Camera cam = bench::anchor_camera(grid, i, scale);
       render_brick(cam, fields, tasks, out, opt);
       finish_image_into(out[0], cam, grid, image, {0, 0, 0}, OutlineStyle{false});
     }

@@ -32,6 +32,11 @@ struct RenderOptions {
   bool adaptive = false;
   int adaptive_stride = 4;               ///< coarse lattice spacing in pixels (>= 2), refined by halves
   float adaptive_tolerance = 4.0f / 255;  ///< largest corner range interpolated (4/255: Round 4 of docs/rendering.md)
+  /// Tile edge of adaptive perspective frames (`tile` is for frames marched pixel by pixel). Each
+  /// tile marches its own lattice's borders, so 16-pixel tiles marched 56 % more lattice rays than
+  /// the stride asks for; 64 marches 13 % more and cut the ParaView anchor's rays from 22.3 to 20.4 %
+  /// of its pixels (−9 % CPU, docs/rendering.md, Round 23).
+  int adaptive_tile = 64;
   /// A cell split at its midpoints whose new lattice points all lie within this of the bilinear
   /// interpolation of its four corners (every premultiplied channel) is filled without splitting
   /// further; not where isosurfaces, slices or maxima are split with the cell (their refinement, and

@@ -346,6 +346,31 @@ TEST(TileSchedule, ARowOfTilesWhileEveryThreadGetsSixteen) {
   EXPECT_EQ(tile_chunk(1, 1, 0), 1);
 }
 
+// Each adaptive tile marches its own lattice, borders included (tiles are independent), so the tile
+// edge sets how many rays a frame marches where nothing needs refining: a 128x128 frame from inside a
+// transparent field marches 4 tiles x 17 x 17 lattice points with the default 64-pixel tiles, and
+// 64 x 5 x 5 with 16-pixel tiles (56 % more than the stride's 32 x 32), which the anchor paid for.
+TEST(Renderer, AdaptiveTilesMarchOnlyTheirLatticeWhereNothingChanges) {
+  const GridGeometry grid{{24, 24, 24}, {0, 0, 0}, {1, 1, 1}};
+  const std::vector<float> zero(std::size_t(24 * 24 * 24), 0.0f);
+  const FieldView view = FieldView::whole(grid, zero.data());
+  const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1.0))};
+  const camera::Camera cam({12, 12, 12}, {30, 14, 11}, {0, 0, 1}, 60, 128, 128);  // inside: every ray meets the field
+  const std::vector<PreparedField> fields{PreparedField(view)};
+  RenderOptions opt;
+  opt.adaptive = true;
+  std::vector<PartialImage> out(1);
+  RenderStats st = render_brick(cam, fields, tasks, out, opt);
+  EXPECT_EQ(opt.adaptive_tile, 64);
+  EXPECT_EQ(st.rays, 4u * 17 * 17);
+  EXPECT_EQ(st.interpolated_pixels, 128u * 128 - st.rays);
+  opt.adaptive_tile = 16;
+  st = render_brick(cam, fields, tasks, out, opt);
+  EXPECT_EQ(st.rays, 64u * 5 * 5);
+  opt.adaptive_tile = 0;
+  EXPECT_THROW(render_brick(cam, fields, tasks, out, opt), Error);
+}
+
 // Tiles are independent, so how the threads share them cannot change an image: a dense adaptive
 // frame on one thread and on two (the OpenMP hand-out of tile_chunk()) has the same bits.
 TEST(Renderer, TheImageDoesNotDependOnTheThreads) {
@@ -353,7 +378,7 @@ TEST(Renderer, TheImageDoesNotDependOnTheThreads) {
   const DenseWaveScene waves = dense_wave_scene(grid);
   const FieldView view = FieldView::whole(grid, waves.p.data());
   const std::vector<TaskSpec> tasks{TaskSpec::volume(0, TransferFunction::preset("p-wave"), ValueWindow::absolute(0, 1.0))};
-  const camera::Camera cam({70, -40, 50}, {16, 24, 12}, {0, 0, 1}, 30, 230, 224);  // 15 x 14 tiles
+  const camera::Camera cam({70, -40, 50}, {16, 24, 12}, {0, 0, 1}, 30, 230, 224);  // 4 x 4 adaptive tiles
   RenderOptions opt;
   opt.adaptive = true;
   const int threads = omp_get_max_threads();
