@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   if (const char* s = std::getenv("PROBE_LIN")) opt.adaptive_linear_tolerance = float(std::atof(s) / 255);
   if (const char* s = std::getenv("PROBE_TOL")) opt.adaptive_tolerance = float(std::atof(s) / 255);
   if (const char* s = std::getenv("PROBE_TILE")) opt.adaptive_tile = std::atoi(s);
+  if (const char* s = std::getenv("PROBE_TERM")) opt.termination_alpha = float(std::atof(s));
   Image image;
   std::uint64_t hash = 1469598103934665603ull, rays = 0, marched = 0, samples = 0, interp = 0;
   double worst = 1e9, sum = 0;

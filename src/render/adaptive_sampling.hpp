@@ -4,7 +4,9 @@
 // the brick, every task's premultiplied RGBA within a tolerance) has its interior pixels filled by
 // bilinear interpolation, otherwise it is split at its midpoints (stride 4 → 2 → 1) and the new
 // lattice points are marched. The images of the in-situ paper settings carry 1.2–4 pixels per voxel,
-// so most of a smooth image is interpolated instead of marched.
+// so most of a smooth image is interpolated instead of marched. Two tests end a split early: a cell
+// whose first split's points are bilinear (linear()), and a 4x4 cell whose 3x3 points predict its
+// sub-cell centres by their biquadratic (quadratic(): a smooth but curved image, Round 23).
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -251,10 +253,95 @@ class AdaptiveTile {
     // Not where `follow` tasks are split with this cell: they are refined wherever any task is, and
     // would lose that refinement in the sub-cells of the tasks filled here.
     const std::uint64_t lin = linear_ > 0 && !(r & follow_) ? linear(x0, y0, x1, y1, xv, nx, yv, ny, r) : 0;
+    const std::uint64_t quad = linear_ > 0 && !(r & follow_) && (r & ~lin) && x1 - x0 == 4 && y1 - y0 == 4
+                                   ? quadratic(x0, y0, r & ~lin, march, locate)
+                                   : 0;
     for (int j = 0; j + 1 < ny; ++j)
       for (int i = 0; i + 1 < nx; ++i) {
         if (lin) fill(xv[i], yv[j], xv[i + 1], yv[j + 1], lin, march, locate);
-        if (r & ~lin) refine(xv[i], yv[j], xv[i + 1], yv[j + 1], r & ~lin, march, locate);
+        if (r & ~lin & ~quad) refine(xv[i], yv[j], xv[i + 1], yv[j + 1], r & ~lin & ~quad, march, locate);
+      }
+  }
+
+  // Lagrange weights of the nodes 0, 2, 4 at offset t = 0 … 4 of a 4-pixel cell.
+  static constexpr float kQuad[5][3] = {
+      {1, 0, 0}, {0.375f, 0.75f, -0.125f}, {0, 1, 0}, {-0.125f, 0.75f, 0.375f}, {0, 0, 1}};
+
+  // The biquadratic through a 4x4 cell's 3x3 lattice (corners, edge midpoints, centre) at offset (i, j).
+  static void biquadratic(const PartialImage& o, int x0, int y0, int i, int j, float* t) {
+    for (int k = 0; k < 4; ++k) t[k] = 0;
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a) {
+        const float w = kQuad[i][a] * kQuad[j][b];
+        if (w == 0) continue;
+        const float* q = o.rgba_at(x0 + 2 * a, y0 + 2 * b);
+        for (int k = 0; k < 4; ++k) t[k] += w * q[k];
+      }
+  }
+
+  // A 4x4 cell (the stride-4 lattice's) split at its midpoints whose new points are not bilinear
+  // for the tasks of `mask`: its level-two cells would march 12 more of its pixels for them. Where
+  // the image is smooth but curved, the biquadratic through the 3x3 points already marched predicts
+  // them; its four sub-cell centres are marched to check it, and the tasks (plain images) whose
+  // centres all lie within linear_ of it are filled from it (returned); the rest split further.
+  template <class March, class Locate>
+  std::uint64_t quadratic(int x0, int y0, std::uint64_t mask, March& march, Locate& locate) {
+    const PartialImage& o0 = out_[0];
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a)
+        if (depth(o0, x0 + 2 * a, y0 + 2 * b) == PartialImage::kNoDepth) return 0;
+    std::uint64_t plain = 0;
+    for (std::uint64_t m = mask & ~keyed_; m; m &= m - 1)
+      if (!out_[std::size_t(std::countr_zero(m))].slivers) plain |= m & -m;
+    if (!plain) return 0;
+    const int cx[4] = {1, 3, 1, 3}, cy[4] = {1, 1, 3, 3};
+    for (int c = 0; c < 4; ++c) {
+      mark_marched(x0 + cx[c], y0 + cy[c], plain, march);
+      if (depth(o0, x0 + cx[c], y0 + cy[c]) == PartialImage::kNoDepth) return 0;
+    }
+    std::uint64_t ok = 0;
+    for (std::uint64_t m = plain; m; m &= m - 1) {
+      const PartialImage& o = out_[std::size_t(std::countr_zero(m))];
+      bool good = true;
+      for (int c = 0; c < 4 && good; ++c) {
+        float t[4];
+        biquadratic(o, x0, y0, cx[c], cy[c], t);
+        const float* q = o.rgba_at(x0 + cx[c], y0 + cy[c]);
+        for (int k = 0; k < 4; ++k)
+          if (q[k] - t[k] > linear_ || q[k] - t[k] < -linear_) good = false;
+      }
+      if (good) ok |= m & -m;
+    }
+    if (ok) fill_quadratic(x0, y0, ok, march, locate);
+    return ok;
+  }
+
+  // The cell's pixels not marched for the tasks of `mask` from the biquadratic (quadratic()); a pixel
+  // whose exact hit/miss status is a miss is marched instead, as in fill().
+  template <class March, class Locate>
+  void fill_quadratic(int x0, int y0, std::uint64_t mask, March& march, Locate& locate) {
+    std::uint8_t face = face_[at(x0, y0)];
+    if (face_[at(x0 + 4, y0)] != face || face_[at(x0, y0 + 4)] != face || face_[at(x0 + 4, y0 + 4)] != face) face = 0;
+    for (int j = 0; j <= 4; ++j)
+      for (int i = 0; i <= 4; ++i) {
+        const int x = x0 + i, y = y0 + j;
+        const std::size_t p = at(x, y);
+        const std::uint64_t pending = mask & ~marched_for_[p];
+        if (!pending) continue;
+        const float d = locate(x, y, face);
+        if (d == PartialImage::kNoDepth) {
+          mark_marched(x, y, pending, march);
+          continue;
+        }
+        filled_[p] = 1;
+        for (std::uint64_t m = pending; m; m &= m - 1) {
+          PartialImage& o = out_[std::size_t(std::countr_zero(m))];
+          float t[4];
+          biquadratic(o, x0, y0, i, j, t);
+          std::copy_n(t, 4, o.rgba_at(x, y));
+        }
+        for (std::size_t k = 0; k < out_.size(); ++k)
+          if (!(keyed_ >> k & 1)) out_[k].depth[out_[k].index(x, y)] = d;
       }
   }
 

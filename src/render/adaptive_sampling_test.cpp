@@ -20,11 +20,15 @@ constexpr int kW = 32, kH = 32;
 struct Scene {
   std::vector<PartialImage> out = std::vector<PartialImage>(2);
   int marches = 0;
-  bool step = false;  // a jump in image 0 at x >= 21
+  bool step = false;    // a jump in image 0 at x >= 21
+  bool curved = false;  // image 0 a quadratic in x and y instead of the ramp
   Scene() {
     for (PartialImage& o : out) o.resize(kW, kH, {0, 0, kW, kH});
   }
-  float ramp(int x, int y) const { return step && x >= 21 ? 0.9f : 0.01f * float(x) + 0.005f * float(y); }
+  float ramp(int x, int y) const {
+    if (curved) return 0.1f + 0.0004f * float(x * x) + 0.0003f * float(y * y) + 0.00002f * float(x * x * y);
+    return step && x >= 21 ? 0.9f : 0.01f * float(x) + 0.005f * float(y);
+  }
   // Image 0: an opaque ramp at entry depth 5; image 1 (keyed): a constant colour, key −(x + y).
   std::uint8_t march(int x, int y, std::uint64_t tasks) {
     ++marches;
@@ -95,4 +99,28 @@ TEST(AdaptiveSampling, ALinearRampStopsTheSplitOneLevelUp) {
   jump.run(0.02f, 0.01f);
   for (int y = 0; y < kH; ++y)
     for (int x = 18; x < 24; ++x) ASSERT_NEAR(jump.out[0].rgba_at(x, y)[0], jump.ramp(x, y), 1e-5f) << x << "," << y;
+}
+
+// A curved but smooth image (a quadratic in x and in y) fails the linear test in every cell; the
+// biquadratic through a 4x4 cell's 3x3 marched points reproduces it, its four sub-cell centres
+// (marched to check it) agree, and the cell is filled from it: 9 of its 16 inner pixels' marches
+// instead of all, and the same values. A jump still fails the check and is refined.
+TEST(AdaptiveSampling, ACurvedSmoothCellIsFilledFromItsBiquadratic) {
+  Scene pixels, quad;
+  pixels.curved = quad.curved = true;
+  pixels.run(0.0f, 0);     // every cell split to its pixels: every pixel marched
+  quad.run(0.0f, 1e-4f);  // the bilinear misses the curvature by >= 0.0016 at the midpoints
+  EXPECT_EQ(pixels.marches, kW * kH);
+  // The tile's last lattice cells are 3 pixels wide ({…, 28, 31}): those split to their pixels.
+  EXPECT_LT(quad.marches, 2 * kW * kH / 3) << quad.marches;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      ASSERT_NEAR(quad.out[0].rgba_at(x, y)[0], quad.ramp(x, y), 2e-5f) << x << "," << y;
+      EXPECT_EQ(quad.out[0].depth[std::size_t(y) * kW + std::size_t(x)], 5.0f);
+    }
+  Scene jump;
+  jump.step = true;
+  jump.run(0.0f, 1e-4f);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 16; x < 28; ++x) ASSERT_NEAR(jump.out[0].rgba_at(x, y)[0], jump.ramp(x, y), 1e-5f) << x << "," << y;
 }
