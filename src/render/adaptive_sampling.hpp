@@ -74,6 +74,23 @@ class Silhouette {
   double x_[8] = {}, y_[8] = {};
 };
 
+namespace adaptive_detail {
+// The bilinear blend of four corner colours, for AdaptiveTile's fill() and fill_one(): both must give
+// the same bits (a K-task march's image is its one-task image). Left to itself the compiler fuses
+// some products into the sums and not others, and may do so differently in the two functions (it
+// did, by an ulp, in a variant of fill_one()), so where the target has a fused multiply-add the
+// chain of fusions is written out; without one nothing can be fused. Internal linkage: the renderer and a
+// test built with other instruction sets each keep their own.
+[[maybe_unused]] static inline void bilerp(float w00, float w10, float w01, float w11, const float* a, const float* b,
+                                           const float* c, const float* e, float* t) {
+#ifdef FP_FAST_FMAF
+  for (int k = 0; k < 4; ++k) t[k] = std::fma(w11, e[k], std::fma(w01, c[k], std::fma(w10, b[k], w00 * a[k])));
+#else
+  for (int k = 0; k < 4; ++k) t[k] = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k];
+#endif
+}
+}  // namespace adaptive_detail
+
 /// Refines one tile of a brick's partial images. All K tasks of a march (K ≤ 64) share the coarse
 /// lattice, marched once for all of them; every refinement decision is then taken per task (a cell
 /// is split for the tasks whose corners disagree and filled for the others), and the points of a
@@ -130,8 +147,8 @@ class AdaptiveTile {
     out_ = out;
     const std::uint64_t all = out.size() == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << out.size()) - 1;
     const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
+    const std::uint64_t marched_before = marched_;
     marched_for_.assign(n, 0);
-    filled_.assign(n, 0);
     face_.resize(n);  // read only at pixels marched for some task
     // The coarse lattice: the tile's borders and the multiples of the stride between them.
     xs_.clear();
@@ -143,7 +160,9 @@ class AdaptiveTile {
     for (std::size_t j = 0; j + 1 < ys_.size(); ++j)
       for (std::size_t i = 0; i + 1 < xs_.size(); ++i)
         refine(xs_[i], ys_[j], xs_[i + 1], ys_[j + 1], all, march, locate);
-    for (std::size_t i = 0; i < n; ++i) interpolated_ += filled_[i] && !marched_for_[i];
+    // Every pixel of the tile is marched (for some task) or filled (for all): the lattice and its
+    // cells cover the tile, and a cell is filled, split or marched whole.
+    interpolated_ += n - (marched_ - marched_before);
   }
 
  private:
@@ -333,7 +352,6 @@ class AdaptiveTile {
           mark_marched(x, y, pending, march);
           continue;
         }
-        filled_[p] = 1;
         for (std::uint64_t m = pending; m; m &= m - 1) {
           PartialImage& o = out_[std::size_t(std::countr_zero(m))];
           float t[4];
@@ -384,13 +402,6 @@ class AdaptiveTile {
     return lin;
   }
 
-  // The bilinear blend of four corner colours: one expression for fill() and fill_one(), so both
-  // give the same bits (the compiler contracts it the same way in both).
-  static void bilerp(float w00, float w10, float w01, float w11, const float* a, const float* b, const float* c,
-                     const float* e, float* t) {
-    for (int k = 0; k < 4; ++k) t[k] = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * e[k];
-  }
-
   // fill() for the common march of one plain image (one task, no slivers, no order key): the same
   // decisions and values without the per-task masks and tables, whose spills cost more than the
   // blend itself (a filled pixel cost ~70 cycles in fill() on the ParaView anchor).
@@ -416,12 +427,11 @@ class AdaptiveTile {
           mark_marched(x, y, 1, march);
           continue;
         }
-        filled_[p0 + dx] = 1;
         if (hit) {
           const float u = float(x - x0) * sx;
           const float w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
           float t[4];
-          bilerp(w00, w10, w01, w11, a, b, c, e, t);
+          adaptive_detail::bilerp(w00, w10, w01, w11, a, b, c, e, t);
           std::copy_n(t, 4, row + 4 * dx);
         } else {
           std::fill_n(row + 4 * dx, 4, 0.0f);
@@ -469,7 +479,6 @@ class AdaptiveTile {
           mark_marched(x, y, pending, march);
           continue;
         }
-        filled_[p] = 1;
         const std::size_t dx = std::size_t(x - x0);
         if (hit) {
           const float u = float(x - x0) * sx;
@@ -480,7 +489,7 @@ class AdaptiveTile {
             // Into a local first: the corners may be this image's pixels, so the compiler could not
             // take the four channels at once.
             float t[4];
-            bilerp(w00, w10, w01, w11, a, b, c, e, t);
+            adaptive_detail::bilerp(w00, w10, w01, w11, a, b, c, e, t);
             std::copy_n(t, 4, row[i] + 4 * dx);
             if (PartialImage& o = out_[i]; o.slivers) {  // the corners' end state agrees (rough())
               const float *oa = &o.rgba_open[4 * o.index(x0, y0)], *ob = &o.rgba_open[4 * o.index(x1, y0)],
@@ -523,7 +532,6 @@ class AdaptiveTile {
   std::span<PartialImage> out_;
   const Silhouette* silhouette_ = nullptr;
   std::vector<std::uint64_t> marched_for_;  // per pixel of the tile: the tasks it was marched for
-  std::vector<std::uint8_t> filled_;        // per pixel: interpolated for some task
   std::vector<std::uint8_t> face_;          // per pixel: march()'s entry face
   std::vector<int> xs_, ys_;
   std::uint64_t marched_ = 0, interpolated_ = 0;
