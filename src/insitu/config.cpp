@@ -398,7 +398,8 @@ const char* config_keys_help() {
             adaptive = true (image-space adaptive sampling: march every 4th pixel, interpolate where the
             corners agree within adaptive_tolerance = 4 (units of 1/255), refine elsewhere, and stop
             refining where the first split's new points lie within adaptive_linear_tolerance = 2 of
-            the bilinear image of its corners, 0 = never; false = march every pixel);
+            the bilinear image of its corners, or a 4x4 cell's sub-cell centres within it of the
+            biquadratic through its 3x3 points, 0 = never; false = march every pixel);
             equirect_adaptive = true (360° frames: that sampling on the sphere, a lattice about 1.5°
             apart whose columns widen toward the poles, whatever adaptive says; false = every pixel);
             equirect_tolerance = 11 (360° frames: the largest corner range interpolated, units of 1/255)

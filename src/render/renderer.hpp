@@ -35,14 +35,17 @@ struct RenderOptions {
   /// Tile edge of adaptive perspective frames (`tile` is for frames marched pixel by pixel). Each
   /// tile marches its own lattice's borders, so 16-pixel tiles marched 56 % more lattice rays than
   /// the stride asks for; 64 marches 13 % more and cut the ParaView anchor's rays from 22.3 to 20.4 %
-  /// of its pixels (−9 % CPU, docs/rendering.md, Round 23).
+  /// of its pixels (−9 % CPU, docs/rendering.md, Round 23). Larger tiles share a frame's work among
+  /// the threads more coarsely.
   int adaptive_tile = 64;
   /// A cell split at its midpoints whose new lattice points all lie within this of the bilinear
   /// interpolation of its four corners (every premultiplied channel) is filled without splitting
   /// further; not where isosurfaces, slices or maxima are split with the cell (their refinement, and
   /// so every image of such a march, stays as without it); 0: off. 2/255 (Round 13
   /// of docs/rendering.md): the dense anchor marches 22 % of its rays instead of 32 % (−17 % CPU) at
-  /// 59.8 instead of 60.7 dB of the full march, max error 8/255 instead of 7. Perspective frames only.
+  /// 59.8 instead of 60.7 dB of the full march, max error 8/255 instead of 7. A 4x4 cell that fails it
+  /// is filled from the biquadratic through its 3x3 points where its four sub-cell centres lie within
+  /// this of it (Round 23: the anchor's rays 20.4 → 17.1 % of the pixels). Perspective frames only.
   float adaptive_linear_tolerance = 2.0f / 255;
   /// Equirectangular cameras: adaptive sampling on the sphere (render/equirect_sampling.hpp) whatever
   /// `adaptive` says — 64×32-pixel tiles (`tile` does not apply), a coarse lattice of rows about
