@@ -177,6 +177,12 @@ class AdaptiveTile {
   float depth(const PartialImage& o, int x, int y) const {
     return o.depth[std::size_t(y - o.rect.y0) * std::size_t(o.rect.width()) + std::size_t(x - o.rect.x0)];
   }
+  // The entry face shared by the four corners of a cell whose corners hit, 0 when they differ: every
+  // pixel of the cell then enters through it too (see the class comment), so locate() may use it.
+  std::uint8_t cell_face(int x0, int y0, int x1, int y1) const {
+    const std::uint8_t face = face_[at(x0, y0)];
+    return face_[at(x1, y0)] == face && face_[at(x0, y1)] == face && face_[at(x1, y1)] == face ? face : 0;
+  }
   // Marches pixel (x, y) for the tasks of `mask` it was not marched for yet.
   template <class March>
   void mark_marched(int x, int y, std::uint64_t mask, March& march) {
@@ -339,8 +345,7 @@ class AdaptiveTile {
   // whose exact hit/miss status is a miss is marched instead, as in fill().
   template <class March, class Locate>
   void fill_quadratic(int x0, int y0, std::uint64_t mask, March& march, Locate& locate) {
-    std::uint8_t face = face_[at(x0, y0)];
-    if (face_[at(x0 + 4, y0)] != face || face_[at(x0, y0 + 4)] != face || face_[at(x0 + 4, y0 + 4)] != face) face = 0;
+    const std::uint8_t face = cell_face(x0, y0, x0 + 4, y0 + 4);  // its nine points hit (quadratic())
     for (int j = 0; j <= 4; ++j)
       for (int i = 0; i <= 4; ++i) {
         const int x = x0 + i, y = y0 + j;
@@ -448,8 +453,7 @@ class AdaptiveTile {
   void fill(int x0, int y0, int x1, int y1, std::uint64_t mask, March& march, Locate& locate) {
     const bool hit = depth(out_[0], x0, y0) != PartialImage::kNoDepth;
     // All four corners entered through one plane: the interior did too (see the class comment).
-    std::uint8_t face = face_[at(x0, y0)];
-    if (!hit || face_[at(x1, y0)] != face || face_[at(x0, y1)] != face || face_[at(x1, y1)] != face) face = 0;
+    const std::uint8_t face = hit ? cell_face(x0, y0, x1, y1) : 0;
     // Four misses well outside the brick's silhouette: no pixel between them can hit.
     const bool outside = !hit && silhouette_ && silhouette_->excludes(x0, y0, x1, y1);
     if (out_.size() == 1 && !keyed_ && !out_[0].slivers) return fill_one(x0, y0, x1, y1, hit, face, outside, march, locate);
